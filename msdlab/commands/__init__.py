@@ -1,0 +1,5 @@
+"""Sub-commands of the ``msdlab`` command line; each module has ``register(subparsers)``."""
+
+from . import demo
+
+COMMANDS = [demo]

@@ -1,0 +1,202 @@
+"""Constraints: rules applied after each integrator step (floor, drag, walls, driven particles).
+
+A constraint edits the new positions and velocities in place and returns the
+energy it removed (J; negative when it put energy in) for the energy ledger.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from .body import Body
+from .errors import check_non_negative
+
+
+@dataclass
+class StepState:
+    """The end of a step, as constraints see it (edit ``x`` and ``v`` in place)."""
+
+    body: Body
+    x_old: np.ndarray  # positions at the start of the step (m)
+    x: np.ndarray  # new positions (m)
+    v: np.ndarray  # new velocities (m/s)
+    time: float  # time at the end of the step (s)
+    dt: float  # step (s)
+    energy_of: Callable[[np.ndarray], float]  # energy (J) involving these particles now
+
+
+class Constraint(ABC):
+    """A rule applied after each integrator step; see the module docstring."""
+
+    ledger_name = "other"
+
+    def check(self, body: Body) -> None:
+        """Raise ValueError if this constraint cannot act on ``body``."""
+
+    @abstractmethod
+    def apply(self, state: StepState) -> float:
+        """Edit ``state.x``/``state.v``; return the energy removed (J)."""
+
+
+class Ground(Constraint):
+    """The template's floor: particles that end a step below the plane are put back on it.
+
+    Fixed particles are left where they are. The plane holds the points p with
+    p·normal = height (normal defaults to +y,
+    the brief's floor y = 0; use ``normal=(0, 0, 1)`` for z-up scenes). A clamped
+    particle keeps its tangential velocity (times 1 - ``friction``) and its
+    normal velocity becomes the displacement it really made over the step / dt,
+    which is what position Verlet implies: no bounce, no sticking.
+    """
+
+    ledger_name = "ground"
+
+    def __init__(
+        self, height: float = 0.0, normal: Sequence[float] | None = None, friction: float = 0.0
+    ) -> None:
+        self.height = float(height)
+        self.normal = None if normal is None else np.asarray(normal, dtype=float)
+        if self.normal is not None:
+            length = np.linalg.norm(self.normal)
+            if self.normal.ndim != 1 or not np.isfinite(length) or length == 0:
+                raise ValueError(f"ground normal must be a non-zero vector, got {normal!r}")
+            self.normal = self.normal / length
+        check_non_negative("ground friction", friction)
+        if friction > 1:
+            raise ValueError(f"ground friction is a fraction in [0, 1], got {friction}")
+        self.friction = float(friction)
+
+    def _normal(self, body: Body) -> np.ndarray:
+        if self.normal is None:
+            return np.eye(body.dim)[1]
+        return self.normal
+
+    def check(self, body: Body) -> None:
+        if len(self._normal(body)) != body.dim:
+            raise ValueError(
+                f"ground normal has {len(self._normal(body))} components but the body is "
+                f"{body.dim}-D"
+            )
+
+    def apply(self, state: StepState) -> float:
+        n = self._normal(state.body)
+        depth = self.height - state.x @ n
+        below = np.flatnonzero((depth > 0) & ~state.body.fixed)
+        if len(below) == 0:
+            return 0.0
+        before = state.energy_of(below)
+        x, v = state.x, state.v
+        x[below] += depth[below, None] * n
+        normal_speed = (x[below] - state.x_old[below]) @ n / state.dt
+        tangential = v[below] - (v[below] @ n)[:, None] * n
+        v[below] = (1.0 - self.friction) * tangential + normal_speed[:, None] * n
+        return before - state.energy_of(below)
+
+    def __repr__(self) -> str:
+        return f"Ground(height={self.height:g}, normal={self.normal}, friction={self.friction:g})"
+
+
+class Drag(Constraint):
+    """Air drag solved exactly over each step: v ← v·exp(-rate·dt), rate in 1/s.
+
+    Being the exact solution of dv/dt = -rate·v it is stable at any dt (unlike
+    the force -c·v, see `ViscousDamping`).
+    """
+
+    ledger_name = "drag"
+
+    def __init__(self, rate: float) -> None:
+        check_non_negative("drag rate", rate, "The drag rate is in 1/s.")
+        self.rate = float(rate)
+
+    def apply(self, state: StepState) -> float:
+        factor = math.exp(-self.rate * state.dt)
+        kinetic = 0.5 * np.sum(state.body.masses * np.einsum("ij,ij->i", state.v, state.v))
+        state.v *= factor
+        return float(kinetic * (1.0 - factor * factor))
+
+    def __repr__(self) -> str:
+        return f"Drag(rate={self.rate:g})"
+
+
+class Walls(Constraint):
+    """A box [lower, upper] per axis: ``"reflect"`` bounces particles back, ``"periodic"`` wraps.
+
+    Periodic wrapping moves a particle across the box but not its springs, which
+    then stretch across the whole box (as on the p5.js page); use it for loose
+    particles, not for connected bodies.
+    """
+
+    ledger_name = "walls"
+
+    def __init__(
+        self, lower: Sequence[float], upper: Sequence[float], mode: str = "reflect"
+    ) -> None:
+        self.lower = np.asarray(lower, dtype=float)
+        self.upper = np.asarray(upper, dtype=float)
+        if self.lower.shape != self.upper.shape or np.any(self.lower >= self.upper):
+            raise ValueError(f"walls need lower < upper per axis, got {lower!r} and {upper!r}")
+        if mode not in ("reflect", "periodic"):
+            raise ValueError(f"wall mode must be 'reflect' or 'periodic', got {mode!r}")
+        self.mode = mode
+
+    def check(self, body: Body) -> None:
+        if len(self.lower) != body.dim:
+            raise ValueError(f"walls have {len(self.lower)} axes but the body is {body.dim}-D")
+
+    def apply(self, state: StepState) -> float:
+        x, v = state.x, state.v
+        outside = np.any((x < self.lower) | (x > self.upper), axis=1)
+        outside = np.flatnonzero(outside & ~state.body.fixed)
+        if len(outside) == 0:
+            return 0.0
+        before = state.energy_of(outside)
+        if self.mode == "periodic":
+            x[outside] = self.lower + np.mod(x[outside] - self.lower, self.upper - self.lower)
+        else:
+            low, high = x[outside] < self.lower, x[outside] > self.upper
+            x[outside] = np.clip(x[outside], self.lower, self.upper)
+            v[outside] = np.where(
+                low, np.abs(v[outside]), np.where(high, -np.abs(v[outside]), v[outside])
+            )
+        return before - state.energy_of(outside)
+
+    def __repr__(self) -> str:
+        return f"Walls({self.lower.tolist()}, {self.upper.tolist()}, mode={self.mode!r})"
+
+
+class Prescribed(Constraint):
+    """Particles moved along a given path: x_p(t) = path(t) (an (M, d) array, m).
+
+    The particles are marked fixed so no force moves them; their velocity is
+    the displacement over the step / dt, so dashpots and the ledger see it.
+    The energy they put in is booked (negative) under "driven".
+    """
+
+    ledger_name = "driven"
+
+    def __init__(self, particles: Sequence[int], path: Callable[[float], np.ndarray]) -> None:
+        self.particles = np.atleast_1d(np.asarray(particles, dtype=np.int64))
+        self.path = path
+
+    def check(self, body: Body) -> None:
+        if np.any((self.particles < 0) | (self.particles >= len(body))):
+            raise ValueError(
+                f"prescribed particles {self.particles.tolist()} must be indices below {len(body)}"
+            )
+        body.fixed[self.particles] = True
+
+    def apply(self, state: StepState) -> float:
+        p = self.particles
+        before = state.energy_of(p)
+        target = np.broadcast_to(
+            np.asarray(self.path(state.time), dtype=float), (len(p), state.body.dim)
+        )
+        state.x[p] = target
+        state.v[p] = (target - state.x_old[p]) / state.dt
+        return before - state.energy_of(p)

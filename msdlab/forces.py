@@ -1,0 +1,159 @@
+"""External forces: each adds its force on every particle to a (N, d) array."""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Sequence
+
+import numpy as np
+import scipy.sparse as sp
+
+from .body import Body
+from .errors import check_non_negative, check_positive
+
+
+class Force(ABC):
+    """A force field acting on the particles of a body.
+
+    `add_to` adds the force (N) to ``out``; conservative forces also give their
+    potential energy, and forces that depend on x or v may give their Jacobians
+    (used by `ImplicitEuler`).
+    """
+
+    def check(self, body: Body) -> None:
+        """Raise ValueError if this force cannot act on ``body`` (e.g. wrong dimension)."""
+
+    @abstractmethod
+    def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        """Add this force on each particle (N, d) in N to ``out``."""
+
+    def potential_energy(
+        self, body: Body, x: np.ndarray, particles: np.ndarray | None = None
+    ) -> float:
+        """Potential energy (J) of this force, or of the terms involving ``particles``."""
+        return 0.0
+
+    def jacobians(
+        self, body: Body, x: np.ndarray, v: np.ndarray
+    ) -> tuple[sp.spmatrix | None, sp.spmatrix | None]:
+        """∂F/∂x and ∂F/∂v (N·d square, sparse), None where zero or left explicit."""
+        return None, None
+
+
+class Gravity(Force):
+    """Uniform gravity: F = m g on every particle; g in m/s², e.g. (0, -9.81, 0)."""
+
+    def __init__(self, g: Sequence[float] = (0.0, -9.81, 0.0)) -> None:
+        self.g = np.asarray(g, dtype=float)
+        if self.g.ndim != 1 or len(self.g) not in (2, 3) or not np.all(np.isfinite(self.g)):
+            raise ValueError(f"gravity must be a finite 2- or 3-vector in m/s², got {g!r}")
+
+    def check(self, body: Body) -> None:
+        _check_dim("Gravity g", self.g, body)
+
+    def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        out += body.masses[:, None] * self.g
+
+    def potential_energy(
+        self, body: Body, x: np.ndarray, particles: np.ndarray | None = None
+    ) -> float:
+        """-Σ m g·x (J), zero at the origin."""
+        pick = slice(None) if particles is None else particles
+        return float(-np.sum(body.masses[pick] * (x[pick] @ self.g)))
+
+    def __repr__(self) -> str:
+        return f"Gravity({self.g.tolist()})"
+
+
+class ViscousDamping(Force):
+    """Linear drag F = -c v on every particle, c in N·s/m (the cloth seed's λ).
+
+    Under explicit integrators it is stable only for c·dt/m < 2; `Drag` is the
+    version that is stable at any dt.
+    """
+
+    def __init__(self, coefficient: float) -> None:
+        check_non_negative("viscous damping coefficient", coefficient)
+        self.coefficient = float(coefficient)
+
+    def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        out -= self.coefficient * v
+
+    def jacobians(self, body: Body, x: np.ndarray, v: np.ndarray) -> tuple[None, sp.spmatrix]:
+        return None, -self.coefficient * sp.identity(x.size, format="csr")
+
+    def __repr__(self) -> str:
+        return f"ViscousDamping({self.coefficient:g})"
+
+
+class SphereContact(Force):
+    """A ball that pushes particles out of it with a penalty spring.
+
+    The ball is particle ``center`` of the body (so it has a mass, moves, and
+    feels the reaction): every other particle p inside the ball, at depth
+    δ = radius - |x_p - x_c| > 0, gets f = stiffness·δ·n (n from the centre to p)
+    and the ball gets -f, so contact forces are equal and opposite.
+    A fixed ``center`` makes a still obstacle.
+    """
+
+    def __init__(
+        self, center: int, radius: float, stiffness: float, particles: Sequence[int] | None = None
+    ) -> None:
+        self.center = int(center)
+        self.radius = check_positive("sphere radius", radius, "The ball radius is in m.")
+        self.stiffness = check_positive("contact stiffness", stiffness, "It is in N/m.")
+        self.particles = None if particles is None else np.asarray(particles, dtype=np.int64)
+
+    def check(self, body: Body) -> None:
+        if not 0 <= self.center < len(body):
+            raise ValueError(
+                f"sphere centre particle {self.center} does not exist: the body has "
+                f"{len(body)} particles"
+            )
+
+    def _others(self, body: Body) -> np.ndarray:
+        if self.particles is None:
+            others = np.arange(len(body))
+            return others[others != self.center]
+        return self.particles[self.particles != self.center]
+
+    def _depths(self, body: Body, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        others = self._others(body)
+        d = x[others] - x[self.center]
+        distance = np.sqrt(np.einsum("ij,ij->i", d, d))
+        inside = distance < self.radius
+        return others[inside], d[inside], distance[inside]
+
+    def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+        touched, d, distance = self._depths(body, x)
+        if len(touched) == 0:
+            return
+        depth = self.radius - distance
+        direction = d / np.where(distance > 0, distance, np.inf)[:, None]
+        f = (self.stiffness * depth)[:, None] * direction
+        np.add.at(out, touched, f)
+        out[self.center] -= f.sum(axis=0)
+
+    def potential_energy(
+        self, body: Body, x: np.ndarray, particles: np.ndarray | None = None
+    ) -> float:
+        """Σ ½ stiffness δ² over particles inside the ball (J)."""
+        touched, _, distance = self._depths(body, x)
+        energy = 0.5 * self.stiffness * (self.radius - distance) ** 2
+        if particles is not None and self.center not in particles:
+            energy = energy[np.isin(touched, particles)]
+        return float(energy.sum())
+
+    def __repr__(self) -> str:
+        return (
+            f"SphereContact(center={self.center}, radius={self.radius:g}, "
+            f"stiffness={self.stiffness:g})"
+        )
+
+
+def _check_dim(name: str, vector: np.ndarray, body: Body) -> None:
+    if len(vector) != body.dim:
+        raise ValueError(
+            f"{name} has {len(vector)} components but the body is {body.dim}-D; "
+            f"give {body.dim} components"
+        )

@@ -1,0 +1,265 @@
+"""Simulation: steps a body in time and records what happened."""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import kernels
+from .body import Body
+from .constraints import Constraint, StepState
+from .dynamics import Dynamics
+from .energy import EnergyLedger, kinetic_energy
+from .errors import SimulationDiverged, check_finite_array, check_positive
+from .forces import Force
+from .integrators import Integrator, Verlet
+from .stability import diagnose_divergence
+
+
+@dataclass
+class Trajectory:
+    """Frames recorded by `Simulation.run`: ``times`` (F,) s, ``positions`` (F, N, d) m,
+    ``velocities`` (F, N, d) m/s or None, ``steps`` (F,) and the ``energies`` ledger."""
+
+    body: Body
+    dt: float
+    steps: np.ndarray
+    times: np.ndarray
+    positions: np.ndarray
+    velocities: np.ndarray | None
+    energies: EnergyLedger
+
+    def __len__(self) -> int:
+        return len(self.times)
+
+
+class Simulation:
+    """A body, an integrator, a time step ``dt`` (s) and the forces acting on it.
+
+    ``forces`` holds `Force` objects (gravity, contact, ...) and `Constraint`
+    objects (ground, drag, walls, ...), applied in the given order after each
+    integrator step. Each step pins the fixed particles, keeps an energy
+    ledger, and raises `SimulationDiverged` in the step where the state stops
+    being finite or a spring is stretched past ``max_stretch`` times its rest length.
+    """
+
+    def __init__(
+        self,
+        body: Body,
+        integrator: Integrator | None = None,
+        dt: float = 1e-3,
+        forces: Sequence[Force | Constraint] = (),
+        *,
+        max_stretch: float | None = 100.0,
+    ) -> None:
+        if not isinstance(body, Body):
+            raise TypeError(f"Simulation needs a msdlab.Body, got {type(body).__name__}")
+        if len(body) == 0:
+            raise ValueError("the body has no particles; add some with body.add_particle(...)")
+        integrator = Verlet() if integrator is None else integrator
+        if isinstance(integrator, type):
+            raise TypeError(
+                f"pass an integrator instance, e.g. {integrator.__name__}(), not the class"
+            )
+        if not isinstance(integrator, Integrator):
+            raise TypeError(
+                f"integrator must be a msdlab.Integrator, got {type(integrator).__name__}"
+            )
+        check_finite_array("positions", body.positions)
+        check_finite_array("velocities", body.velocities)
+        body.velocities[body.fixed] = 0.0
+        self.body = body
+        self.integrator = integrator
+        self.dt = dt
+        self.max_stretch = max_stretch
+        self.constraints: list[Constraint] = []
+        field_forces: list[Force] = []
+        for item in forces:
+            if isinstance(item, Force):
+                field_forces.append(item)
+            elif isinstance(item, Constraint):
+                self.constraints.append(item)
+            else:
+                raise TypeError(
+                    f"{item!r} is neither a msdlab.Force (Gravity, SphereContact, ...) "
+                    "nor a msdlab.Constraint (Ground, Drag, Walls, ...)"
+                )
+            item.check(body)
+        self.dynamics = Dynamics(body, field_forces)
+        self.time = 0.0
+        self.step_count = 0
+        self.dissipated: dict[str, float] = defaultdict(float)
+        self.initial_positions = body.positions.copy()
+
+    @property
+    def dt(self) -> float:
+        """Time step (s)."""
+        return self._dt
+
+    @dt.setter
+    def dt(self, value: float) -> None:
+        self._dt = check_positive("dt", value, "The time step is in seconds, e.g. dt=1e-3.")
+
+    @property
+    def forces(self) -> list[Force]:
+        """The force fields (not the constraints)."""
+        return self.dynamics.forces
+
+    # ------------------------------------------------------------------ stepping
+    def step(self) -> None:
+        """Advance the body by one step of ``dt``."""
+        body, dt = self.body, self.dt
+        x, v = body.positions, body.velocities
+        booked = {
+            "dashpot": kernels.dashpot_power(body, x, v) * dt,
+            "integrator": self.integrator.dissipated_energy(v, body.masses),
+        }
+        x_new, v_new = self._checked(self.integrator.step(x, v, dt, self.dynamics), x)
+        fixed = body.fixed
+        if fixed.any():
+            x_new[fixed] = x[fixed]
+            v_new[fixed] = 0.0
+        state = StepState(body, x, x_new, v_new, self.time + dt, dt, self._energy_of(x_new, v_new))
+        for constraint in self.constraints:
+            name = constraint.ledger_name
+            booked[name] = booked.get(name, 0.0) + constraint.apply(state)
+        self._check_divergence(x, x_new, v_new)
+        x[...] = x_new
+        v[...] = v_new
+        self.time += dt
+        self.step_count += 1
+        for name, energy in booked.items():
+            self.dissipated[name] += energy
+
+    def run(
+        self,
+        steps: int | None = None,
+        duration: float | None = None,
+        record_every: int = 1,
+        record_velocities: bool = False,
+        callback: Callable[[Simulation], None] | None = None,
+    ) -> Trajectory:
+        """Run ``steps`` steps (or ``duration`` seconds) and return the recorded frames.
+
+        A frame is recorded at the start, every ``record_every`` steps and at the
+        end. ``callback(sim)`` is called after every step (e.g. a progress bar).
+        """
+        steps = self._count_steps(steps, duration)
+        if isinstance(record_every, bool) or not isinstance(record_every, int) or record_every < 1:
+            raise ValueError(f"record_every must be an integer >= 1, got {record_every!r}")
+        start = dict(self.dissipated)
+        ledger = EnergyLedger()
+        frames: list[tuple[int, float, np.ndarray, np.ndarray | None]] = []
+
+        def record() -> None:
+            x, v = self.body.positions, self.body.velocities
+            frames.append(
+                (self.step_count, self.time, x.copy(), v.copy() if record_velocities else None)
+            )
+            if self.step_count > 0:  # before the first step v is the user's v(t0)
+                a = self.dynamics.acceleration(x, v)
+                v = self.integrator.velocity_at_positions(v, a, self.dt)
+            ledger.record(
+                self.step_count,
+                self.time,
+                kinetic_energy(self.body, v),
+                kernels.elastic_energy(self.body, x),
+                sum(f.potential_energy(self.body, x) for f in self.forces),
+                {k: e - start.get(k, 0.0) for k, e in self.dissipated.items()},
+            )
+
+        record()
+        try:
+            for i in range(1, steps + 1):
+                self.step()
+                if i % record_every == 0 or i == steps:
+                    record()
+                if callback is not None:
+                    callback(self)
+        except SimulationDiverged as error:
+            error.trajectory = self._trajectory(frames, ledger)
+            raise
+        return self._trajectory(frames, ledger)
+
+    # ------------------------------------------------------------------ helpers
+    def _count_steps(self, steps: int | None, duration: float | None) -> int:
+        if (steps is None) == (duration is None):
+            raise ValueError("give either steps=... or duration=... (in seconds), not both")
+        if duration is not None:
+            duration = float(duration)
+            if not math.isfinite(duration) or duration < 0:
+                raise ValueError(
+                    f"duration must be a finite number of seconds >= 0, got {duration}"
+                )
+            return round(duration / self.dt)
+        if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 0:
+            raise ValueError(f"steps must be an integer >= 0, got {steps!r}")
+        return int(steps)
+
+    def _checked(self, result: object, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The integrator's (x, v) as fresh float arrays of the body's shape."""
+        try:
+            x_new, v_new = result  # type: ignore[misc]
+        except (TypeError, ValueError):
+            raise TypeError(
+                f"{self.integrator!r}.step must return (x_new, v_new), got {type(result).__name__}"
+            ) from None
+        arrays = []
+        for name, array in (("x_new", x_new), ("v_new", v_new)):
+            array = np.asarray(array, dtype=float)
+            if array.shape != x.shape:
+                raise ValueError(
+                    f"{self.integrator!r}.step returned {name} of shape {array.shape}; "
+                    f"it must have the shape of the positions, {x.shape}"
+                )
+            arrays.append(array.copy() if np.shares_memory(array, x) else array)
+        return arrays[0], arrays[1]
+
+    def _energy_of(self, x: np.ndarray, v: np.ndarray) -> Callable[[np.ndarray], float]:
+        """Energy (J) of some particles at (x, v): their kinetic and external potential
+        energy plus the elastic energy of the springs touching them. The kinetic
+        part uses the velocity at the time of x (see `Integrator.velocity_at_positions`)."""
+        body, dynamics, integrator = self.body, self.dynamics, self.integrator
+
+        def energy(particles: np.ndarray) -> float:
+            a = dynamics.acceleration_of(particles, x, v)
+            u = integrator.velocity_at_positions(v[particles], a, self.dt)
+            kinetic = 0.5 * np.sum(body.masses[particles] * np.einsum("ij,ij->i", u, u))
+            potential = sum(f.potential_energy(body, x, particles) for f in self.forces)
+            touching = body.springs_touching(particles)
+            return float(kinetic + potential + kernels.elastic_energy(body, x, touching))
+
+        return energy
+
+    def _check_divergence(self, x: np.ndarray, x_new: np.ndarray, v_new: np.ndarray) -> None:
+        finite = math.isfinite(float(np.sum(x_new)) + float(np.sum(v_new)))
+        stretched = self.max_stretch is not None and self.dynamics.max_stretch > self.max_stretch
+        if not finite or stretched:
+            raise SimulationDiverged(
+                self.step_count, self.time, diagnose_divergence(self, x, x_new, v_new)
+            )
+
+    def _trajectory(self, frames: list, ledger: EnergyLedger) -> Trajectory:
+        velocities = (
+            None if not frames or frames[0][3] is None else np.array([f[3] for f in frames])
+        )
+        return Trajectory(
+            body=self.body,
+            dt=self.dt,
+            steps=np.array([f[0] for f in frames]),
+            times=np.array([f[1] for f in frames]),
+            positions=np.array([f[2] for f in frames]),
+            velocities=velocities,
+            energies=ledger,
+        )
+
+    def __repr__(self) -> str:
+        items = [*self.forces, *self.constraints]
+        return (
+            f"<Simulation {self.body!r}, {self.integrator!r}, dt={self.dt:g} s, "
+            f"t={self.time:g} s, forces={items}>"
+        )

@@ -1,0 +1,182 @@
+"""How large may dt be? Prediction from the stiffest mode, and the diagnosis of a blow-up.
+
+A linear mass-spring system splits into modes x'' = -ω² x - γ x'. An integrator
+is stable for a mode when its one-step map on (x, v) has spectral radius <= 1;
+`stability_limit` finds the largest such dt by running the integrator's own
+`step` on that one mode, so it works for any `Integrator`, a student's included.
+`max_stable_dt` applies it to the stiffest mode of a body: the largest
+eigenvalue ω² of M⁻¹K (K = -∂F/∂x of the springs).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+import scipy.linalg
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from . import kernels
+from .body import Body
+from .forces import Force
+from .integrators import Integrator
+
+if TYPE_CHECKING:
+    from .simulation import Simulation
+
+
+@dataclass(frozen=True)
+class Mode:
+    """A vibration mode: angular frequency ω (rad/s) and damping rate γ (1/s)."""
+
+    omega: float
+    gamma: float = 0.0
+
+    @property
+    def period(self) -> float:
+        """2π/ω (s)."""
+        return 2 * math.pi / self.omega if self.omega > 0 else math.inf
+
+
+def stiffest_mode(body: Body, forces: Sequence[Force] = (), x: np.ndarray | None = None) -> Mode:
+    """The highest-frequency mode of the free particles of ``body`` at positions ``x``.
+
+    ω² is the largest eigenvalue of M⁻¹K; γ is the damping (dashpots and
+    viscous forces) seen by that mode, uᵀCu / uᵀMu.
+    """
+    x = body.positions if x is None else x
+    jx, jv = kernels.spring_jacobians(body, x)
+    for force in forces:
+        fx, fv = force.jacobians(body, x, body.velocities)
+        jx = jx if fx is None else jx + fx
+        jv = jv if fv is None else jv + fv
+    free = np.repeat(~body.fixed, body.dim)
+    if not free.any() or body.n_springs == 0:
+        return Mode(0.0)
+    scale = 1.0 / np.sqrt(np.repeat(body.masses, body.dim)[free])
+    stiffness = sp.diags(scale) @ (-jx.tocsr()[free][:, free]) @ sp.diags(scale)
+    damping = sp.diags(scale) @ (-jv.tocsr()[free][:, free]) @ sp.diags(scale)
+    if stiffness.shape[0] <= 400:
+        values, vectors = scipy.linalg.eigh(stiffness.toarray())
+        value, vector = values[-1], vectors[:, -1]
+    else:
+        values, vectors = spla.eigsh(stiffness, k=1, which="LA", tol=1e-10)
+        value, vector = values[0], vectors[:, 0]
+    gamma = float(vector @ (damping @ vector)) / float(vector @ vector)
+    return Mode(math.sqrt(max(value, 0.0)), max(gamma, 0.0))
+
+
+class _OneMode:
+    """The dynamics of one mode, x'' = -ω² x - γ x', in the form integrators expect."""
+
+    def __init__(self, mode: Mode) -> None:
+        self.mode = mode
+        self.masses = np.ones(1)
+        self.free = np.ones(1, dtype=bool)
+
+    def force(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return -(self.mode.omega**2) * x - self.mode.gamma * v
+
+    acceleration = force  # unit mass
+
+    def jacobians(self, x: np.ndarray, v: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        return sp.csr_matrix([[-(self.mode.omega**2)]]), sp.csr_matrix([[-self.mode.gamma]])
+
+
+def spectral_radius(integrator: Integrator, mode: Mode, dt: float) -> float:
+    """Spectral radius of the integrator's one-step map on (x, v) for ``mode``."""
+    dynamics = _OneMode(mode)
+    columns = []
+    for x0, v0 in ((1.0, 0.0), (0.0, 1.0)):
+        x, v = integrator.step(np.array([[x0]]), np.array([[v0]]), dt, dynamics)  # type: ignore[arg-type]
+        columns.append([float(np.asarray(x).ravel()[0]), float(np.asarray(v).ravel()[0])])
+    return float(np.max(np.abs(np.linalg.eigvals(np.array(columns).T))))
+
+
+def stability_limit(integrator: Integrator, mode: Mode, tolerance: float = 1e-12) -> float:
+    """Largest dt (s) for which ``integrator`` keeps ``mode`` bounded.
+
+    0.0 if it is unstable at any dt (explicit Euler without damping), inf if it
+    is stable at every dt tried (implicit Euler).
+    """
+    if mode.omega == 0:
+        return math.inf
+    stable = 0.0
+    for dt in np.logspace(-6, 3, 361) / mode.omega:
+        if spectral_radius(integrator, mode, dt) > 1.0 + tolerance:
+            break
+        stable = dt
+    else:
+        return math.inf
+    if stable == 0.0:
+        return 0.0
+    low, high = stable, dt
+    while high - low > 1e-10 * low:
+        middle = 0.5 * (low + high)
+        if spectral_radius(integrator, mode, middle) > 1.0 + tolerance:
+            high = middle
+        else:
+            low = middle
+    return low
+
+
+def max_stable_dt(
+    body: Body, integrator: Integrator, forces: Sequence[Force] = (), x: np.ndarray | None = None
+) -> float:
+    """Predicted largest stable dt (s): `stability_limit` of the stiffest mode of ``body``.
+
+    For undamped springs: 2/ω for symplectic Euler, velocity Verlet and
+    Verlet (√(4 - 2λ)/ω with damping λ), 2√2/ω for RK4, 0 for explicit Euler,
+    inf for implicit Euler.
+    """
+    return stability_limit(integrator, stiffest_mode(body, forces, x))
+
+
+def diagnose_divergence(
+    sim: Simulation, x: np.ndarray, x_new: np.ndarray, v_new: np.ndarray
+) -> str:
+    """Explain a blow-up: which particle and spring, and dt against the predicted limit."""
+    body = sim.body
+    lines = []
+    bad = ~(np.all(np.isfinite(x_new), axis=1) & np.all(np.isfinite(v_new), axis=1))
+    if bad.any():
+        first, others = int(np.flatnonzero(bad)[0]), int(bad.sum()) - 1
+        also = f" (and {others} more)" if others else ""
+        lines.append(f"particle {first}{also} got a non-finite position or velocity")
+    else:
+        speed = np.linalg.norm(v_new, axis=1)
+        fastest = int(np.argmax(speed))
+        lines.append(f"particle {fastest} moves at {speed[fastest]:.3g} m/s")
+    if body.n_springs:
+        _, length = kernels.spring_vectors(body, x)
+        stretch = length / body.rest_lengths
+        worst = int(np.argmax(stretch))
+        lines.append(
+            f"spring {worst} (particles {body.spring_a[worst]}-{body.spring_b[worst]}) is at "
+            f"{stretch[worst]:.3g}× its rest length"
+        )
+    mode = stiffest_mode(body, sim.forces, sim.initial_positions)
+    limit = stability_limit(sim.integrator, mode)
+    name, dt = type(sim.integrator).__name__, sim.dt
+    if limit == 0.0:
+        lines.append(
+            f"{name} is unstable at any dt for these springs (its energy grows every step): "
+            "use SymplecticEuler, Verlet, VelocityVerlet or ImplicitEuler, or add dashpots"
+        )
+    elif dt > limit:
+        lines.append(
+            f"dt = {dt:.3g} s is {dt / limit:.3g}× the predicted stable limit {limit:.3g} s "
+            f"of {name} (stiffest mode ω = {mode.omega:.3g} rad/s, period {mode.period:.3g} s): "
+            f"use dt < {0.9 * limit:.3g} s, softer springs, or ImplicitEuler"
+        )
+    else:
+        lines.append(
+            f"dt = {dt:.3g} s is below the predicted linear limit {limit:.3g} s of {name}, so "
+            "the blow-up comes from large deformations or contact (ground, sphere, drivers): "
+            "reduce dt or the stiffness, or add damping"
+        )
+    return "; ".join(lines)
