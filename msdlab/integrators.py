@@ -115,14 +115,19 @@ class Verlet(Integrator):
 
 
 class VelocityVerlet(Integrator):
-    """Velocity Verlet (leapfrog): half kick, drift, half kick. Order 2, symplectic."""
+    """Velocity Verlet (leapfrog): half kick, drift, half kick. Order 2, symplectic.
+
+    The second kick needs a(x_new, v_new); for velocity-dependent forces
+    (dashpots) it uses the predictor v + dt·a, which keeps the scheme second order.
+    """
 
     order = 2
 
     def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: Dynamics) -> State:
-        v_half = v + 0.5 * dt * dynamics.acceleration(x, v)
+        a = dynamics.acceleration(x, v)
+        v_half = v + 0.5 * dt * a
         x_new = x + dt * v_half
-        return x_new, v_half + 0.5 * dt * dynamics.acceleration(x_new, v_half)
+        return x_new, v_half + 0.5 * dt * dynamics.acceleration(x_new, v + dt * a)
 
 
 class RK4(Integrator):

@@ -11,6 +11,8 @@ from .errors import check_finite_array, check_positive
 if TYPE_CHECKING:
     from .body import Body
 
+MASS_HINT = "Give every particle a mass > 0 (kg); to pin a particle use fixed=True."
+
 
 class Particle:
     """A point mass: position (m), velocity (m/s), mass (kg), and whether it is fixed.
@@ -41,7 +43,7 @@ class Particle:
                 f"position {position.tolist()!r}"
             )
         check_finite_array("particle velocity", velocity[None])
-        mass = check_positive("mass", mass, "Give every particle a mass > 0 (kg).")
+        mass = check_positive("mass", mass, MASS_HINT)
         self._body: Body | None = None
         self._index = -1
         self._own = {"position": position, "velocity": velocity, "mass": mass, "fixed": fixed}
@@ -92,7 +94,7 @@ class Particle:
 
     @mass.setter
     def mass(self, value: float) -> None:
-        value = check_positive("mass", value, "Give every particle a mass > 0 (kg).")
+        value = check_positive("mass", value, MASS_HINT)
         if self._body is None:
             self._own["mass"] = value
         else:

@@ -1,0 +1,127 @@
+"""Bad input gets a clear error that says what was wrong and how to fix it."""
+
+import numpy as np
+import pytest
+
+import msdlab as msd
+
+
+def body_2d() -> msd.Body:
+    return msd.Body.from_arrays([[0.0, 0.0], [1.0, 0.0]], [[0, 1]])
+
+
+@pytest.mark.parametrize("mass", [0.0, -1.0, float("nan")])
+def test_non_positive_mass(mass):
+    with pytest.raises(ValueError, match=r"mass.*> 0.*fixed=True"):
+        msd.Particle(position=(0, 0), mass=mass)
+    with pytest.raises(ValueError, match="mass"):
+        body_2d().masses = [1.0, mass]
+
+
+@pytest.mark.parametrize("dt", [0.0, -1e-3, float("inf")])
+def test_dt_must_be_positive(dt):
+    with pytest.raises(ValueError, match=r"dt must be a positive.*seconds"):
+        msd.Simulation(body_2d(), msd.Verlet(), dt=dt)
+
+
+@pytest.mark.parametrize("damping", [-0.1, 1.0, 1.2])
+def test_verlet_damping_outside_unit_interval(damping):
+    with pytest.raises(ValueError, match=r"λ must be in \[0, 1\)"):
+        msd.Verlet(damping=damping)
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf")])
+def test_non_finite_positions(bad):
+    with pytest.raises(ValueError, match="finite"):
+        msd.Particle(position=(0, bad, 0))
+    body = body_2d()
+    with pytest.raises(ValueError, match=r"positions must be finite.*row 1"):
+        body.positions = [[0, 0], [bad, 0]]
+    body.positions[1, 0] = bad  # written behind the body's back
+    with pytest.raises(ValueError, match="positions must be finite"):
+        msd.Simulation(body, msd.Verlet(), dt=0.1)
+
+
+def test_spring_to_itself():
+    with pytest.raises(ValueError, match="itself"):
+        msd.Spring(1, 1)
+    with pytest.raises(ValueError, match="itself"):
+        body_2d().add_springs([[0, 0]])
+
+
+def test_spring_to_missing_particle():
+    with pytest.raises(ValueError, match=r"joins particles 0 and 5.*2 particles.*0 to 1"):
+        body_2d().add_spring(msd.Spring(0, 5))
+
+
+def test_spring_ends_must_be_integers():
+    with pytest.raises(TypeError, match="particle indices"):
+        msd.Spring(0.5, 1)
+
+
+def test_zero_length_spring():
+    body = msd.Body.from_arrays([[0.0, 0.0], [0.0, 0.0]])
+    with pytest.raises(ValueError, match=r"zero-length spring.*rest_length"):
+        body.add_spring(msd.Spring(0, 1))
+    with pytest.raises(ValueError, match="rest_length"):
+        msd.Spring(0, 1, rest_length=0.0)
+
+
+def test_mixed_dimensions():
+    body = msd.Body()
+    body.add_particle(msd.Particle(position=(0, 0, 0)))
+    with pytest.raises(ValueError, match=r"3-D.*2 coordinates.*do not mix"):
+        body.add_particle(msd.Particle(position=(0, 0)))
+
+
+def test_wrong_shape_assigned_to_positions():
+    body = body_2d()
+    with pytest.raises(ValueError, match=r"shape \(2, 2\), got shape \(3, 2\)"):
+        body.positions = np.zeros((3, 2))
+    with pytest.raises(ValueError, match="shape"):
+        body.velocities = np.zeros((2, 3))
+
+
+def test_negative_stiffness():
+    with pytest.raises(ValueError, match=r"stiffness must be finite and >= 0"):
+        msd.Spring(0, 1, stiffness=-1.0)
+    with pytest.raises(ValueError, match="stiffness"):
+        body_2d().add_springs([[0, 1]], stiffness=-5.0)
+
+
+def test_integrator_class_instead_of_instance():
+    with pytest.raises(TypeError, match=r"Verlet\(\)"):
+        msd.Simulation(body_2d(), msd.Verlet, dt=0.1)
+
+
+def test_force_of_wrong_dimension_and_unknown_force():
+    with pytest.raises(ValueError, match=r"3 components.*2-D"):
+        msd.Simulation(body_2d(), msd.Verlet(), 0.1, [msd.Gravity((0, -9.81, 0))])
+    with pytest.raises(TypeError, match="neither a msdlab.Force"):
+        msd.Simulation(body_2d(), msd.Verlet(), 0.1, ["gravity"])
+
+
+def test_run_needs_steps_or_duration():
+    sim = msd.Simulation(body_2d(), msd.Verlet(), 0.1)
+    with pytest.raises(ValueError, match="either steps"):
+        sim.run()
+    with pytest.raises(ValueError, match="record_every"):
+        sim.run(steps=3, record_every=0)
+
+
+def test_integrator_returning_wrong_shape_is_named():
+    class Broken(msd.Integrator):
+        def step(self, x, v, dt, dynamics):
+            return x[:1], v
+
+    with pytest.raises(ValueError, match=r"returned x_new of shape \(1, 2\)"):
+        msd.Simulation(body_2d(), Broken(), 0.1).step()
+
+
+def test_bad_grid_arguments():
+    with pytest.raises(ValueError, match="squared distances"):
+        msd.Body.grid((3, 3), neighbours=(0,))
+    with pytest.raises(ValueError, match="spacing"):
+        msd.Body.grid((3, 3), spacing=-1)
+    with pytest.raises(ValueError, match="origin must have 2"):
+        msd.Body.grid((3, 3), origin=(0, 0, 0))
