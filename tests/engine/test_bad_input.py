@@ -97,7 +97,7 @@ def test_integrator_class_instead_of_instance():
 def test_force_of_wrong_dimension_and_unknown_force():
     with pytest.raises(ValueError, match=r"3 components.*2-D"):
         msd.Simulation(body_2d(), msd.Verlet(), 0.1, [msd.Gravity((0, -9.81, 0))])
-    with pytest.raises(TypeError, match="neither a msdlab.Force"):
+    with pytest.raises(TypeError, match=r"neither a msdlab\.Force"):
         msd.Simulation(body_2d(), msd.Verlet(), 0.1, ["gravity"])
 
 

@@ -73,9 +73,7 @@ def test_grid_springs_counts_and_rest_lengths(shape):
     assert body.n_springs == n_axis
     np.testing.assert_allclose(body.rest_lengths, 0.5)
     full = msd.Body.grid(shape, spacing=0.5, neighbours=(1, 2, 3))
-    lengths = np.linalg.norm(
-        full.positions[full.spring_a] - full.positions[full.spring_b], axis=1
-    )
+    lengths = np.linalg.norm(full.positions[full.spring_a] - full.positions[full.spring_b], axis=1)
     np.testing.assert_allclose(full.rest_lengths, lengths)  # at rest: no pre-stress
     assert set(np.round(full.rest_lengths / 0.5, 6)) <= {1.0, round(2**0.5, 6), round(3**0.5, 6)}
 

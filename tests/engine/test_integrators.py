@@ -93,8 +93,14 @@ def test_brief_verlet_is_second_order_when_the_start_is_not_accelerating():
 def test_verlet_damping_is_equation_1_4():
     """One step by hand: x_new = (2 - λ) x - (1 - λ) x_old + a dt²."""
     lam, dt = 0.25, 0.1
-    body = msd.Body.from_arrays([[0.0, 0.0], [1.5, 0.0]], [[0, 1]], velocities=[[0, 0], [0.4, 0]],
-                                stiffness=2.0, rest_lengths=[1.0], fixed=[True, False])
+    body = msd.Body.from_arrays(
+        [[0.0, 0.0], [1.5, 0.0]],
+        [[0, 1]],
+        velocities=[[0, 0], [0.4, 0]],
+        stiffness=2.0,
+        rest_lengths=[1.0],
+        fixed=[True, False],
+    )
     x, v = body.positions[1].copy(), body.velocities[1].copy()
     msd.Simulation(body, msd.Verlet(lam), dt).step()
     a = np.array([-2.0 * 0.5, 0.0])

@@ -44,7 +44,11 @@ def reference(body: msd.Body, gravity: np.ndarray, duration: float) -> np.ndarra
 @pytest.mark.parametrize("seed", [0, 1, 2])
 @pytest.mark.parametrize(
     "integrator, dt, tolerance",
-    [(msd.RK4(), 1e-3, 1e-10), (msd.VelocityVerlet(), 5e-4, 3e-7), (msd.ImplicitEuler(), 5e-4, 5e-3)],
+    [
+        (msd.RK4(), 1e-3, 1e-10),
+        (msd.VelocityVerlet(), 5e-4, 3e-7),
+        (msd.ImplicitEuler(), 5e-4, 5e-3),
+    ],
     ids=["RK4", "VelocityVerlet", "ImplicitEuler"],
 )
 def test_agrees_with_solve_ivp(seed, integrator, dt, tolerance):

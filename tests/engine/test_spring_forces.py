@@ -34,7 +34,9 @@ def rotations(draw: st.DrawFn, dim: int) -> np.ndarray:
     angle = draw(st.floats(-180.0, 180.0))
     if dim == 2:
         return msd.rotation_matrix(angle)
-    axis = draw(arrays(float, 3, elements=st.floats(-1, 1)).filter(lambda a: np.linalg.norm(a) > 0.1))
+    axis = draw(
+        arrays(float, 3, elements=st.floats(-1, 1)).filter(lambda a: np.linalg.norm(a) > 0.1)
+    )
     return msd.rotation_matrix(angle, axis)
 
 
@@ -78,7 +80,9 @@ def test_vectorised_forces_equal_the_readable_spring_class(body):
 
 
 def test_stretched_spring_pulls_the_ends_together():
-    body = msd.Body.from_arrays([[0.0, 0.0], [2.0, 0.0]], [[0, 1]], stiffness=3.0, rest_lengths=[1.0])
+    body = msd.Body.from_arrays(
+        [[0.0, 0.0], [2.0, 0.0]], [[0, 1]], stiffness=3.0, rest_lengths=[1.0]
+    )
     f = forces(body)
     np.testing.assert_allclose(f, [[3.0, 0.0], [-3.0, 0.0]])  # eq. (1.2): k (l - |d|) d/|d|
 

@@ -51,7 +51,9 @@ def test_free_fall_height_follows_the_discrete_formula():
 
 def test_springy_grid_matches_template_with_spring_acceleration():
     """The template extended with eq. (1.1)-(1.2) (unit mass) against Verlet + body springs."""
-    body = msd.Body.grid((4, 4, 4), spacing=0.5, stiffness=0.5, neighbours=(1, 2, 3), origin=(-1, 1.5, -1))
+    body = msd.Body.grid(
+        (4, 4, 4), spacing=0.5, stiffness=0.5, neighbours=(1, 2, 3), origin=(-1, 1.5, -1)
+    )
     body.rotate(msd.rotation_matrix(58.3, axis=(0, 0, 1)))
     cur = body.positions.copy()
     old = cur.copy()
