@@ -1,0 +1,135 @@
+"""External forces and constraints: consistency with their potentials, and their rules."""
+
+import numpy as np
+import pytest
+
+import msdlab as msd
+
+
+def ball_over_net() -> tuple[msd.Body, msd.SphereContact]:
+    net = msd.Body.grid((4, 4), spacing=1.0, stiffness=50.0)
+    positions = np.c_[net.positions, np.zeros(len(net))]
+    body = msd.Body.from_arrays(positions, np.c_[net.spring_a, net.spring_b], stiffness=50.0)
+    ball = body.add_particle(
+        msd.Particle(position=(1.45, 1.5, 0.3), velocity=(0.2, 0, -1), mass=2.0)
+    )
+    return body, msd.SphereContact(ball, radius=0.9, stiffness=500.0)
+
+
+def potential_gradient(force: msd.Force, body: msd.Body, h: float = 1e-6) -> np.ndarray:
+    x = body.positions.copy()
+    gradient = np.zeros_like(x)
+    for index in np.ndindex(*x.shape):
+        for sign in (1, -1):
+            shifted = x.copy()
+            shifted[index] += sign * h
+            gradient[index] += sign * force.potential_energy(body, shifted) / (2 * h)
+    return gradient
+
+
+@pytest.mark.parametrize(
+    "make_force", [lambda: msd.Gravity((0, 0, -9.8)), lambda: ball_over_net()[1]]
+)
+def test_force_is_minus_the_gradient_of_its_potential(make_force):
+    body, _ = ball_over_net()
+    force = make_force()
+    out = np.zeros_like(body.positions)
+    force.add_to(body, body.positions, body.velocities, out)
+    np.testing.assert_allclose(out, -potential_gradient(force, body), atol=1e-5)
+
+
+def test_sphere_contact_is_equal_and_opposite_and_conserves_momentum():
+    body, contact = ball_over_net()
+    out = np.zeros_like(body.positions)
+    contact.add_to(body, body.positions, body.velocities, out)
+    assert np.count_nonzero(np.linalg.norm(out, axis=1)) == 5  # four nodes and the ball
+    np.testing.assert_allclose(out.sum(axis=0), 0.0, atol=1e-12)
+    p0 = msd.momentum(body).copy()
+    msd.Simulation(body, msd.VelocityVerlet(), 1e-3, [contact]).run(steps=500)
+    np.testing.assert_allclose(msd.momentum(body), p0, atol=1e-10)
+
+
+def test_sphere_contact_energy_is_conserved_by_velocity_verlet():
+    body, contact = ball_over_net()
+    ledger = msd.Simulation(body, msd.VelocityVerlet(), 2e-4, [contact]).run(steps=3000).energies
+    assert np.max(ledger.potential) > 0.01  # the contact was loaded
+    assert ledger.relative_drift() < 1e-3
+
+
+def test_ground_with_a_z_up_normal_and_height():
+    body = msd.Body.from_arrays([[0.0, 0.0, 1.0]], velocities=[[1.0, 0.0, -3.0]])
+    sim = msd.Simulation(body, msd.SymplecticEuler(), 1e-2, [msd.Ground(0.5, normal=(0, 0, 2))])
+    sim.run(steps=50)
+    assert body.positions[0, 2] == pytest.approx(0.5)
+    assert body.velocities[0, 2] == pytest.approx(0.0, abs=1e-12)  # no bounce
+    assert body.velocities[0, 0] == pytest.approx(1.0)  # no friction by default
+
+
+def test_ground_friction_slows_sliding():
+    body = msd.Body.from_arrays([[0.0, 0.0]], velocities=[[1.0, 0.0]])
+    msd.Simulation(
+        body, msd.Verlet(), 1e-2, [msd.Gravity((0, -9.81)), msd.Ground(0.0, friction=0.5)]
+    ).run(steps=20)
+    assert 0 < body.velocities[0, 0] < 1e-3
+
+
+def test_drag_is_exact_and_stable_at_any_dt():
+    body = msd.Body.from_arrays([[0.0, 0.0]], velocities=[[2.0, 0.0]])
+    msd.Simulation(body, msd.SymplecticEuler(), 10.0, [msd.Drag(rate=3.0)]).run(steps=3)
+    assert body.velocities[0, 0] == pytest.approx(2.0 * np.exp(-3.0 * 30.0))
+
+
+def test_viscous_damping_force_is_minus_c_v():
+    body = msd.Body.from_arrays([[0.0, 0.0]], velocities=[[2.0, -1.0]])
+    out = np.zeros((1, 2))
+    msd.ViscousDamping(0.5).add_to(body, body.positions, body.velocities, out)
+    np.testing.assert_allclose(out, [[-1.0, 0.5]])
+
+
+def test_reflecting_walls_keep_particles_inside():
+    rng = np.random.default_rng(0)
+    body = msd.Body.from_arrays(rng.uniform(1, 9, (20, 2)), velocities=rng.normal(0, 5, (20, 2)))
+    msd.Simulation(body, msd.SymplecticEuler(), 0.05, [msd.Walls((0, 0), (10, 10))]).run(steps=400)
+    assert np.all((body.positions >= 0) & (body.positions <= 10))
+    assert msd.kinetic_energy(body) > 0
+
+
+def test_periodic_walls_wrap_positions():
+    body = msd.Body.from_arrays([[9.5, 5.0]], velocities=[[1.0, 0.0]])
+    msd.Simulation(
+        body, msd.SymplecticEuler(), 1.0, [msd.Walls((0, 0), (10, 10), "periodic")]
+    ).step()
+    np.testing.assert_allclose(body.positions[0], [0.5, 5.0])
+
+
+def test_prescribed_particle_follows_its_path_and_drives_the_body():
+    body = msd.Body.from_arrays([[0.0, 0.0], [1.0, 0.0]], [[0, 1]], stiffness=20.0)
+    driver = msd.Prescribed([0], lambda t: [[0.3 * np.sin(2 * t), 0.0]])
+    sim = msd.Simulation(body, msd.VelocityVerlet(), 1e-3, [driver])
+    trajectory = sim.run(duration=2.0, record_every=100)
+    np.testing.assert_allclose(body.positions[0], [0.3 * np.sin(4.0), 0.0], atol=1e-12)
+    assert np.ptp(trajectory.positions[:, 1, 0]) > 0.1  # the free end was dragged along
+    assert body.fixed[0]
+
+
+@pytest.mark.parametrize(
+    "make, message",
+    [
+        (lambda: msd.SphereContact(0, radius=-1, stiffness=1), "radius"),
+        (lambda: msd.Ground(friction=2), "friction"),
+        (lambda: msd.Ground(normal=(0, 0)), "normal"),
+        (lambda: msd.Drag(-1), "drag rate"),
+        (lambda: msd.Walls((0, 0), (0, 1)), "lower < upper"),
+        (lambda: msd.Walls((0, 0), (1, 1), "wrap"), "reflect"),
+        (lambda: msd.Gravity((0, float("nan"))), "finite"),
+    ],
+)
+def test_bad_force_arguments(make, message):
+    with pytest.raises(ValueError, match=message):
+        make()
+
+
+def test_sphere_centre_must_exist():
+    body = msd.Body.from_arrays([[0.0, 0.0]])
+    with pytest.raises(ValueError, match="does not exist"):
+        msd.Simulation(body, msd.Verlet(), 0.1, [msd.SphereContact(3, 1.0, 1.0)])
