@@ -20,7 +20,8 @@ class Scene:
     duration: float  # how long `msdlab run` runs it by default (s, or frames for 2-D scenes)
     frames: int = 100  # frames an animation shows
     view: tuple[float, float] = (45.0, 30.0)  # azimuth, elevation (degrees) of 3-D views
-    unit: str = "s"
+    up: str = "z"  # the vertical axis
+    unit: str = "s"  # of time
 
     def settings(self) -> dict[str, object]:
         """The keyword arguments of ``build`` and their defaults."""
@@ -44,7 +45,8 @@ SCENES: dict[str, Scene] = {
             "the brief's 20³ grid, rotated 58.3°, 26 neighbours, damped Verlet, lands on the floor",
             duration=600.0,
             frames=60,
-            view=(-60.0, 20.0),
+            view=(-30.0, 20.0),
+            up="y",
             unit="time units",
         ),
         Scene(
@@ -61,7 +63,7 @@ SCENES: dict[str, Scene] = {
             "a 10×10 cloth over 10 m × 8 m at z = 10 m, pinned at two corners, damped by λ",
             duration=10.0,
             frames=100,
-            view=(-60.0, 20.0),
+            view=(-30.0, 20.0),
         ),
         _gallery(
             "two-particles", gallery.two_particles, "two particles and one spring, pulled apart"
