@@ -19,7 +19,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from ..body import Body
+from ..body import Body, rotation_matrix
 from ..constraints import Constraint, Drag, Prescribed, Walls
 from ..forces import Force, Gravity
 from ..integrators import VelocityVerlet
@@ -186,6 +186,7 @@ def mesh(
     shape: Sequence[int] = (10, 10),
     spacing: float = 30.0,
     diagonals: bool = True,
+    tilt: float = 0.0,
     stiffness: float = 0.08,
     gravity: float = 0.1,
     damping: float = 0.93,
@@ -194,9 +195,11 @@ def mesh(
 ) -> Simulation:
     """Springs 4: a square mesh with both diagonals in every cell (342 springs for 10×10).
 
-    Without ``diagonals`` the squares have no shear stiffness and the mesh collapses.
+    Without ``diagonals`` the squares have no shear stiffness: dropped upright the
+    mesh stands on its vertical springs, but tilted by ``tilt`` degrees it folds flat.
     """
     body = _mesh_body(shape, spacing, diagonals, stiffness)
+    body.rotate(rotation_matrix(tilt))
     return simulation(body, model=model, damping=damping, gravity=gravity, walls=walls)
 
 
