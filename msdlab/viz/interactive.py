@@ -85,9 +85,12 @@ class Dragger:
             inverse = self.ax.transData.inverted()
             self.grab.move(inverse.transform((event.x, event.y)))
             return
-        jacobian = self._screen_jacobian(start)  # screen px per m, (2, 3)
-        shift = np.linalg.pinv(jacobian) @ (np.array([event.x, event.y]) - mouse)
-        self.grab.move(start + shift)
+        wanted = self._to_screen(start[None])[0] + (event.x, event.y) - mouse
+        target = start.copy()
+        for _ in range(3):  # Newton steps on screen(target) = wanted, moving parallel to the screen
+            miss = wanted - self._to_screen(target[None])[0]
+            target += np.linalg.pinv(self._screen_jacobian(target)) @ miss
+        self.grab.move(target)
 
     def on_release(self, event: MouseEvent) -> None:
         if self._press is not None:
