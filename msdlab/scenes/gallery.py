@@ -291,7 +291,9 @@ def _mesh_body(shape: Sequence[int], spacing: float, diagonals: bool, stiffness:
     )
 
 
-def _smooth_noise(rng: np.random.Generator, size: float, period: float) -> Callable:
+def _smooth_noise(
+    rng: np.random.Generator, size: float, period: float
+) -> Callable[[float], np.ndarray]:
     """A smooth random 2-D wander of about ``size`` px: four slow sines per axis."""
     frequencies = rng.uniform(0.2, 1.0, (4, 2)) / period
     phases = rng.uniform(0.0, 2 * np.pi, (4, 2))

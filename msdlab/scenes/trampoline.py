@@ -11,6 +11,18 @@ mass), link forces act along the links (not from atan and sign tables), and
 the ball is a particle of the body touching the nodes through `SphereContact`,
 so contact forces are equal and opposite, with a contact stiffness of its own.
 As in the report, the links themselves do not touch the ball: only nodes do.
+
+With this model the report's outcomes hold (see `run_experiment`): a heavier
+ball and softer links sink deeper, stiffer links less; a ball of radius
+0.5 m fits through a cell (half diagonal 0.71 m), so dropped off a node it rolls
+off and falls through, while one of radius 1 m is caught between four nodes.
+The ball placed exactly on a node stays there only by symmetry (it balances
+on a point). On the 11×11 net the ball ends nearer the centre, but mostly for
+the same reason as on the 7×7 net: landing beside the top of a node pushes it
+in +x+y into the next cell, which here lies toward the centre. The net is indeed
+softer near its centre (a ball resting there sits lower), but that pull only
+shifts a resting ball a few millimetres within its cell: the nodes around the
+cell hold it where it lands.
 """
 
 from __future__ import annotations

@@ -9,6 +9,7 @@ parallel to the screen; the right button turns the view.
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Sequence
 
 import numpy as np
@@ -16,6 +17,7 @@ from matplotlib.axes import Axes
 from matplotlib.backend_bases import MouseEvent
 
 from ..constraints import Grab
+from ..errors import SimulationDiverged
 from ..simulation import Simulation
 from .view import BodyView, new_axes, spheres_of
 
@@ -60,9 +62,13 @@ class Dragger:
         return self
 
     def advance(self) -> None:
-        """Step the simulation one frame and redraw."""
-        for _ in range(self.steps_per_frame):
-            self.sim.step()
+        """Step the simulation one frame and redraw; on a blow-up, stop and say why."""
+        try:
+            for _ in range(self.steps_per_frame):
+                self.sim.step()
+        except SimulationDiverged as error:
+            self.timer.stop()
+            self.ax.set_title(textwrap.fill(f"stopped: {error}", 90), fontsize="small")
         self.drawing.update(self.sim.body.positions)
         self.ax.figure.canvas.draw_idle()
 

@@ -97,7 +97,8 @@ class BodyView:
         self.balls = [self._ball(positions[p], r) for p, r in self.spheres]
         self.fit(positions[None])
         if colorbar and body.n_springs:
-            ax.figure.colorbar(self.springs, ax=ax, shrink=0.6, label="strain")
+            pad = 0.12 if self.is_3d else 0.04
+            ax.figure.colorbar(self.springs, ax=ax, shrink=0.6, pad=pad, label="strain")
 
     def update(self, positions: np.ndarray) -> list:
         """Redraw for ``positions`` (N, d); return the changed artists."""

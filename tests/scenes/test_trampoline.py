@@ -115,6 +115,20 @@ def test_on_the_larger_net_an_off_centre_ball_moves_toward_the_centre(outcomes):
     assert outcome.fate == "caught between four nodes"
 
 
+def test_the_larger_net_pulls_a_resting_ball_toward_its_centre_only_slightly():
+    """Softer near the centre: a big ball resting in a cell nearer the centre sits lower,
+    and sits a few mm off its cell's middle toward the centre, but stays in the cell."""
+    rest = {}
+    for cell in (1.5, 3.5):
+        sim = trampoline(size=11, ball_radius=1.0, ball_position=(cell, cell, 1.5), drag=5.0)
+        sim.run(duration=4.0, record_every=1000)
+        rest[cell] = sim.body.positions[BALL]
+    assert rest[3.5][2] < rest[1.5][2] - 0.02
+    for cell, position in rest.items():
+        shift = position[:2] - cell
+        assert np.all((shift > 1e-3) & (shift < 0.02))  # toward (5, 5), within the cell
+
+
 def test_experiment_table_has_one_row_per_experiment(outcomes):
     table = experiment_table(list(outcomes.values()))
     lines = table.splitlines()

@@ -112,6 +112,13 @@ def test_grab_constraint_keeps_a_pinned_particle_pinned():
         grab.hold(body, 5)
 
 
+def test_a_blow_up_stops_the_window_with_the_diagnosis():
+    dragger = viz.Dragger(gallery.rope(stiffness=1.5, damping=1.0), steps_per_frame=50)
+    dragger.advance()
+    assert "stopped: simulation diverged" in dragger.ax.get_title()
+    assert np.all(np.isfinite(dragger.sim.body.positions))
+
+
 def test_show_without_a_display_says_so():
     with pytest.raises(RuntimeError, match="no display"):
         viz.show(gallery.mesh())
