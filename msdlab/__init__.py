@@ -8,7 +8,7 @@ trajectory = sim.run(duration=1.0, record_every=10)
 """
 
 from .body import Body, rotation_matrix
-from .constraints import Constraint, Drag, Ground, Prescribed, StepState, Walls
+from .constraints import Constraint, Drag, Grab, Ground, Prescribed, StepState, Walls
 from .dynamics import Dynamics
 from .energy import (
     EnergyLedger,
@@ -47,6 +47,7 @@ __all__ = [
     "EnergyLedger",
     "ExplicitEuler",
     "Force",
+    "Grab",
     "Gravity",
     "Ground",
     "ImplicitEuler",

@@ -30,7 +30,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     try:
         return int(args.run(args) or 0)
-    except (ValueError, TypeError, FileNotFoundError) as error:
+    except (ValueError, TypeError, OSError, RuntimeError) as error:
         print(f"msdlab {args.command}: error: {error}", file=sys.stderr)
         return 2
 

@@ -200,3 +200,51 @@ class Prescribed(Constraint):
         state.x[p] = target
         state.v[p] = (target - state.x_old[p]) / state.dt
         return before - state.energy_of(p)
+
+
+class Grab(Constraint):
+    """A particle held by a hand (the mouse) at a target position (m) while the simulation runs.
+
+    While held, the particle is fixed (forces do not move it), sits on the
+    target, and its velocity is the target's displacement over the step / dt,
+    so dashpots and the ledger ("driven") see the hand's motion. On release it
+    keeps that velocity: zero if the hand was still, so it does not fling with
+    the spring forces it resisted while held (the bug of pegging the position only).
+    """
+
+    ledger_name = "driven"
+
+    def __init__(self) -> None:
+        self.particle: int | None = None
+        self.target: np.ndarray | None = None
+        self._body: Body | None = None
+        self._was_fixed = False
+
+    def hold(self, body: Body, particle: int, target: Sequence[float] | None = None) -> None:
+        """Take ``particle`` of ``body`` in hand at ``target`` (default: where it is)."""
+        self.release()
+        if not 0 <= particle < len(body):
+            raise ValueError(f"particle {particle} does not exist: the body has {len(body)}")
+        self._body, self.particle = body, int(particle)
+        self._was_fixed = bool(body.fixed[particle])
+        body.fixed[particle] = True
+        self.move(body.positions[particle] if target is None else target)
+
+    def move(self, target: Sequence[float]) -> None:
+        """Move the hand to ``target`` (m); the particle follows at the next step."""
+        self.target = np.array(target, dtype=float)
+
+    def release(self) -> None:
+        """Let go: the particle is free again (or stays fixed if it was pinned before)."""
+        if self._body is not None and self.particle is not None:
+            self._body.fixed[self.particle] = self._was_fixed
+        self._body, self.particle, self.target = None, None, None
+
+    def apply(self, state: StepState) -> float:
+        if self.particle is None or self.target is None:
+            return 0.0
+        p = np.array([self.particle])
+        before = state.energy_of(p)
+        state.x[p] = self.target
+        state.v[p] = (self.target - state.x_old[p]) / state.dt
+        return before - state.energy_of(p)

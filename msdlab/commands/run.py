@@ -1,0 +1,174 @@
+"""``msdlab run SCENE``: run a scene, print its energy ledger, save or show an animation."""
+
+from __future__ import annotations
+
+import argparse
+import ast
+from pathlib import Path
+
+from ..errors import SimulationDiverged
+from ..integrators import (
+    RK4,
+    ExplicitEuler,
+    ImplicitEuler,
+    Integrator,
+    SymplecticEuler,
+    VelocityVerlet,
+    Verlet,
+)
+from ..scenes import SCENES, Scene, get_scene
+from ..scenes.trampoline import EXPERIMENTS, experiment_table, run_experiment
+from ..simulation import Simulation, Trajectory
+from .progress import ProgressBar
+
+INTEGRATORS: dict[str, type[Integrator]] = {
+    "explicit-euler": ExplicitEuler,
+    "symplectic-euler": SymplecticEuler,
+    "verlet": Verlet,
+    "velocity-verlet": VelocityVerlet,
+    "rk4": RK4,
+    "implicit-euler": ImplicitEuler,
+}
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "run",
+        help="run a scene: energy ledger, animation (--save), live window (--show)",
+        description=__doc__ + " `msdlab scenes` lists the scenes, `msdlab scenes NAME` "
+        "their settings.",
+    )
+    parser.add_argument("scene", choices=list(SCENES), metavar="SCENE", help="a scene name")
+    parser.add_argument("--duration", type=float, help="how long to run (default: the scene's)")
+    parser.add_argument("--dt", type=float, help="time step (default: the scene's)")
+    parser.add_argument(
+        "--integrator", choices=list(INTEGRATORS), help="replace the scene's integrator"
+    )
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="change a scene setting, e.g. --set ball_mass=5 (repeatable)",
+    )
+    parser.add_argument(
+        "--save", type=Path, metavar="FILE", help="write an animation: FILE.gif, .mp4 or .html"
+    )
+    parser.add_argument(
+        "--show", action="store_true", help="open a window; drag particles with the mouse"
+    )
+    parser.add_argument(
+        "--experiments",
+        action="store_true",
+        help="trampoline only: run the report's seven experiments and print their outcomes",
+    )
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    scene = get_scene(args.scene)
+    settings = parse_settings(scene, args.set)
+    if args.save is not None:
+        from ..viz.animation import check_format
+
+        check_format(args.save)
+    if args.show:
+        from ..viz.interactive import check_display
+
+        check_display()
+    if args.experiments:
+        return _experiments(scene, settings, args)
+    sim = _build(scene, settings, args)
+    steps = round((args.duration or scene.duration) / sim.dt)
+    print(f"{scene.name}: {sim!r}")
+    trajectory = _run(sim, steps, scene.name)
+    if trajectory is None:
+        return 1
+    print(trajectory.energies.table(rows=10))
+    if args.save is not None:
+        from ..viz import save_animation, spheres_of
+
+        path = save_animation(
+            trajectory,
+            args.save,
+            max_frames=scene.frames,
+            view=scene.view,
+            up=scene.up,
+            spheres=spheres_of(sim),
+            time_unit=scene.unit,
+            title=scene.name,
+        )
+        print(f"animation written to {path.resolve()}")
+    if args.show:
+        from ..viz import show
+
+        show(_build(scene, settings, args), view=scene.view, up=scene.up)
+    return 0
+
+
+def parse_settings(scene: Scene, items: list[str]) -> dict[str, object]:
+    """``key=value`` strings as keyword arguments of the scene (values read as Python literals)."""
+    valid = scene.settings()
+    valid.pop("integrator", None)
+    settings = {}
+    for item in items:
+        key, sep, text = item.partition("=")
+        key = key.strip()
+        if not sep:
+            raise ValueError(f"--set takes key=value, got {item!r}")
+        if key not in valid:
+            raise ValueError(
+                f"scene {scene.name!r} has no setting {key!r}; valid settings: {', '.join(valid)}"
+            )
+        try:
+            settings[key] = ast.literal_eval(text.strip())
+        except (ValueError, SyntaxError):
+            settings[key] = text.strip()  # a word, e.g. model=frame
+    return settings
+
+
+def _build(scene: Scene, settings: dict[str, object], args: argparse.Namespace) -> Simulation:
+    sim = scene.build(**settings)
+    if args.integrator is not None:
+        sim.integrator = INTEGRATORS[args.integrator]()
+    if args.dt is not None:
+        sim.dt = args.dt
+    return sim
+
+
+def _run(sim: Simulation, steps: int, label: str) -> Trajectory | None:
+    """Run with a progress bar; on a blow-up print the diagnosis and return None."""
+    bar = ProgressBar(steps, label)
+    try:
+        return sim.run(
+            steps=steps,
+            record_every=max(1, steps // 200),
+            callback=lambda s: bar(s.step_count),
+        )
+    except SimulationDiverged as error:
+        print(f"the simulation blew up: {error}")
+        return None
+    finally:
+        bar.close()
+
+
+def _experiments(scene: Scene, settings: dict[str, object], args: argparse.Namespace) -> int:
+    if scene.name != "trampoline":
+        raise ValueError(
+            "--experiments runs the trampoline report's experiments: msdlab run "
+            "trampoline --experiments"
+        )
+    duration = args.duration or scene.duration
+    if args.dt is not None:
+        settings["dt"] = args.dt
+    if args.integrator is not None:
+        settings["integrator"] = INTEGRATORS[args.integrator]()
+    bar = ProgressBar(len(EXPERIMENTS), "experiments", delay=0.0)
+    outcomes = []
+    for done, experiment in enumerate(EXPERIMENTS.values()):
+        bar(done)
+        outcomes.append(run_experiment(experiment, duration, **settings))
+    bar.close()
+    print(f"ball centre heights in m after {duration:g} s (deepest, mean of the last second):")
+    print(experiment_table(outcomes))
+    return 0

@@ -1,0 +1,27 @@
+"""Seeing a simulation: plots of a body and of its energy ledger, animations, mouse dragging.
+
+from msdlab import viz
+viz.plot_body(sim.body)                        # springs coloured by strain
+viz.plot_energy(trajectory.energies)
+viz.save_animation(trajectory, "run.gif")      # or .mp4 (needs ffmpeg), .html
+viz.show(sim)                                  # window: drag particles with the mouse
+"""
+
+from .animation import FORMATS, animate, save_animation
+from .energy import plot_energy
+from .interactive import Dragger, show
+from .view import BodyView, new_axes, plot_body, spheres_of, strains
+
+__all__ = [
+    "FORMATS",
+    "BodyView",
+    "Dragger",
+    "animate",
+    "new_axes",
+    "plot_body",
+    "plot_energy",
+    "save_animation",
+    "show",
+    "spheres_of",
+    "strains",
+]

@@ -1,0 +1,144 @@
+"""Grab a particle with the mouse and drag it while the simulation runs (2-D and 3-D).
+
+Works in any interactive matplotlib window and in Jupyter with ipympl
+(``%matplotlib widget``). Press the left button near a particle to take the
+nearest one in hand (`Grab`), move to drag it, release to let go: it keeps the
+hand's velocity, not the spring forces it resisted. In 3-D the particle moves
+parallel to the screen; the right button turns the view.
+"""
+
+from __future__ import annotations
+
+import textwrap
+from collections.abc import Sequence
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.backend_bases import MouseEvent
+
+from ..constraints import Grab
+from ..errors import SimulationDiverged
+from ..simulation import Simulation
+from .view import BodyView, new_axes, spheres_of
+
+
+class Dragger:
+    """Runs ``sim`` in a figure with mouse grabbing: ``steps_per_frame`` steps per ``interval`` ms.
+
+    `advance` does one frame (the timer calls it; tests call it directly).
+    """
+
+    def __init__(
+        self,
+        sim: Simulation,
+        ax: Axes | None = None,
+        *,
+        steps_per_frame: int = 1,
+        interval: int = 30,
+        view: Sequence[float] | None = None,
+        up: str = "z",
+    ) -> None:
+        self.sim = sim
+        self.steps_per_frame = int(steps_per_frame)
+        self.grab = Grab()
+        sim.constraints.append(self.grab)
+        self.ax = ax or new_axes(sim.body)
+        self.drawing = BodyView(self.ax, sim.body, view=view, up=up, spheres=spheres_of(sim))
+        self._press: tuple[np.ndarray, np.ndarray] | None = None  # (screen px, target) at press
+        if self.drawing.is_3d:
+            self.ax.mouse_init(rotate_btn=3, pan_btn=2, zoom_btn=[])
+        canvas = self.ax.figure.canvas
+        self._connections = [
+            canvas.mpl_connect("button_press_event", self.on_press),
+            canvas.mpl_connect("motion_notify_event", self.on_motion),
+            canvas.mpl_connect("button_release_event", self.on_release),
+        ]
+        self.timer = canvas.new_timer(interval=interval)
+        self.timer.add_callback(self.advance)
+
+    def start(self) -> Dragger:
+        """Start stepping on the figure's timer."""
+        self.timer.start()
+        return self
+
+    def advance(self) -> None:
+        """Step the simulation one frame and redraw; on a blow-up, stop and say why."""
+        try:
+            for _ in range(self.steps_per_frame):
+                self.sim.step()
+        except SimulationDiverged as error:
+            self.timer.stop()
+            self.ax.set_title(textwrap.fill(f"stopped: {error}", 90), fontsize="small")
+        self.drawing.update(self.sim.body.positions)
+        self.ax.figure.canvas.draw_idle()
+
+    # ------------------------------------------------------------------ mouse
+    def on_press(self, event: MouseEvent) -> None:
+        if event.inaxes is not self.ax or event.button != 1:
+            return
+        mouse = np.array([event.x, event.y], dtype=float)
+        screen = self._to_screen(self.sim.body.positions)
+        nearest = int(np.argmin(np.linalg.norm(screen - mouse, axis=1)))
+        self.grab.hold(self.sim.body, nearest)
+        self._press = (mouse, self.sim.body.positions[nearest].copy())
+        self.on_motion(event)
+
+    def on_motion(self, event: MouseEvent) -> None:
+        if self._press is None or event.x is None or event.y is None:
+            return
+        mouse, start = self._press
+        if not self.drawing.is_3d:
+            inverse = self.ax.transData.inverted()
+            self.grab.move(inverse.transform((event.x, event.y)))
+            return
+        wanted = self._to_screen(start[None])[0] + (event.x, event.y) - mouse
+        target = start.copy()
+        for _ in range(3):  # Newton steps on screen(target) = wanted, moving parallel to the screen
+            miss = wanted - self._to_screen(target[None])[0]
+            target += np.linalg.pinv(self._screen_jacobian(target)) @ miss
+        self.grab.move(target)
+
+    def on_release(self, event: MouseEvent) -> None:
+        if self._press is not None:
+            self.grab.release()
+            self._press = None
+
+    # ------------------------------------------------------------------ geometry
+    def _to_screen(self, points: np.ndarray) -> np.ndarray:
+        """Screen pixels (M, 2) of points (M, d)."""
+        if not self.drawing.is_3d:
+            return self.ax.transData.transform(points)
+        from mpl_toolkits.mplot3d import proj3d
+
+        x, y, _ = proj3d.proj_transform(*points.T, self.ax.get_proj())
+        return self.ax.transData.transform(np.column_stack([x, y]))
+
+    def _screen_jacobian(self, point: np.ndarray) -> np.ndarray:
+        """d(screen px)/d(position) at ``point``, by finite differences, (2, 3)."""
+        span = np.ptp(np.array([self.ax.get_xlim(), self.ax.get_ylim(), self.ax.get_zlim()]), 1)
+        step = 1e-4 * span
+        probes = point + np.vstack([np.zeros(3), np.diag(step)])
+        screen = self._to_screen(probes)
+        return ((screen[1:] - screen[0]) / step[:, None]).T
+
+
+def check_display() -> None:
+    """Raise RuntimeError if matplotlib cannot open a window (no display, Agg backend)."""
+    import matplotlib
+    import matplotlib.pyplot as plt  # noqa: F401  (selects the backend)
+
+    if matplotlib.get_backend().lower() == "agg":
+        raise RuntimeError(
+            "no display: showing a window needs an interactive matplotlib backend "
+            "(a desktop session, or %matplotlib widget in Jupyter); save an animation instead"
+        )
+
+
+def show(sim: Simulation, **options) -> Dragger:
+    """Open a window running ``sim`` with mouse dragging (blocks until it is closed)."""
+    import matplotlib.pyplot as plt
+
+    check_display()
+    dragger = Dragger(sim, **options).start()
+    plt.show()
+    return dragger

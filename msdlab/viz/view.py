@@ -1,0 +1,162 @@
+"""Drawing one body on matplotlib axes: springs coloured by strain, particles as dots.
+
+`BodyView` owns the artists and redraws them for new positions, so static
+plots, animations and the interactive window share one drawing. 3-D views take
+the report's (MATLAB) angles: azimuth in the xy-plane from the -y axis,
+elevation above the xy-plane; ``up`` names the vertical axis ("y" for the
+brief's cube, whose floor is y = 0).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from matplotlib.artist import Artist
+from matplotlib.axes import Axes
+from matplotlib.collections import LineCollection
+from matplotlib.colors import Normalize
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle
+from mpl_toolkits.mplot3d.art3d import Line3DCollection
+
+from ..body import Body
+from ..forces import SphereContact
+from ..simulation import Simulation
+
+UPS = ("x", "y", "z")
+_U, _V = np.meshgrid(np.linspace(0, 2 * np.pi, 13), np.linspace(0, np.pi, 7))
+_UNIT_SPHERE = np.stack([np.cos(_U) * np.sin(_V), np.sin(_U) * np.sin(_V), np.cos(_V)])
+
+
+def strains(body: Body, positions: np.ndarray) -> np.ndarray:
+    """Strain of each spring, |x_a - x_b| / rest length - 1 (> 0 stretched, < 0 squeezed)."""
+    d = positions[body.spring_a] - positions[body.spring_b]
+    return np.sqrt(np.einsum("ij,ij->i", d, d)) / body.rest_lengths - 1.0
+
+
+def spheres_of(sim: Simulation) -> list[tuple[int, float]]:
+    """(particle, radius) of every ball in ``sim`` (its `SphereContact` forces)."""
+    return [(f.center, f.radius) for f in sim.forces if isinstance(f, SphereContact)]
+
+
+def new_axes(body: Body, figure: Figure | None = None, size: float = 6.0) -> Axes:
+    """Axes fit for ``body``: plain for 2-D, 3-D for 3-D."""
+    import matplotlib.pyplot as plt
+
+    figure = figure or plt.figure(figsize=(size, size * 0.8))
+    return figure.add_subplot(projection="3d" if body.dim == 3 else None)
+
+
+class BodyView:
+    """The artists drawing ``body`` on ``ax`` (2-D or 3-D axes), updated by `update`.
+
+    ``strain_limit`` is the strain drawn at full colour (blue squeezed, red
+    stretched); ``view`` = (azimuth, elevation) in degrees, report convention;
+    ``spheres`` are (particle, radius) pairs drawn as balls (see `spheres_of`).
+    """
+
+    def __init__(
+        self,
+        ax: Axes,
+        body: Body,
+        positions: np.ndarray | None = None,
+        *,
+        strain_limit: float | None = None,
+        view: Sequence[float] | None = None,
+        up: str = "z",
+        spheres: Sequence[tuple[int, float]] = (),
+        colorbar: bool = True,
+    ) -> None:
+        if up not in UPS:
+            raise ValueError(f"unknown vertical axis {up!r}; choose one of {', '.join(UPS)}")
+        self.ax, self.body = ax, body
+        self.is_3d = body.dim == 3
+        if self.is_3d != hasattr(ax, "get_proj"):
+            kind = "3-D" if self.is_3d else "2-D"
+            raise ValueError(f"a {kind} body needs {kind} axes; use new_axes(body)")
+        positions = body.positions if positions is None else positions
+        limit = strain_limit or max(
+            1e-3, float(np.max(np.abs(strains(body, positions)), initial=0))
+        )
+        style = {"cmap": "coolwarm", "norm": Normalize(-limit, limit), "linewidths": 1.2}
+        segments = self._segments(positions)
+        if self.is_3d:
+            self.springs = Line3DCollection(segments, **style)
+            ax.add_collection3d(self.springs)
+            azimuth, elevation = (45.0, 30.0) if view is None else view
+            ax.view_init(elev=elevation, azim=azimuth - 90.0, vertical_axis=up)
+        else:
+            self.springs = LineCollection(segments, **style)
+            ax.add_collection(self.springs)
+            ax.set_aspect("equal")
+        self.springs.set_array(strains(body, positions))
+        (self.free,) = ax.plot(*positions[~body.fixed].T, "o", ms=3, color="0.2")
+        (self.pinned,) = ax.plot(*positions[body.fixed].T, "s", ms=5, color="k")
+        self.spheres = [(int(p), float(r)) for p, r in spheres]
+        self.balls = [self._ball(positions[p], r) for p, r in self.spheres]
+        self.fit(positions[None])
+        if colorbar and body.n_springs:
+            pad = 0.12 if self.is_3d else 0.04
+            ax.figure.colorbar(self.springs, ax=ax, shrink=0.6, pad=pad, label="strain")
+
+    def update(self, positions: np.ndarray) -> list:
+        """Redraw for ``positions`` (N, d); return the changed artists."""
+        self.springs.set_segments(self._segments(positions))
+        self.springs.set_array(strains(self.body, positions))
+        for artist, mask in ((self.free, ~self.body.fixed), (self.pinned, self.body.fixed)):
+            if self.is_3d:
+                artist.set_data_3d(*positions[mask].T)
+            else:
+                artist.set_data(*positions[mask].T)
+        for ball in self.balls:
+            ball.remove()
+        self.balls = [self._ball(positions[p], r) for p, r in self.spheres]
+        return [self.springs, self.free, self.pinned, *self.balls]
+
+    def fit(self, frames: np.ndarray, margin: float = 0.05, thinnest: float = 0.2) -> None:
+        """Set the limits to hold every position of ``frames`` (F, N, d) at equal scales.
+
+        An axis spans at least ``thinnest`` of the widest, so a flat body stays readable.
+        """
+        points = frames.reshape(-1, frames.shape[-1])
+        radii = np.zeros(len(points))
+        for p, r in self.spheres:  # balls are part of the picture
+            radii[p :: frames.shape[1]] = r
+        low = (points - radii[:, None]).min(axis=0)
+        high = (points + radii[:, None]).max(axis=0)
+        width = max(float(np.max(high - low)), 1e-9)
+        half = 0.5 * np.maximum(high - low, thinnest * width) + margin * width
+        low, high = 0.5 * (low + high) - half, 0.5 * (low + high) + half
+        self.ax.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), xlabel="x", ylabel="y")
+        if self.is_3d:
+            self.ax.set(zlim=(low[2], high[2]), zlabel="z")
+            self.ax.set_box_aspect(tuple(high - low))
+
+    def _segments(self, positions: np.ndarray) -> np.ndarray:
+        return np.stack([positions[self.body.spring_a], positions[self.body.spring_b]], axis=1)
+
+    def _ball(self, centre: np.ndarray, radius: float) -> Artist:
+        if not self.is_3d:
+            return self.ax.add_patch(Circle(centre, radius, color="tab:orange", alpha=0.6))
+        x, y, z = centre[:, None, None] + radius * _UNIT_SPHERE
+        return self.ax.plot_wireframe(x, y, z, color="tab:orange", linewidth=0.6)
+
+
+def plot_body(
+    body: Body,
+    positions: np.ndarray | None = None,
+    ax: Axes | None = None,
+    *,
+    view: Sequence[float] | None = None,
+    up: str = "z",
+    spheres: Sequence[tuple[int, float]] = (),
+    strain_limit: float | None = None,
+    title: str | None = None,
+) -> Axes:
+    """Plot ``body`` (at ``positions``, default its own) with springs coloured by strain."""
+    ax = ax or new_axes(body)
+    BodyView(ax, body, positions, strain_limit=strain_limit, view=view, up=up, spheres=spheres)
+    if title:
+        ax.set_title(title)
+    return ax

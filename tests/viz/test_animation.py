@@ -1,0 +1,59 @@
+"""Animations saved as GIF, HTML and (with ffmpeg) MP4."""
+
+import shutil
+
+import pytest
+from matplotlib.animation import FFMpegWriter, FuncAnimation
+from PIL import Image
+
+from msdlab import viz
+from msdlab.scenes import gallery, jelly
+
+
+@pytest.fixture(scope="module")
+def rope_run():
+    return gallery.rope().run(steps=100, record_every=10)
+
+
+def test_animate_returns_a_funcanimation_with_the_frames(rope_run):
+    animation = viz.animate(rope_run, max_frames=5)
+    assert isinstance(animation, FuncAnimation)
+    assert len(list(animation.new_frame_seq())) == 5
+    assert animation.to_jshtml().count("data:image/png;base64") == 5
+
+
+def test_gif_has_one_image_per_frame(rope_run, tmp_path):
+    path = viz.save_animation(rope_run, tmp_path / "rope.gif", max_frames=6, dpi=40)
+    with Image.open(path) as gif:
+        assert gif.n_frames == 6
+
+
+def test_html_is_self_contained(rope_run, tmp_path):
+    path = viz.save_animation(rope_run, tmp_path / "rope.html", max_frames=4, dpi=40)
+    page = path.read_text()
+    assert "<script" in page and page.count("data:image/png;base64") == 4
+    assert 'src="http' not in page
+
+
+def test_3d_animation_with_y_up(tmp_path):
+    run = jelly.jelly_cube(size=3).run(steps=20, record_every=10)
+    path = viz.save_animation(run, tmp_path / "cube.gif", max_frames=3, up="y", dpi=40)
+    assert path.stat().st_size > 1000
+
+
+def test_mp4_without_ffmpeg_says_what_to_do(rope_run, tmp_path, monkeypatch):
+    monkeypatch.setattr(FFMpegWriter, "isAvailable", classmethod(lambda cls: False))
+    with pytest.raises(RuntimeError, match=r"ffmpeg.*\.gif or \.html"):
+        viz.save_animation(rope_run, tmp_path / "rope.mp4")
+    assert not (tmp_path / "rope.mp4").exists()
+
+
+@pytest.mark.skipif(shutil.which("ffmpeg") is None, reason="ffmpeg is not installed")
+def test_mp4_with_ffmpeg(rope_run, tmp_path):
+    path = viz.save_animation(rope_run, tmp_path / "rope.mp4", max_frames=4, dpi=40)
+    assert path.stat().st_size > 1000
+
+
+def test_unknown_file_type_names_the_formats(rope_run, tmp_path):
+    with pytest.raises(ValueError, match=r"\.gif, \.mp4, \.html"):
+        viz.save_animation(rope_run, tmp_path / "rope.avi")

@@ -1,0 +1,86 @@
+"""Static plots: a body with springs coloured by strain (2-D and 3-D), the energy ledger."""
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+from matplotlib.collections import LineCollection
+from matplotlib.patches import Circle
+
+import msdlab as msd
+from msdlab import viz
+from msdlab.scenes import cloth, gallery, trampoline
+
+
+@pytest.fixture(autouse=True)
+def close_figures():
+    yield
+    plt.close("all")
+
+
+def test_strain_is_relative_stretch():
+    body = msd.Body.from_arrays([[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]], [[0, 1], [0, 2]])
+    body.rest_lengths[:] = [1.0, 2.0]
+    np.testing.assert_allclose(viz.strains(body, body.positions), [1.0, -0.5])
+
+
+def test_2d_body_springs_carry_their_strains(tmp_path):
+    sim = gallery.two_particles(pull=50.0)
+    ax = viz.plot_body(sim.body, title="pulled")
+    (springs,) = [c for c in ax.collections if isinstance(c, LineCollection)]
+    np.testing.assert_allclose(springs.get_array(), [0.5])  # 150 px over a rest of 100
+    np.testing.assert_allclose(springs.get_segments()[0], [[250.0, 200.0], [400.0, 200.0]])
+    assert ax.get_title() == "pulled"
+    path = tmp_path / "body.png"
+    ax.figure.savefig(path)
+    assert path.stat().st_size > 1000
+
+
+def test_3d_body_uses_the_reports_view_angles():
+    sim = trampoline.trampoline()
+    ax = viz.plot_body(sim.body, view=(45.0, 45.0), spheres=viz.spheres_of(sim))
+    assert (ax.azim, ax.elev) == (45.0 - 90.0, 45.0)  # azimuth measured from -y, as in MATLAB
+    ax = viz.plot_body(sim.body, view=(0.0, 0.0))
+    assert (ax.azim, ax.elev) == (-90.0, 0.0)  # looking along +y
+    assert viz.spheres_of(sim) == [(49, 0.5)]
+
+
+def test_a_ball_is_drawn_where_the_particle_is():
+    body = msd.Body.from_arrays([[0.0, 0.0], [1.0, 0.0]], [[0, 1]])
+    ax = viz.plot_body(body, spheres=[(1, 0.25)])
+    (ball,) = [p for p in ax.patches if isinstance(p, Circle)]
+    np.testing.assert_array_equal(ball.center, (1.0, 0.0))
+    assert ball.radius == 0.25
+
+
+def test_body_view_follows_new_positions():
+    sim = cloth.cloth()
+    ax = viz.new_axes(sim.body)
+    drawing = viz.BodyView(ax, sim.body)
+    sim.run(steps=50)
+    drawing.update(sim.body.positions)
+    *_, z = drawing.free.get_data_3d()
+    np.testing.assert_allclose(z, sim.body.positions[~sim.body.fixed, 2])
+    np.testing.assert_allclose(
+        drawing.springs.get_array(), viz.strains(sim.body, sim.body.positions)
+    )
+
+
+def test_wrong_axes_or_vertical_axis_are_refused():
+    sim = cloth.cloth()
+    _, flat = plt.subplots()
+    with pytest.raises(ValueError, match="3-D body needs 3-D axes"):
+        viz.BodyView(flat, sim.body)
+    with pytest.raises(ValueError, match="x, y, z"):
+        viz.plot_body(sim.body, up="w")
+
+
+def test_energy_plot_shows_the_ledger(tmp_path):
+    trajectory = gallery.triangle().run(steps=200, record_every=10)
+    ax = viz.plot_energy(trajectory.energies, time_unit="frames")
+    labels = [line.get_label() for line in ax.get_lines()]
+    assert labels[:4] == ["kinetic", "elastic", "potential", "total"]
+    assert "taken out: drag" in labels and labels[-1].startswith("drift")
+    np.testing.assert_allclose(ax.get_lines()[3].get_ydata(), trajectory.energies.total)
+    assert ax.get_xlabel() == "time (frames)"
+    ax.figure.savefig(tmp_path / "energy.png")
+    assert (tmp_path / "energy.png").stat().st_size > 1000
