@@ -51,7 +51,9 @@ class Ground(Constraint):
     the brief's floor y = 0; use ``normal=(0, 0, 1)`` for z-up scenes). A clamped
     particle keeps its tangential velocity (times 1 - ``friction``) and its
     normal velocity becomes the displacement it really made over the step / dt,
-    which is what position Verlet implies: no bounce, no sticking.
+    which is what position Verlet implies: no bounce, no sticking. The clamp is
+    first order: under resting contact the ledger books a small residual to
+    "ground" (it may be negative) that vanishes as dt -> 0.
     """
 
     ledger_name = "ground"
@@ -127,6 +129,11 @@ class Drag(Constraint):
 class Walls(Constraint):
     """A box [lower, upper] per axis: ``"reflect"`` bounces particles back, ``"periodic"`` wraps.
 
+    A particle found outside is put back on the wall with its normal velocity
+    turned inward: a bounce that keeps the speed and can carry a load. Moving it
+    back to the wall does work against the forces on it, so the energy is kept
+    only to first order in dt (the ledger books the difference under "walls").
+
     Periodic wrapping moves a particle across the box but not its springs, which
     then stretch across the whole box (as on the p5.js page); use it for loose
     particles, not for connected bodies.
@@ -158,12 +165,11 @@ class Walls(Constraint):
         before = state.energy_of(outside)
         if self.mode == "periodic":
             x[outside] = self.lower + np.mod(x[outside] - self.lower, self.upper - self.lower)
-        else:
+        else:  # put it back on the wall and turn its normal velocity inward
+            speed = np.abs(v[outside])
             low, high = x[outside] < self.lower, x[outside] > self.upper
             x[outside] = np.clip(x[outside], self.lower, self.upper)
-            v[outside] = np.where(
-                low, np.abs(v[outside]), np.where(high, -np.abs(v[outside]), v[outside])
-            )
+            v[outside] = np.where(low, speed, np.where(high, -speed, v[outside]))
         return before - state.energy_of(outside)
 
     def __repr__(self) -> str:

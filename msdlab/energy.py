@@ -123,7 +123,7 @@ class EnergyLedger:
     def table(self, rows: int = 8) -> str:
         """The ledger as a text table of about ``rows`` evenly spaced frames."""
         names = sorted(self.dissipated)
-        header = ["t (s)", "kinetic", "elastic", "potential", "total", *names, "drift"]
+        header = ["time", "kinetic", "elastic", "potential", "total", *names, "drift"]
         picks = np.unique(
             np.linspace(0, len(self.steps) - 1, min(rows, len(self.steps))).astype(int)
         )

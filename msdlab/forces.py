@@ -16,9 +16,12 @@ class Force(ABC):
     """A force field acting on the particles of a body.
 
     `add_to` adds the force (N) to ``out``; conservative forces also give their
-    potential energy, and forces that depend on x or v may give their Jacobians
-    (used by `ImplicitEuler`).
+    potential energy, dissipative ones the power they take out (booked in the
+    energy ledger under ``ledger_name``), and forces that depend on x or v may
+    give their Jacobians (used by `ImplicitEuler`).
     """
+
+    ledger_name = "other"
 
     def check(self, body: Body) -> None:
         """Raise ValueError if this force cannot act on ``body`` (e.g. wrong dimension)."""
@@ -31,6 +34,10 @@ class Force(ABC):
         self, body: Body, x: np.ndarray, particles: np.ndarray | None = None
     ) -> float:
         """Potential energy (J) of this force, or of the terms involving ``particles``."""
+        return 0.0
+
+    def dissipated_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
+        """Power (W) this force takes out of the body; 0 for conservative forces."""
         return 0.0
 
     def jacobians(
@@ -72,12 +79,19 @@ class ViscousDamping(Force):
     version that is stable at any dt.
     """
 
+    ledger_name = "viscous"
+
     def __init__(self, coefficient: float) -> None:
         check_non_negative("viscous damping coefficient", coefficient)
         self.coefficient = float(coefficient)
 
     def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
         out -= self.coefficient * v
+
+    def dissipated_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
+        """c Σ |v|² over the free particles (W)."""
+        free = ~body.fixed
+        return float(self.coefficient * np.einsum("ij,ij->", v[free], v[free]))
 
     def jacobians(self, body: Body, x: np.ndarray, v: np.ndarray) -> tuple[None, sp.spmatrix]:
         return None, -self.coefficient * sp.identity(x.size, format="csr")

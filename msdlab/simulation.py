@@ -118,6 +118,10 @@ class Simulation:
             "dashpot": kernels.dashpot_power(body, x, v) * dt,
             "integrator": self.integrator.dissipated_energy(v, body.masses),
         }
+        for force in self.forces:
+            power = force.dissipated_power(body, x, v)
+            if power:
+                booked[force.ledger_name] = booked.get(force.ledger_name, 0.0) + power * dt
         x_new, v_new = self._checked(self.integrator.step(x, v, dt, self.dynamics), x)
         fixed = body.fixed
         if fixed.any():

@@ -84,8 +84,9 @@ def test_damped_runs_lose_energy_monotonically(integrator, forces, damping):
         (msd.Verlet(0.02), [], 0.0, "integrator"),
         (msd.VelocityVerlet(), [], 0.5, "dashpot"),
         (msd.VelocityVerlet(), [msd.Drag(0.5)], 0.0, "drag"),
+        (msd.VelocityVerlet(), [msd.ViscousDamping(0.4)], 0.0, "viscous"),
     ],
-    ids=["verlet-lambda", "dashpots", "drag"],
+    ids=["verlet-lambda", "dashpots", "drag", "viscous"],
 )
 def test_ledger_books_the_loss_to_its_source_and_closes(integrator, forces, damping, source):
     trajectory = msd.Simulation(chain(damping), integrator, 0.005, forces).run(duration=10.0)

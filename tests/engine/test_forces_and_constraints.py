@@ -89,9 +89,23 @@ def test_viscous_damping_force_is_minus_c_v():
 def test_reflecting_walls_keep_particles_inside():
     rng = np.random.default_rng(0)
     body = msd.Body.from_arrays(rng.uniform(1, 9, (20, 2)), velocities=rng.normal(0, 5, (20, 2)))
+    energy = msd.kinetic_energy(body)
     msd.Simulation(body, msd.SymplecticEuler(), 0.05, [msd.Walls((0, 0), (10, 10))]).run(steps=400)
     assert np.all((body.positions >= 0) & (body.positions <= 10))
-    assert msd.kinetic_energy(body) > 0
+    assert msd.kinetic_energy(body) == pytest.approx(energy)  # no forces: speeds are kept
+
+
+def test_reflecting_walls_bounce_with_first_order_energy_error():
+    def energy_error(dt: float) -> float:
+        body = msd.Body.from_arrays([[2.0, 3.0]], velocities=[[1.5, 0.0]])
+        forces = [msd.Gravity((0, -9.81)), msd.Walls((0, 0), (4, 10))]
+        ledger = msd.Simulation(body, msd.VelocityVerlet(), dt, forces).run(duration=20.0).energies
+        assert abs(ledger.drift[-1]) < 1e-9  # the ledger books what the walls did
+        assert np.ptp(ledger.potential[len(ledger.potential) // 2 :]) > 0.5 * ledger.total[0]
+        return abs(ledger.total[-1] - ledger.total[0]) / ledger.total[0]
+
+    coarse, fine = energy_error(1e-3), energy_error(5e-4)
+    assert coarse < 0.03 and coarse / fine == pytest.approx(2.0, rel=0.3)
 
 
 def test_periodic_walls_wrap_positions():
