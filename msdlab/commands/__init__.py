@@ -1,5 +1,5 @@
 """Sub-commands of the ``msdlab`` command line; each module has ``register(subparsers)``."""
 
-from . import demo
+from . import check, demo, templates
 
-COMMANDS = [demo]
+COMMANDS = [demo, check, templates]
