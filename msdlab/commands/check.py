@@ -1,7 +1,7 @@
 """``msdlab check [TASK]``: run the checks of one task (or all) on your task files and score them.
 
-The checks run in a fresh pytest process on a folder laid out like
-assignments/ (default: ./assignments, else the course's assignments/). The
+The checks (tests/tasks) run in a fresh pytest process on a folder laid out
+like assignments/ (default: ./assignments, else the course's assignments/). The
 table shows each check, its points, pass or fail and what the check saw;
 the exit status is 0 only if every check passed.
 """
@@ -19,7 +19,7 @@ from pathlib import Path
 from ..course import PROJECT_ROOT, TASKS, loader
 from ..course.report import CheckReport
 
-CHECKS = PROJECT_ROOT / "tests" / "tasks"
+CHECKS = Path("tests") / "tasks"
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -38,7 +38,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "(default: ./assignments if it exists, else the course's assignments/)",
     )
     parser.add_argument(
-        "--checks", type=Path, default=CHECKS, help="folder of the checks (default: %(default)s)"
+        "--checks",
+        type=Path,
+        default=None,
+        help=f"folder of the checks (default: {CHECKS} of the course folder you are in, else "
+        "of the msdlab installation)",
     )
     parser.add_argument(
         "--hidden", action="store_true", help="also run the instructor-only (hidden) checks"
@@ -53,9 +57,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     task = parse_task(args.task)
-    checks = Path(args.checks).resolve()
-    if not checks.is_dir():
-        raise FileNotFoundError(f"no checks folder at {checks}")
+    checks = checks_folder(args.checks, Path.cwd())
     folder = implementation_folder(args.impl, Path.cwd())
     scope = f"task {task}" if task else "all tasks"
     print(f"msdlab check: {scope} on {folder}")
@@ -102,6 +104,17 @@ def parse_task(text: str | None) -> int | None:
     return int(digits)
 
 
+def checks_folder(given: Path | None, cwd: Path) -> Path:
+    """The folder of the checks: given, else the course's tests/tasks (yours first)."""
+    if given is None:
+        local = loader.course_root(cwd) / CHECKS
+        given = local if local.is_dir() else PROJECT_ROOT / CHECKS
+    folder = Path(given).expanduser().resolve()
+    if not folder.is_dir():
+        raise FileNotFoundError(f"no checks folder at {folder}")
+    return folder
+
+
 def implementation_folder(spec: str | None, cwd: Path) -> Path:
     """The folder of task files to check; a student's ./assignments comes first."""
     if spec is None:
@@ -135,6 +148,8 @@ def pytest_command(
         marker,
         "-p",
         "no:cacheprovider",
+        "-p",
+        "no:nbval",  # not needed by the checks; loading it takes most of a second
         "--tb=short" if verbose else "--tb=no",
         "-q",
     ]

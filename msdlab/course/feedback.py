@@ -38,7 +38,7 @@ def num(value: float, digits: int = 3) -> str:
     value = float(value)
     if not np.isfinite(value):
         return str(value)
-    return f"{value:.{digits}g}"
+    return f"{value:.{digits}g}" if value != 0 else "0"  # no "-0"
 
 
 def vec(values: Sequence[float] | np.ndarray, digits: int = 3) -> str:

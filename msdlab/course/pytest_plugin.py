@@ -11,8 +11,10 @@
   has exactly one task marker and its points; ``hidden`` checks are instructor-only.
 - ``--msdlab-report=PATH`` writes the JSON `CheckReport` of the graded checks;
   a points summary ends the terminal output.
-- Hypothesis profiles ``ci`` (no deadline, derandomised, no example database:
-  reproducible grading; loaded unless another profile is chosen) and ``dev``.
+- `hypothesis_profiles`, called by the checks' conftest: profiles ``ci`` (no
+  deadline, derandomised, no example database: reproducible grading; loaded
+  unless ``--hypothesis-profile`` chooses another) and ``dev``. Hypothesis is
+  imported only where checks use it (importing it takes about a second).
 """
 
 from __future__ import annotations
@@ -56,7 +58,6 @@ def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "hidden: instructor-only check, not in the student release")
     config.stash[_REPORT] = CheckReport(implementation=implementation_spec(config))
     config.stash[_STARTED] = time.perf_counter()
-    _hypothesis_profiles(config)
 
 
 def implementation_spec(config: pytest.Config) -> str:
@@ -69,14 +70,13 @@ def implementation_spec(config: pytest.Config) -> str:
 def implementation(pytestconfig: pytest.Config) -> loader.Implementation:
     """The implementation under test (see ``--impl``)."""
     spec = implementation_spec(pytestconfig)
-    impl = loader.load(spec, loader.course_root(pytestconfig.rootpath))
-    pytestconfig.stash[_REPORT].implementation = impl.label
-    return impl
+    return loader.load(spec, loader.course_root(pytestconfig.rootpath))
 
 
 def _task_fixture(number: int):
     @pytest.fixture(scope="session", name=f"task{number}")
-    def task(implementation: loader.Implementation):
+    def task(implementation: loader.Implementation, pytestconfig: pytest.Config):
+        pytestconfig.stash[_REPORT].implementation = implementation.label
         return implementation.task(number)
 
     task.__doc__ = f"The module of task {number} of the implementation under test."
@@ -170,7 +170,11 @@ def _describe(call: pytest.CallInfo) -> tuple[str | None, str]:
         return None, ""
     error = call.excinfo.value
     lines = [str(error).strip()] if str(error).strip() else []
-    lines += [str(note) for note in getattr(error, "__notes__", ())]
+    lines += [  # hypothesis's failing example; its other notes name lines of the checks
+        str(note)
+        for note in getattr(error, "__notes__", ())
+        if str(note).startswith(("Falsifying example", "Failing test case"))
+    ]
     cause = error.__cause__
     if isinstance(error, loader.SubmissionError) and cause is not None:
         lines.append(f"caused by {type(cause).__name__}: {cause}")
@@ -184,11 +188,10 @@ def _skip_reason(report: pytest.TestReport) -> str:
     return str(longrepr or "")
 
 
-def _hypothesis_profiles(config: pytest.Config) -> None:
-    try:
-        from hypothesis import settings
-    except ImportError:  # the checks that use hypothesis need it; others run without
-        return
+def hypothesis_profiles(config: pytest.Config) -> None:
+    """Register the ``ci`` and ``dev`` profiles; load ``ci`` unless a profile was chosen."""
+    from hypothesis import settings
+
     settings.register_profile("ci", deadline=None, derandomize=True, database=None)
     settings.register_profile("dev", deadline=None)
     chosen = config.getoption("hypothesis_profile", None)

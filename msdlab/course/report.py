@@ -112,7 +112,7 @@ class CheckReport:
         """Check, points, result and the short message of every check, then the totals."""
         if not self.checks:
             return "no graded checks ran"
-        name_width = min(max(len(_label(c)) for c in self.checks), 44)
+        name_width = min(max(len(_label(c)) for c in self.checks), max(width // 2, 30))
         message_width = max(width - name_width - 17, 20)
         lines = [f"{'check':<{name_width}}  points  result  message"]
         for check in self.checks:

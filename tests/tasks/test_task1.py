@@ -102,7 +102,7 @@ def test_verlet_step_is_the_kernel(task1):
 
 
 @pytest.mark.points(2)
-def test_height_after_matches_the_running_template(task1):
+def test_height_after_as_template(task1):
     """height_after(n) is the height the running template reaches after n steps."""
     steps = 600
     heights = free_fall_heights(BOTTOM, DT, G, steps)
@@ -125,7 +125,7 @@ def test_height_after_matches_the_running_template(task1):
 
 
 @pytest.mark.points(2)
-def test_steps_to_floor_matches_the_running_template(task1):
+def test_steps_to_floor_as_template(task1):
     """steps_to_floor() is the step in which the running template's floor first catches the
     bottom layer."""
     start = oracles.template_positions((3, 2, 3), 0.1, (-1.0, BOTTOM, -1.0))

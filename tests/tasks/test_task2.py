@@ -80,7 +80,7 @@ def test_grid_at_rest_feels_no_force(task2):
 
 
 @pytest.mark.points(2)
-def test_stretched_spring_pulls_and_compressed_spring_pushes(task2):
+def test_stretched_pulls_compressed_pushes(task2):
     """Two particles: a stretched spring pulls them together, a compressed one pushes apart."""
     k, h = STIFFNESS, SPACING
     for factor, verb in ((1.5, "stretched"), (0.6, "compressed")):

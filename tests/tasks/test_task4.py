@@ -44,7 +44,7 @@ def missing_and_extra(springs, expected):
 
 
 @pytest.mark.points(2)
-def test_neighbour_offsets_of_an_interior_particle(task4):
+def test_neighbour_offsets_26(task4):
     """6 axis, 12 face-diagonal and 8 body-diagonal neighbours, each offset once, both signs."""
     for wanted, count in (((1,), 6), ((2,), 12), ((3,), 8), ((1, 2, 3), 26)):
         offsets = np.asarray(task4.neighbour_offsets(wanted))
@@ -70,7 +70,7 @@ def test_neighbour_offsets_of_an_interior_particle(task4):
 
 
 @pytest.mark.points(3)
-def test_grid_springs_join_each_neighbour_pair_once(task4):
+def test_grid_springs_each_pair_once(task4):
     """On a 3 × 4 × 5 grid the springs are exactly the engine's: none missing, none twice."""
     for neighbours in ((1,), (2,), (3,), (1, 2, 3)):
         springs, _ = student_springs(task4, SHAPE, 0.1, neighbours)
@@ -90,7 +90,7 @@ def test_grid_springs_join_each_neighbour_pair_once(task4):
 
 
 @pytest.mark.points(2)
-def test_rest_lengths_leave_the_grid_unstressed(task4):
+def test_rest_lengths_unstressed(task4):
     """Rest lengths are the distances at rest (h, h√2, h√3): the grid at rest feels no force."""
     spacing = 0.1
     springs, rest = student_springs(task4, SHAPE, spacing, (1, 2, 3))
@@ -114,7 +114,7 @@ def test_rest_lengths_leave_the_grid_unstressed(task4):
 
 
 @pytest.mark.points(3)
-def test_rotated_cube_holds_its_shape_with_diagonal_springs(task4):
+def test_rotated_cube_holds_its_shape(task4):
     """Tilted 45° about z, a cube with 1, √2, √3 springs stands; with axis springs only it folds."""
     axis, angle = (0.0, 0.0, 1.0), 45.0
     held = float(task4.drop_rotated_cube(axis, angle, (1, 2, 3)))

@@ -82,7 +82,7 @@ def test_one_step_is_equation_1_4(task5):
 
 @pytest.mark.points(3)
 def test_no_damping_reproduces_the_template(task5):
-    """λ = 0 reproduces the template's falling grid step for step, floor included."""
+    """λ = 0 reproduces the template's falling grid step for step (to rounding), floor included."""
     shape, spacing, origin, steps = (3, 2, 4), 0.1, (-1.0, 1.5, -1.0), 600
     template = oracles.template_run(
         oracles.template_positions(shape, spacing, origin).reshape(-1, 3), steps
@@ -95,9 +95,10 @@ def test_no_damping_reproduces_the_template(task5):
         .positions
     )
     error = np.max(np.abs(frames - template), axis=(1, 2))
-    first = int(np.argmax(error > 1e-12))
+    tolerance = 1e-9  # rounding only: another order of the same arithmetic differs by ~1e-12
+    first = int(np.argmax(error > tolerance))
     expect(
-        np.all(error <= 1e-12),
+        np.all(error <= tolerance),
         saw=f"with λ = 0 the grid leaves the template's trajectory in step {first} (off by "
         f"{num(error[first])}; the bottom layer meets the floor in step 548)",
         cause="a scheme other than eq. (1.3), or a different start: the template begins with "
@@ -138,7 +139,7 @@ def energy_history(integrator, dt_fraction=0.2, steps=400):
 
 
 @pytest.mark.points(3)
-def test_damping_removes_energy_and_none_keeps_it(task5):
+def test_damping_removes_energy(task5):
     """λ = 0 keeps the total energy of a wobbling jelly; λ = 0.01 takes it out steadily."""
     energy, dt, limit = energy_history(task5.DampedVerlet(0.0))
     drift = float(np.max(np.abs(energy - energy[0])) / energy[0])
@@ -213,7 +214,7 @@ def test_predicted_stability_limit(task5):
 
 
 @pytest.mark.points(3)
-def test_measured_stable_dt_agrees_with_the_prediction(task5):
+def test_measured_stable_dt_as_predicted(task5):
     """measured_stable_dt agrees with √(4 - 2λ)/ω; damping does not allow larger steps."""
     measured = {}
     for lam in (0.0, 0.5):
