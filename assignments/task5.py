@@ -27,6 +27,12 @@ N = 3  # particles per edge of the jelly used by `measured_stable_dt`
 STIFFNESS = 0.5
 
 
+# --------------------------------------------------------------------------- given code
+def jelly(n: int = N) -> msd.Body:
+    """An n³ jelly cube: spacing 2/n, stiffness STIFFNESS, neighbours at 1, √2 and √3 spacings."""
+    return msd.Body.grid((n, n, n), spacing=2.0 / n, stiffness=STIFFNESS, neighbours=(1, 2, 3))
+
+
 # --------------------------------------------------------------------------- your answers
 class DampedVerlet(msd.Integrator):
     """Position Verlet with damping λ in [0, 1), eq. (1.4); λ = 0 is eq. (1.3), the template."""
@@ -52,11 +58,6 @@ class DampedVerlet(msd.Integrator):
         raise NotImplementedError(
             "Task 5: recover x(t - dt), apply eq. (1.4), return the new positions and velocities."
         )
-
-
-def jelly(n: int = N) -> msd.Body:
-    """Given: an n³ jelly cube (spacing 2/n, stiffness STIFFNESS, neighbours at 1, √2, √3)."""
-    return msd.Body.grid((n, n, n), spacing=2.0 / n, stiffness=STIFFNESS, neighbours=(1, 2, 3))
 
 
 def measured_stable_dt(damping: float, n: int = N, steps: int = 1000, rtol: float = 1e-3) -> float:

@@ -47,8 +47,9 @@ def vec(values: Sequence[float] | np.ndarray, digits: int = 3) -> str:
 
 
 def percent(fraction: float) -> str:
-    """A fraction as a percentage, e.g. 0.4 -> '40 %', 2e-5 -> '0.002 %'."""
-    return f"{num(100.0 * float(fraction), 2)} %"
+    """A fraction as a percentage, e.g. 0.4 -> '40 %', 2e-5 -> '0.002 %', 650 -> '65000 %'."""
+    value = 100.0 * float(fraction)
+    return f"{value:.0f} %" if abs(value) >= 100 else f"{num(value, 2)} %"
 
 
 def relative_error(got: np.ndarray, expected: np.ndarray) -> float:

@@ -76,7 +76,9 @@ def spring_acceleration(body: msd.Body, x: np.ndarray) -> np.ndarray:
     return force / body.masses[:, None]
 
 
-def energies(body: msd.Body, frames: np.ndarray, dt: float, g: Sequence[float] | None = None):
+def energies(
+    body: msd.Body, frames: np.ndarray, dt: float, g: Sequence[float] | None = None
+) -> np.ndarray:
     """Total energy (J) at frames 1 .. F-2 from positions only (central-difference velocities).
 
     Independent of how an integrator stores its velocity. ``g`` adds -Σ m g·x.

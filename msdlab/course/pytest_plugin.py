@@ -175,9 +175,6 @@ def _describe(call: pytest.CallInfo) -> tuple[str | None, str]:
         for note in getattr(error, "__notes__", ())
         if str(note).startswith(("Falsifying example", "Failing test case"))
     ]
-    cause = error.__cause__
-    if isinstance(error, loader.SubmissionError) and cause is not None:
-        lines.append(f"caused by {type(cause).__name__}: {cause}")
     return type(error).__name__, "\n".join(lines)
 
 

@@ -74,11 +74,6 @@ def make_template(source: str, task: int, name: str = "<solution>") -> str:
     return template
 
 
-def template_path(solution: Path, assignments: Path) -> Path:
-    """Where the template of ``solution`` goes."""
-    return assignments / solution.name
-
-
 def solution_files(solutions: Path) -> list[Path]:
     """The task files ``taskN.py`` of a solutions folder, in task order."""
     if not solutions.is_dir():

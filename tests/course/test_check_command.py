@@ -27,7 +27,8 @@ def test_all_checks_of_a_task_pass_on_the_solutions(capsys, tmp_path):
 def test_templates_fail_with_what_to_do(capsys):
     assert main(["check", "task1", "--impl", "assignments"]) == 1
     out = capsys.readouterr().out
-    assert "FAILED  NotImplementedError: Task 1:" in out
+    assert "FAILED  to do: return the number of particles" in out
+    assert "NotImplementedError: Task 1: return the number of particles" in out  # details
     assert "total: 0/9 points, 0 of 5 checks passed" in out
     assert "what the failing checks saw:" in out
 

@@ -57,7 +57,7 @@ MISTAKES = [
         {
             "stretched_pulls_compressed_pushes": "the sign",
             "matches_equations_on_a_deformed_grid": "a stretched spring pushes",
-            "energy_is_conserved_in_a_verlet_run": "total energy changed",
+            "energy_is_conserved_in_a_verlet_run": "total energy grew",
         },
     ),
     Mistake(

@@ -185,7 +185,8 @@ def test_energy_is_conserved_in_a_verlet_run(task2):
     change = (energy(flat, v) - start) / start
     expect(
         abs(change) < 0.02,
-        saw=f"total energy changed by {percent(change)} in {steps} velocity-Verlet steps at "
+        saw=f"total energy {'grew' if change > 0 else 'fell'} by {percent(abs(change))} in "
+        f"{steps} velocity-Verlet steps at "
         f"dt = {num(dt)} (the predicted stable limit is {num(limit)}); it should stay within "
         "2 %",
         cause="forces that are not the gradient of the spring energy: a wrong sign, a wrong "

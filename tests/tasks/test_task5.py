@@ -124,7 +124,15 @@ def test_damping_outside_0_to_1_is_refused(task5):
             "velocity every step; NaN fails every comparison, so test 'not 0 <= λ < 1')",
         )
     for lam in (0.0, 0.01, 0.99):
-        task5.DampedVerlet(lam)
+        try:
+            task5.DampedVerlet(lam)
+        except ValueError as error:
+            expect(
+                False,
+                saw=f"DampedVerlet({lam}) was refused ({error})",
+                cause="a range check that excludes valid values: 0 <= λ < 1 is allowed, "
+                "λ = 0 being no damping at all",
+            )
 
 
 def energy_history(integrator, dt_fraction=0.2, steps=400):
