@@ -1,5 +1,5 @@
 """Sub-commands of the ``msdlab`` command line; each module has ``register(subparsers)``."""
 
-from . import demo, run, scenes
+from . import check, demo, run, scenes, templates
 
-COMMANDS = [demo, scenes, run]
+COMMANDS = [demo, scenes, run, check, templates]

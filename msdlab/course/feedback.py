@@ -1,0 +1,97 @@
+"""Messages of failing checks: what the check saw, in physics terms, and what usually causes it.
+
+A check states its expectation with `expect`::
+
+    expect(
+        drift < 0.01,
+        saw=f"total energy grew {percent(drift)} in {steps} steps at dt = {num(dt)}",
+        cause="forces that are not equal and opposite, or dt above the stable limit",
+    )
+
+and the student reads "total energy grew 40 % in 200 steps at dt = 0.1. Usual
+cause: ...". `CheckFailed` is an `AssertionError`, so pytest reports it as a
+failed check, not as an error in the check itself.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+
+class CheckFailed(AssertionError):
+    """A check saw wrong physics; the message says what it saw and the usual cause."""
+
+
+def expect(condition: object, saw: str, cause: str = "") -> None:
+    """Raise `CheckFailed` with "<saw>. Usual cause: <cause>" unless ``condition`` holds."""
+    if not bool(condition):
+        message = saw.rstrip(". ") + "."
+        if cause:
+            message += f" Usual cause: {cause.rstrip('. ')}."
+        raise CheckFailed(message)
+
+
+def num(value: float, digits: int = 3) -> str:
+    """A number with ``digits`` significant digits, e.g. 0.000123 -> '0.000123'."""
+    value = float(value)
+    if not np.isfinite(value):
+        return str(value)
+    return f"{value:.{digits}g}" if value != 0 else "0"  # no "-0"
+
+
+def vec(values: Sequence[float] | np.ndarray, digits: int = 3) -> str:
+    """A short vector, e.g. '(0.1, -0.002, 0)'."""
+    return "(" + ", ".join(num(v, digits) for v in np.ravel(values)) + ")"
+
+
+def percent(fraction: float) -> str:
+    """A fraction as a percentage, e.g. 0.4 -> '40 %', 2e-5 -> '0.002 %', 650 -> '65000 %'."""
+    value = 100.0 * float(fraction)
+    return f"{value:.0f} %" if abs(value) >= 100 else f"{num(value, 2)} %"
+
+
+def relative_error(got: np.ndarray, expected: np.ndarray) -> float:
+    """max |got - expected| relative to max |expected| (absolute if expected is all zero)."""
+    got, expected = np.asarray(got, dtype=float), np.asarray(expected, dtype=float)
+    scale = float(np.max(np.abs(expected), initial=0.0))
+    error = float(np.max(np.abs(got - expected), initial=0.0))
+    return error / scale if scale > 0 else error
+
+
+def as_array(value: object, what: str, shape: tuple[int, ...] | None = None) -> np.ndarray:
+    """``value`` as a float array, or a `CheckFailed` saying what came back instead."""
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise CheckFailed(
+            f"{what} returned {type(value).__name__}, not an array of numbers"
+        ) from None
+    if shape is not None and array.shape != shape:
+        raise CheckFailed(f"{what} returned an array of shape {array.shape}, expected {shape}")
+    expect(
+        np.all(np.isfinite(array)),
+        saw=f"{what} returned NaN or infinite values",
+        cause="dividing by a zero spring length or a zero time step",
+    )
+    return array
+
+
+def matching_variant(
+    got: np.ndarray, variants: dict[str, np.ndarray], rtol: float = 1e-6
+) -> str | None:
+    """The name of the first variant (a typical mistake, computed by the check) equal to ``got``."""
+    got = np.asarray(got, dtype=float)
+    for name, values in variants.items():
+        values = np.asarray(values, dtype=float)
+        if values.shape == got.shape and relative_error(got, values) < rtol:
+            return name
+    return None
+
+
+def grid_place(index: Sequence[int], shape: Sequence[int]) -> str:
+    """Where particle ``index`` sits in a grid: 'corner particle (0, 0, 0)', 'interior ...'."""
+    borders = sum(1 for i, n in zip(index, shape) if n > 1 and i in (0, n - 1))
+    kind = ("interior", "face", "edge", "corner")[min(borders, 3)]
+    return f"{kind} particle {tuple(int(i) for i in index)}"

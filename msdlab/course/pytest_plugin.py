@@ -1,0 +1,196 @@
+"""pytest plugin of the course checks (registered as the ``pytest11`` entry point ``msdlab``).
+
+- ``--impl=solutions|assignments|PATH`` chooses the implementation under test
+  (fallback: the ``MSDLAB_IMPL`` environment variable; default: ``solutions``
+  where the course root has them, else ``assignments``). PATH is a folder laid
+  out like ``assignments/``.
+- Fixtures ``implementation`` (see `msdlab.course.loader`) and ``task1`` ...
+  ``task5`` (the task modules). Override ``implementation`` in a conftest to
+  load submissions another way.
+- Markers ``task1`` ... ``task5``, ``points(n)`` and ``hidden``. A graded check
+  has exactly one task marker and its points; ``hidden`` checks are instructor-only.
+- ``--msdlab-report=PATH`` writes the JSON `CheckReport` of the graded checks;
+  a points summary ends the terminal output.
+- `hypothesis_profiles`, called by the checks' conftest: profiles ``ci`` (no
+  deadline, derandomised, no example database: reproducible grading; loaded
+  unless ``--hypothesis-profile`` chooses another) and ``dev``. Hypothesis is
+  imported only where checks use it (importing it takes about a second).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+import pytest
+
+from . import TASKS, loader
+from .report import CheckReport, CheckResult
+
+ENV_IMPL = "MSDLAB_IMPL"
+_REPORT = pytest.StashKey[CheckReport]()
+_STARTED = pytest.StashKey[float]()
+_GRADED = pytest.StashKey[tuple[int, int, bool]]()
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    group = parser.getgroup("msdlab", "msdlab course checks")
+    group.addoption(
+        "--impl",
+        default=None,
+        metavar="IMPL",
+        help="implementation under test: 'solutions', 'assignments' or a folder laid out "
+        f"like assignments/ (default: ${ENV_IMPL}, else solutions where they exist)",
+    )
+    group.addoption(
+        "--msdlab-report",
+        default=None,
+        metavar="PATH",
+        help="write the results of the graded checks as JSON to PATH",
+    )
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    for number in TASKS:
+        config.addinivalue_line("markers", f"task{number}: a graded check of task {number}")
+    config.addinivalue_line("markers", "points(n): the points a graded check is worth")
+    config.addinivalue_line("markers", "hidden: instructor-only check, not in the student release")
+    config.stash[_REPORT] = CheckReport(implementation=implementation_spec(config))
+    config.stash[_STARTED] = time.perf_counter()
+
+
+def implementation_spec(config: pytest.Config) -> str:
+    """The ``--impl`` value in force: the option, else $MSDLAB_IMPL, else the default."""
+    spec = config.getoption("impl") or os.environ.get(ENV_IMPL)
+    return spec or loader.default_spec(loader.course_root(config.rootpath))
+
+
+@pytest.fixture(scope="session")
+def implementation(pytestconfig: pytest.Config) -> loader.Implementation:
+    """The implementation under test (see ``--impl``)."""
+    spec = implementation_spec(pytestconfig)
+    return loader.load(spec, loader.course_root(pytestconfig.rootpath))
+
+
+def _task_fixture(number: int):
+    @pytest.fixture(scope="session", name=f"task{number}")
+    def task(implementation: loader.Implementation, pytestconfig: pytest.Config):
+        pytestconfig.stash[_REPORT].implementation = implementation.label
+        return implementation.task(number)
+
+    task.__doc__ = f"The module of task {number} of the implementation under test."
+    return task
+
+
+task1 = _task_fixture(1)
+task2 = _task_fixture(2)
+task3 = _task_fixture(3)
+task4 = _task_fixture(4)
+task5 = _task_fixture(5)
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Record task, points and hidden for each graded check; refuse checks without points."""
+    problems = []
+    for item in items:
+        tasks = [n for n in TASKS if item.get_closest_marker(f"task{n}")]
+        points = item.get_closest_marker("points")
+        if not tasks:
+            if points or item.get_closest_marker("hidden"):
+                problems.append(f"{item.nodeid}: has points or hidden but no task marker")
+            continue
+        if len(tasks) > 1:
+            problems.append(f"{item.nodeid}: belongs to several tasks {tasks}")
+            continue
+        value = points.args[0] if points and len(points.args) == 1 else None
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            problems.append(f"{item.nodeid}: needs @pytest.mark.points(N) with an integer N >= 1")
+            continue
+        item.stash[_GRADED] = (tasks[0], value, item.get_closest_marker("hidden") is not None)
+    if problems:
+        raise pytest.UsageError("graded checks are badly marked:\n  " + "\n  ".join(problems))
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo):
+    outcome = yield
+    graded = item.stash.get(_GRADED, None)
+    if graded is None:
+        return
+    report = outcome.get_result()
+    results = item.config.stash[_REPORT].checks
+    if report.when == "setup":
+        results.append(_result(item, graded))
+    result = results[-1]
+    result.duration += report.duration
+    if report.skipped:
+        result.outcome, result.message = "skipped", _skip_reason(report)
+    elif report.failed:
+        result.outcome = "failed" if report.when == "call" else "error"
+        result.exception, result.message = _describe(call)
+    elif report.when == "call":
+        result.outcome = "passed"
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    config = session.config
+    report = config.stash[_REPORT]
+    report.duration = time.perf_counter() - config.stash[_STARTED]
+    path = config.getoption("msdlab_report")
+    if path:
+        report.write(Path(path))
+
+
+def pytest_terminal_summary(terminalreporter, config: pytest.Config) -> None:
+    report = config.stash[_REPORT]
+    if not report.checks:
+        return
+    parts = []
+    for number in report.tasks():
+        checks = [c for c in report.checks if c.task == number]
+        earned, points = sum(c.earned for c in checks), sum(c.points for c in checks)
+        parts.append(f"task{number} {earned}/{points}")
+    terminalreporter.write_sep("-", "msdlab points")
+    terminalreporter.write_line(
+        f"{report.implementation}: {report.earned}/{report.points} points ({', '.join(parts)})"
+    )
+
+
+def _result(item: pytest.Item, graded: tuple[int, int, bool]) -> CheckResult:
+    task, points, hidden = graded
+    name = item.name.removeprefix("test_")
+    # "error" until the check's call phase has run
+    return CheckResult(item.nodeid, name, task, points, hidden, outcome="error")
+
+
+def _describe(call: pytest.CallInfo) -> tuple[str | None, str]:
+    """The exception's type name and its message (with notes such as a falsifying example)."""
+    if call.excinfo is None:
+        return None, ""
+    error = call.excinfo.value
+    lines = [str(error).strip()] if str(error).strip() else []
+    lines += [  # hypothesis's failing example; its other notes name lines of the checks
+        str(note)
+        for note in getattr(error, "__notes__", ())
+        if str(note).startswith(("Falsifying example", "Failing test case"))
+    ]
+    return type(error).__name__, "\n".join(lines)
+
+
+def _skip_reason(report: pytest.TestReport) -> str:
+    longrepr = report.longrepr
+    if isinstance(longrepr, tuple) and len(longrepr) == 3:
+        return str(longrepr[2]).removeprefix("Skipped: ")
+    return str(longrepr or "")
+
+
+def hypothesis_profiles(config: pytest.Config) -> None:
+    """Register the ``ci`` and ``dev`` profiles; load ``ci`` unless a profile was chosen."""
+    from hypothesis import settings
+
+    settings.register_profile("ci", deadline=None, derandomize=True, database=None)
+    settings.register_profile("dev", deadline=None)
+    chosen = config.getoption("hypothesis_profile", None)
+    if not chosen:
+        settings.load_profile("ci")

@@ -1,0 +1,146 @@
+"""Checks of task 1: the template's falling grid and what its kernel really is."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import msdlab as msd
+from msdlab.course import oracles
+from msdlab.course.feedback import as_array, expect, matching_variant, num, relative_error
+
+pytestmark = pytest.mark.task1
+
+DT = oracles.TEMPLATE_DT
+G = oracles.TEMPLATE_GRAVITY[1]
+BOTTOM = 1.5  # height of the template's bottom layer
+
+
+def free_fall_heights(y0: float, dt: float, g: float, steps: int) -> np.ndarray:
+    """Heights (steps + 1,) of a particle falling from rest, run by the engine's Verlet."""
+    body = msd.Body.from_arrays([[0.0, y0, 0.0]])
+    simulation = msd.Simulation(body, msd.Verlet(), dt, [msd.Gravity((0.0, g, 0.0))])
+    return simulation.run(steps=steps).positions[:, 0, 1]
+
+
+@pytest.mark.points(1)
+def test_particle_count(task1):
+    """particle_count(n) is the number of particles of the template's n × n × n grid."""
+    for n in (20, 30, 3):
+        got = task1.particle_count(n)
+        expected = oracles.grid_body((n, n, n), 2.0 / n, 1.0).n_particles
+        expect(
+            got == expected,
+            saw=f"particle_count({n}) = {got!r}, but a grid of {n} per edge has {expected} "
+            "particles",
+            cause="counting one edge (n) or one layer (n²) instead of the whole cube (n³)",
+        )
+
+
+ACCEPTED_SCHEMES = ("position verlet", "symplectic euler")
+SCHEME_HINTS = {
+    "explicit euler": "explicit Euler moves with the velocity of the previous step; the kernel "
+    "first adds dt·a to v and then moves with the new v. Put v = (cur - old)/dt + dt·a into "
+    "new = cur + dt·v and compare with eq. (1.3)",
+    "velocity verlet": "velocity Verlet evaluates the acceleration twice per step and "
+    "stores a velocity; the kernel has only positions (old, current, new). Put v into "
+    "the last line and compare with eq. (1.3)",
+    "runge-kutta 4": "Runge-Kutta 4 evaluates the acceleration four times per step; the "
+    "kernel does it once",
+}
+
+
+@pytest.mark.points(2)
+def test_kernel_is_position_verlet(task1):
+    """integration_scheme() names the scheme msd_kernel really is (eq. 1.3)."""
+    answer = str(task1.integration_scheme()).strip().lower()
+    expect(
+        answer in ACCEPTED_SCHEMES,
+        saw=f"you named the kernel's scheme {answer!r}",
+        cause=SCHEME_HINTS.get(
+            answer, "an answer outside SCHEMES; substitute v into new = cur + dt·v"
+        ),
+    )
+
+
+def template_kernel(old: np.ndarray, current: np.ndarray, dt: float, a: np.ndarray) -> np.ndarray:
+    """The template's three lines (floor left out)."""
+    v = (current - old) / dt
+    v = v + dt * a
+    return current + dt * v
+
+
+@pytest.mark.points(2)
+def test_verlet_step_is_the_kernel(task1):
+    """verlet_step (eq. 1.3) gives the same new positions as the template's kernel."""
+    rng = np.random.default_rng(1)
+    a = np.array([0.01, -0.001, 0.002])
+    for shape in ((4, 3, 5, 3), (7, 3)):
+        current = rng.uniform(-1.0, 1.0, shape) + np.array([0.0, 5.0, 0.0])
+        old = current - 0.05 * rng.standard_normal(shape)
+        expected = template_kernel(old, current, DT, a)
+        got = as_array(task1.verlet_step(old.copy(), current.copy(), DT, tuple(a)), "verlet_step")
+        mistake = matching_variant(
+            got,
+            {
+                "the acceleration is missing (a·dt² was left out)": 2 * current - old,
+                "a·dt instead of a·dt²": 2 * current - old + a * DT,
+                "½·a·dt², the exact free fall of one step, instead of the kernel's a·dt²": (
+                    2 * current - old + 0.5 * a * DT**2
+                ),
+                "x(t - dt) added instead of subtracted": 2 * current + old + a * DT**2,
+            },
+        )
+        expect(
+            got.shape == expected.shape and relative_error(got, expected) < 1e-12,
+            saw=f"for positions of shape {shape} verlet_step differs from the kernel's new "
+            f"positions by up to {num(np.max(np.abs(got - expected)))} (positions ~1)",
+            cause=mistake
+            or "eq. (1.3) is x(t+dt) = 2 x(t) - x(t-dt) + a dt², with current = "
+            "x(t) and old = x(t-dt)",
+        )
+
+
+@pytest.mark.points(2)
+def test_height_after_as_template(task1):
+    """height_after(n) is the height the running template reaches after n steps."""
+    steps = 600
+    heights = free_fall_heights(BOTTOM, DT, G, steps)
+    for n in (0, 1, 2, 10, 100, 547, 600):
+        got = float(task1.height_after(n, BOTTOM, DT, G))
+        parabola = BOTTOM + 0.5 * G * (n * DT) ** 2
+        cause = (
+            "that is the exact free fall y0 + ½ g t²; the template moves by g dt² in its "
+            "first step, 2 g dt² in the second, ...: y0 + g dt² n(n+1)/2"
+            if n > 0 and np.isclose(got, parabola, rtol=0, atol=1e-12)
+            else "the template's recurrence: each step adds g·dt² to the distance moved per "
+            "step, so after n steps y = y0 + g dt² (1 + 2 + ... + n)"
+        )
+        expect(
+            abs(got - heights[n]) <= 1e-9,
+            saw=f"height_after({n}) = {num(got, 6)}, but the running template is at "
+            f"y = {num(heights[n], 6)} after {n} steps (y0 = {BOTTOM}, dt = {DT}, g = {G})",
+            cause=cause,
+        )
+
+
+@pytest.mark.points(2)
+def test_steps_to_floor_as_template(task1):
+    """steps_to_floor() is the step in which the running template's floor first catches the
+    bottom layer."""
+    start = oracles.template_positions((3, 2, 3), 0.1, (-1.0, BOTTOM, -1.0))
+    frames = oracles.template_run(start, 600)
+    on_floor = np.flatnonzero(frames[:, :, 0, :, 1].min(axis=(1, 2)) <= 0.0)
+    first = int(on_floor[0])
+    for got, call in (
+        (task1.steps_to_floor(), "steps_to_floor()"),
+        (task1.steps_to_floor(BOTTOM, DT, G), f"steps_to_floor({BOTTOM}, {DT}, {G})"),
+    ):
+        expect(
+            got == first,
+            saw=f"{call} = {got!r}, but the running template's bottom layer (y0 = {BOTTOM}) "
+            f"first reaches the floor in step {first} (its height after step {first - 1} is "
+            f"{num(frames[first - 1, :, 0, :, 1].min())})",
+            cause="an off-by-one step, or the exact parabola ½ g t² instead of the template's "
+            "y0 + g dt² n(n+1)/2 (solve n(n+1)/2 · |g| dt² >= y0 for the smallest integer n)",
+        )

@@ -1,0 +1,90 @@
+"""Instructor-only checks of task 1 (left out of the student release)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from msdlab.course import oracles
+from msdlab.course.feedback import as_array, expect, num
+
+pytestmark = [pytest.mark.task1, pytest.mark.hidden]
+
+
+def template_height(y0: float, dt: float, g: float, steps: int) -> float:
+    """Height after ``steps`` steps of the template's kernel from rest, no floor."""
+    y_old = y = y0
+    for _ in range(steps):
+        y_old, y = y, y + dt * ((y - y_old) / dt + dt * g)
+    return y
+
+
+@pytest.mark.points(2)
+@settings(max_examples=30)
+@given(
+    y0=st.floats(0.01, 5.0),
+    dt=st.floats(0.01, 0.5),
+    g=st.floats(-0.05, -1e-4),
+)
+def test_steps_to_floor_for_any_start(task1, y0, dt, g):
+    """steps_to_floor(y0, dt, g) agrees with the running template for any height, step and g."""
+    got = task1.steps_to_floor(y0, dt, g)
+    first = oracles.first_floor_contact(y0, dt, g)
+    at_boundary = abs(template_height(y0, dt, g, min(int(got), first))) < 1e-9 * y0
+    expect(
+        got == first or at_boundary,
+        saw=f"steps_to_floor({num(y0)}, {num(dt)}, {num(g)}) = {got!r}, but the running "
+        f"template first reaches the floor in step {first}",
+        cause="a formula that only works for the default numbers, or rounding: check the "
+        "smallest n with y0 + g dt² n(n+1)/2 <= 0 directly",
+    )
+
+
+@pytest.mark.points(1)
+@settings(max_examples=30)
+@given(
+    steps=st.integers(0, 2000),
+    y0=st.floats(-3.0, 5.0),
+    dt=st.floats(0.01, 0.5),
+    g=st.floats(-0.05, 0.05),
+)
+def test_height_after_for_any_start(task1, steps, y0, dt, g):
+    """height_after agrees with the running template for any steps, height, dt and g."""
+    got = float(task1.height_after(steps, y0, dt, g))
+    expected = template_height(y0, dt, g, steps)
+    expect(
+        abs(got - expected) <= 1e-9 * max(1.0, abs(expected)),
+        saw=f"height_after({steps}, {num(y0)}, {num(dt)}, {num(g)}) = {num(got, 6)}, the "
+        f"template gives {num(expected, 6)}",
+        cause="the default values hard-coded instead of the arguments y0, dt, g",
+    )
+
+
+@pytest.mark.points(1)
+def test_particle_count_for_any_size(task1):
+    """particle_count(n) is n³ for every n from 1 to 40."""
+    wrong = [n for n in range(1, 41) if task1.particle_count(n) != n**3]
+    expect(
+        not wrong,
+        saw=f"particle_count(n) is not the number of particles for n = {wrong[:5]}",
+        cause="a result that holds for the default N only",
+    )
+
+
+@pytest.mark.points(1)
+def test_verlet_step_leaves_its_inputs_alone(task1):
+    """verlet_step returns a new array and does not change old or current."""
+    rng = np.random.default_rng(3)
+    current = rng.standard_normal((5, 3))
+    old = current - 0.01
+    kept_old, kept_current = old.copy(), current.copy()
+    got = as_array(task1.verlet_step(old, current, 0.1, (0.0, -0.001, 0.0)), "verlet_step")
+    expect(
+        np.array_equal(old, kept_old) and np.array_equal(current, kept_current),
+        saw="verlet_step changed the arrays it was given",
+        cause="in-place updates such as current *= 2 or old += ...; the caller still needs "
+        "x(t) and x(t - dt) (the template rotates its three buffers)",
+    )
+    expect(got.shape == current.shape, saw=f"verlet_step returned shape {got.shape}")

@@ -1,0 +1,230 @@
+"""Checks of task 3: rotating the layout, orientation-free spring forces, the collapse."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import msdlab as msd
+from msdlab.course import oracles
+from msdlab.course.feedback import (
+    as_array,
+    expect,
+    matching_variant,
+    num,
+    percent,
+    relative_error,
+    vec,
+)
+
+pytestmark = pytest.mark.task3
+
+AXES = ((0.0, 0.0, 1.0), (1.0, 0.0, 0.0), (0.0, 2.0, 0.0), (1.0, -2.0, 0.5))
+
+
+def jelly(shape=(3, 4, 2), neighbours=(1, 2, 3), spacing=0.5, stiffness=0.5):
+    return oracles.grid_body(shape, spacing, stiffness, neighbours, origin=(-0.5, 1.0, 0.3))
+
+
+def springs_of(body):
+    return np.stack([body.spring_a, body.spring_b], axis=1), body.rest_lengths.copy()
+
+
+def student_acceleration(task3, positions, springs, rest, stiffness):
+    got = task3.spring_acceleration(positions.copy(), springs.copy(), rest.copy(), stiffness)
+    return as_array(got, "spring_acceleration", positions.shape)
+
+
+@pytest.mark.points(2)
+def test_rotation_matrix_right_handed(task3):
+    """rotation_matrix(axis, angle) is a right-handed rotation, for an axis of any length."""
+    x, y = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+    quarter = as_array(task3.rotation_matrix((0.0, 0.0, 1.0), 90.0), "rotation_matrix", (3, 3))
+    expect(
+        np.allclose(quarter @ x, y, atol=1e-12),
+        saw=f"rotation_matrix((0, 0, 1), 90) turns the x axis into {vec(quarter @ x)}; a "
+        "right-handed quarter turn about z takes x to y",
+        cause="the transpose (a left-handed turn: the sign of the sin terms) or radians "
+        "where degrees are given (use np.radians)",
+    )
+    for axis in AXES:
+        for angle in (30.0, -58.3, 180.0):
+            got = as_array(task3.rotation_matrix(axis, angle), "rotation_matrix", (3, 3))
+            expected = msd.rotation_matrix(angle, axis)
+            mistake = matching_variant(
+                got,
+                {
+                    "a left-handed turn (the transpose): flip the sign of the sin terms": (
+                        expected.T
+                    ),
+                    "the axis is not normalised: divide it by its length first": (
+                        np.cos(np.radians(angle)) * np.eye(3)
+                        + np.sin(np.radians(angle)) * np.cross(np.eye(3), np.asarray(axis))
+                        + (1 - np.cos(np.radians(angle))) * np.outer(axis, axis)
+                    ),
+                },
+                rtol=1e-9,
+            )
+            expect(
+                np.allclose(got, expected, atol=1e-12),
+                saw=f"rotation_matrix({axis}, {angle}) has R Rᵀ = I off by "
+                f"{num(np.max(np.abs(got @ got.T - np.eye(3))))} and differs from the "
+                f"rotation by {angle}° about {axis} by {num(np.max(np.abs(got - expected)))}",
+                cause=mistake
+                or "Rodrigues' formula with the unit axis n: "
+                "cos θ I + sin θ [n]× + (1 - cos θ) n nᵀ",
+            )
+
+
+@pytest.mark.points(2)
+def test_rotate_layout_turns_about_centroid(task3):
+    """rotate_layout keeps the shape of the array, the centroid and every distance."""
+    grid = oracles.template_positions((3, 4, 2), 0.1, (-1.0, 1.5, -1.0))
+    for axis, angle in (((0.0, 0.0, 1.0), 45.0), ((1.0, 1.0, 0.0), -30.0)):
+        got = as_array(task3.rotate_layout(grid.copy(), axis, angle), "rotate_layout", grid.shape)
+        centroid = grid.reshape(-1, 3).mean(axis=0)
+        expected = (grid - centroid) @ msd.rotation_matrix(angle, axis).T + centroid
+        mistake = matching_variant(
+            got,
+            {
+                "rotating about the origin instead of the centroid: subtract the mean "
+                "position first and add it back": grid @ msd.rotation_matrix(angle, axis).T,
+                "x @ R rotates by -angle; row vectors need x @ R.T": (
+                    (grid - centroid) @ msd.rotation_matrix(angle, axis) + centroid
+                ),
+            },
+        )
+        moved = got.reshape(-1, 3).mean(axis=0) - centroid
+        expect(
+            relative_error(got, expected) < 1e-12,
+            saw=f"rotate_layout(grid, {axis}, {angle}) moved the centroid by {vec(moved)} and "
+            f"puts particles up to {num(np.max(np.abs(got - expected)))} away from the rotated "
+            "grid",
+            cause=mistake or "rotate every position p to R (p - c) + c, c the centroid",
+        )
+
+
+def compare_with_engine(got, body, x, what):
+    expected = oracles.spring_acceleration(body, x)
+    error = relative_error(got, expected)
+    if error < 1e-9:
+        return
+    springs, rest = springs_of(body)
+    last_wins = np.zeros_like(x)
+    d = x[springs[:, 0]] - x[springs[:, 1]]
+    length = np.linalg.norm(d, axis=1, keepdims=True)
+    f = body.stiffness[0] * (rest[:, None] - length) * d / length
+    last_wins[springs[:, 0]] += f  # repeated indices: only one spring per particle counts
+    last_wins[springs[:, 1]] -= f
+    worst = int(np.argmax(np.linalg.norm(got - expected, axis=1)))
+    mistake = matching_variant(
+        got,
+        {
+            "a[i] += f with repeated indices keeps only one spring per particle; use "
+            "np.add.at or np.bincount (or a loop) to add every spring": last_wins,
+            "the sign of (l - |x_i - x_j|) or of the direction x_i - x_j": -expected,
+            "-f_ij is never added to particle j": oracles.pair_acceleration(
+                x, springs, rest, body.stiffness[0], reaction=False
+            ),
+        },
+    )
+    expect(
+        False,
+        saw=f"{what}: particle {worst} gets a = {vec(got[worst])}, eq. (1.1)-(1.2) give "
+        f"{vec(expected[worst])} (largest error {percent(error)})",
+        cause=mistake or "sum f_ij over every spring of the particle, as eq. (1.1) says",
+    )
+
+
+@pytest.mark.points(3)
+def test_spring_acceleration_matches_equations(task3):
+    """On a rotated, deformed jelly (1, √2, √3 springs) every particle gets eq. (1.1)-(1.2)."""
+    rng = np.random.default_rng(11)
+    body = jelly()
+    body.rotate(msd.rotation_matrix(58.3, (0, 0, 1)))
+    x = body.positions + 0.05 * rng.standard_normal(body.positions.shape)
+    springs, rest = springs_of(body)
+    got = student_acceleration(task3, x, springs, rest, 0.5)
+    compare_with_engine(got, body, x, "on a rotated, deformed 3 × 4 × 2 jelly")
+
+
+@pytest.mark.points(2)
+@settings(max_examples=15)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_same_physics_in_any_orientation(task3, seed):
+    """Any rotation of a body at rest leaves it force-free; for a deformed body a(Rx) = R a(x)."""
+    rng = np.random.default_rng(seed)
+    rotation = oracles.random_rotation(rng)
+    body = jelly()
+    springs, rest = springs_of(body)
+    at_rest = body.positions @ rotation.T
+    a_rest = student_acceleration(task3, at_rest, springs, rest, 0.5)
+    expect(
+        np.max(np.abs(a_rest)) < 1e-9,
+        saw=f"a rotated body at rest feels accelerations up to {num(np.max(np.abs(a_rest)))}",
+        cause="a rest length or a force direction that depends on the coordinate axes",
+    )
+    x = body.positions + 0.05 * rng.standard_normal(body.positions.shape)
+    a = student_acceleration(task3, x, springs, rest, 0.5)
+    turned = student_acceleration(task3, x @ rotation.T, springs, rest, 0.5)
+    error = relative_error(turned, a @ rotation.T)
+    expect(
+        error < 1e-9,
+        saw=f"rotating a deformed body changes its accelerations by {percent(error)} beyond "
+        "the rotation itself: the physics depends on the orientation",
+        cause="using coordinate axes instead of the spring direction x_i - x_j",
+    )
+
+
+@pytest.mark.points(1)
+def test_no_net_force_or_torque(task3):
+    """The spring forces of a deformed body add up to zero force and zero torque."""
+    rng = np.random.default_rng(12)
+    body = jelly()
+    x = body.positions + 0.1 * rng.standard_normal(body.positions.shape)
+    springs, rest = springs_of(body)
+    a = student_acceleration(task3, x, springs, rest, 0.5)
+    scale = float(np.max(np.abs(a)))
+    net = a.sum(axis=0)
+    torque = np.cross(x - x.mean(axis=0), a).sum(axis=0)
+    expect(
+        np.linalg.norm(net) <= 1e-9 * scale * len(x),
+        saw=f"the springs give the body a net acceleration {vec(net)} (each ~{num(scale)})",
+        cause="the reaction -f_ij on particle j is missing or added twice",
+    )
+    expect(
+        np.linalg.norm(torque) <= 1e-9 * scale * len(x),
+        saw=f"the springs give the body a net torque {vec(torque)}",
+        cause="forces not along the spring direction x_i - x_j",
+    )
+
+
+@pytest.mark.points(3)
+def test_tilted_cube_collapses_upright_one_stands(task3):
+    """Axis springs only: tilted 45° about z the cube folds flat; turned 45° about y it stands."""
+    for axis, angle, collapses in (((0.0, 0.0, 1.0), 45.0, True), ((0.0, 1.0, 0.0), 45.0, False)):
+        got = float(task3.drop_rotated_cube(axis, angle, (1,)))
+        expected = oracles.drop_rotated_cube(axis, angle, (1,))
+        expect(
+            abs(got - expected) < 0.1,
+            saw=f"drop_rotated_cube({axis}, {angle}) = {num(got)}, but the experiment as "
+            f"described gives a flatness ratio of {num(expected)}",
+            cause="a different experiment: check the rotation, the lift to y = LIFT, the "
+            "number of steps, dt, gravity and the floor",
+        )
+        if collapses:
+            expect(
+                got < 0.3,
+                saw=f"a cube with axis springs only, tilted {angle}° about {axis}, kept "
+                f"{percent(got)} of its thickness",
+                cause="springs beyond the 6 axis neighbours, or the cube was not rotated",
+            )
+        else:
+            expect(
+                got > 0.9,
+                saw=f"a cube turned {angle}° about the vertical axis {axis} kept only "
+                f"{percent(got)} of its thickness; its springs still carry gravity vertically",
+                cause="rotating about the wrong axis",
+            )

@@ -1,0 +1,98 @@
+"""Instructor-only checks of task 3 (left out of the student release)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import msdlab as msd
+from msdlab.course import oracles
+from msdlab.course.feedback import as_array, expect, num, relative_error
+
+pytestmark = [pytest.mark.task3, pytest.mark.hidden]
+
+axes = st.tuples(*3 * [st.floats(-2.0, 2.0)]).filter(lambda a: np.linalg.norm(a) > 0.1)
+angles = st.floats(-360.0, 360.0)
+
+
+@pytest.mark.points(2)
+@settings(max_examples=30)
+@given(axis=axes, first=angles, second=angles)
+def test_rotations_compose_and_invert(task3, axis, first, second):
+    """About one axis, turns add up, a turn back is the transpose, and the axis length is free."""
+    r1 = as_array(task3.rotation_matrix(axis, first), "rotation_matrix", (3, 3))
+    r2 = as_array(task3.rotation_matrix(axis, second), "rotation_matrix", (3, 3))
+    both = as_array(task3.rotation_matrix(axis, first + second), "rotation_matrix", (3, 3))
+    back = as_array(task3.rotation_matrix(axis, -first), "rotation_matrix", (3, 3))
+    longer = as_array(
+        task3.rotation_matrix(tuple(3.0 * np.asarray(axis)), first), "rotation_matrix", (3, 3)
+    )
+    expect(
+        np.allclose(r2 @ r1, both, atol=1e-9) and np.allclose(back, r1.T, atol=1e-9),
+        saw=f"about {axis}: R({num(second)}°)·R({num(first)}°) differs from R(sum) by "
+        f"{num(np.max(np.abs(r2 @ r1 - both)))}, or R(-θ) from R(θ)ᵀ",
+        cause="a matrix that is not a rotation about the given axis",
+    )
+    expect(
+        np.allclose(longer, r1, atol=1e-9),
+        saw="scaling the axis by 3 changed the rotation",
+        cause="the axis is not normalised before use",
+    )
+    expect(np.allclose(r1, msd.rotation_matrix(first, axis), atol=1e-9), saw="not the rotation")
+
+
+@pytest.mark.points(2)
+@settings(max_examples=20)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(2, 12), e=st.integers(1, 40))
+def test_any_spring_list(task3, seed, n, e):
+    """Random spring graphs (many springs on one particle, any order) obey eq. (1.1)-(1.2)."""
+    rng = np.random.default_rng(seed)
+    x = rng.uniform(-1.0, 1.0, (n, 3))
+    i = rng.integers(0, n, e)
+    j = (i + rng.integers(1, n, e)) % n
+    springs = np.stack([i, j], axis=1)
+    rest = rng.uniform(0.2, 1.5, e)
+    kept = (x.copy(), springs.copy(), rest.copy())
+    got = as_array(task3.spring_acceleration(x, springs, rest, 0.7), "spring_acceleration")
+    expected = oracles.pair_acceleration(x, springs, rest, 0.7)
+    expect(
+        got.shape == x.shape and relative_error(got, expected) < 1e-9,
+        saw=f"for {e} random springs between {n} particles the accelerations are off by "
+        f"{num(relative_error(got, expected) if got.shape == x.shape else np.inf)} (relative)",
+        cause="a particle with several springs must get the sum of all of them (np.add.at, "
+        "np.bincount or a loop; a[i] += f keeps only one of repeated indices)",
+    )
+    expect(
+        all(np.array_equal(a, b) for a, b in zip((x, springs, rest), kept)),
+        saw="spring_acceleration changed its inputs",
+        cause="in-place operations on the positions, springs or rest lengths",
+    )
+
+
+@pytest.mark.points(1)
+def test_zero_length_spring_gives_no_nan(task3):
+    """A spring whose ends coincide adds nothing: no NaN."""
+    x = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    springs = np.array([[0, 1], [1, 2]])
+    got = np.asarray(task3.spring_acceleration(x, springs, np.array([0.5, 0.5]), 1.0), float)
+    expected = oracles.pair_acceleration(x, springs, np.array([0.5, 0.5]), 1.0)
+    expect(
+        np.all(np.isfinite(got)) and np.allclose(got, expected, atol=1e-12),
+        saw=f"with a zero-length spring the accelerations are {got.tolist()}",
+        cause="dividing by the spring length without a guard for zero length",
+    )
+
+
+@pytest.mark.points(1)
+def test_cube_tilted_about_x_collapses(task3):
+    """Axis springs only, tilted 30° about x: the cube folds flat too."""
+    got = float(task3.drop_rotated_cube((1.0, 0.0, 0.0), 30.0, (1,)))
+    expected = oracles.drop_rotated_cube((1.0, 0.0, 0.0), 30.0, (1,))
+    expect(
+        abs(got - expected) < 0.1 and got < 0.3,
+        saw=f"tilted 30° about x the flatness ratio is {num(got)}; the experiment gives "
+        f"{num(expected)} (a collapse)",
+        cause="a rotation about the wrong axis, or a different experiment",
+    )

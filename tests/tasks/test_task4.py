@@ -1,0 +1,152 @@
+"""Checks of task 4: face- and body-diagonal springs, a rotated cube that holds, cost per step."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from msdlab.course import oracles
+from msdlab.course.feedback import as_array, expect, num, percent
+
+pytestmark = pytest.mark.task4
+
+SHAPE = (3, 4, 5)
+KINDS = {1: "axis", 2: "face-diagonal", 3: "body-diagonal"}
+
+
+def engine_pairs(shape, neighbours):
+    body = oracles.grid_body(shape, 1.0, 1.0, neighbours)
+    return {frozenset(p) for p in zip(body.spring_a.tolist(), body.spring_b.tolist())}, body
+
+
+def student_springs(task4, shape, spacing, neighbours):
+    springs, rest = task4.grid_springs(shape, spacing, neighbours)
+    springs = np.asarray(springs)
+    rest = as_array(rest, "grid_springs (rest lengths)")
+    expect(
+        springs.ndim == 2 and springs.shape[1:] == (2,) and len(springs) == len(rest),
+        saw=f"grid_springs returned springs of shape {springs.shape} and {len(rest)} rest "
+        "lengths; expected (E, 2) and (E,)",
+    )
+    expect(
+        np.issubdtype(springs.dtype, np.integer),
+        saw=f"grid_springs returned spring ends of type {springs.dtype}, not integers",
+        cause="building the index pairs with floats (np.array of a float grid)",
+    )
+    return springs.astype(np.int64), rest
+
+
+def missing_and_extra(springs, expected):
+    found = [frozenset(p) for p in springs.tolist()]
+    return expected - set(found), set(found) - expected, len(found) - len(set(found))
+
+
+@pytest.mark.points(2)
+def test_neighbour_offsets_26(task4):
+    """6 axis, 12 face-diagonal and 8 body-diagonal neighbours, each offset once, both signs."""
+    for wanted, count in (((1,), 6), ((2,), 12), ((3,), 8), ((1, 2, 3), 26)):
+        offsets = np.asarray(task4.neighbour_offsets(wanted))
+        expect(
+            offsets.ndim == 2 and offsets.shape[1:] == (3,),
+            saw=f"neighbour_offsets({wanted}) has shape {offsets.shape}, expected (M, 3)",
+        )
+        unique = {tuple(o) for o in offsets.astype(int).tolist()}
+        lengths = sorted({int(np.sum(np.square(o))) for o in unique})
+        expect(
+            len(offsets) == len(unique) == count and lengths == sorted(wanted),
+            saw=f"neighbour_offsets({wanted}) gives {len(offsets)} offsets ({len(unique)} "
+            f"different) of squared lengths {lengths}; an interior particle has {count} such "
+            "neighbours",
+            cause="only one of o and -o (both directions are neighbours), the zero offset "
+            "included, or offsets of other squared lengths",
+        )
+        expect(
+            all(tuple(-np.array(o)) in unique for o in unique),
+            saw=f"neighbour_offsets({wanted}) has an offset without its opposite",
+            cause="a neighbour in one direction is a neighbour in the other too",
+        )
+
+
+@pytest.mark.points(3)
+def test_grid_springs_each_pair_once(task4):
+    """On a 3 × 4 × 5 grid the springs are exactly the engine's: none missing, none twice."""
+    for neighbours in ((1,), (2,), (3,), (1, 2, 3)):
+        springs, _ = student_springs(task4, SHAPE, 0.1, neighbours)
+        expected, _ = engine_pairs(SHAPE, neighbours)
+        missing, extra, repeated = missing_and_extra(springs, expected)
+        kinds = "+".join(KINDS[n] for n in neighbours)
+        example = sorted(tuple(sorted(p)) for p in (missing or extra))[:1]
+        expect(
+            not missing and not extra and repeated == 0,
+            saw=f"for {kinds} springs of a {SHAPE} grid you give {len(springs)} springs, "
+            f"{len(expected)} expected: {len(missing)} missing, {len(extra)} that are not "
+            f"neighbour pairs, {repeated} listed twice (e.g. particles {example})",
+            cause="both i→j and j→i listed (a spring counted twice doubles its force), "
+            "neighbours across the border wrapped around, or C order mixed up "
+            "(index = (i·ny + j)·nz + k)",
+        )
+
+
+@pytest.mark.points(2)
+def test_rest_lengths_unstressed(task4):
+    """Rest lengths are the distances at rest (h, h√2, h√3): the grid at rest feels no force."""
+    spacing = 0.1
+    springs, rest = student_springs(task4, SHAPE, spacing, (1, 2, 3))
+    positions = oracles.template_positions(SHAPE, spacing, (0.0, 0.0, 0.0)).reshape(-1, 3)
+    expect(
+        np.all((springs >= 0) & (springs < len(positions))),
+        saw=f"spring ends outside 0 .. {len(positions) - 1}",
+        cause="indices computed for another grid shape",
+    )
+    distance = np.linalg.norm(positions[springs[:, 0]] - positions[springs[:, 1]], axis=1)
+    worst = int(np.argmax(np.abs(rest - distance)))
+    a = oracles.pair_acceleration(positions, springs, rest, 0.5)
+    expect(
+        np.allclose(rest, distance, rtol=1e-12),
+        saw=f"spring {worst} joins particles {springs[worst].tolist()} at distance "
+        f"{num(distance[worst])} but has rest length {num(rest[worst])}: the body at rest is "
+        f"pre-stressed (accelerations up to {num(np.max(np.abs(a)))})",
+        cause="rest lengths in grid units (1, √2, √3) instead of times the spacing, or the "
+        "same rest length for every kind of spring",
+    )
+
+
+@pytest.mark.points(3)
+def test_rotated_cube_holds_its_shape(task4):
+    """Tilted 45° about z, a cube with 1, √2, √3 springs stands; with axis springs only it folds."""
+    axis, angle = (0.0, 0.0, 1.0), 45.0
+    held = float(task4.drop_rotated_cube(axis, angle, (1, 2, 3)))
+    expected = oracles.drop_rotated_cube(axis, angle, (1, 2, 3))
+    expect(
+        held > 0.9 and abs(held - expected) < 0.1,
+        saw=f"with 26 neighbours, tilted {angle}° about z, the cube kept {percent(held)} of its "
+        f"thickness (the experiment as described gives {percent(expected)})",
+        cause="missing diagonal springs or wrong rest lengths, or a different experiment",
+    )
+    folded = float(task4.drop_rotated_cube(axis, angle, (1,)))
+    expect(
+        folded < 0.3,
+        saw=f"with axis springs only the tilted cube kept {percent(folded)} of its thickness; "
+        "it has no shear stiffness and should fold flat",
+        cause="drop_rotated_cube ignores squared_distances",
+    )
+
+
+@pytest.mark.points(1)
+def test_step_cost_reports_springs_and_time(task4):
+    """step_cost gives the number of springs of the n³ grid and a plausible time per step."""
+    for neighbours in ((1,), (1, 2, 3)):
+        springs, seconds = task4.step_cost(6, neighbours, 5)
+        expected = oracles.grid_body((6, 6, 6), 1.0, 1.0, neighbours).n_springs
+        expect(
+            springs == expected,
+            saw=f"step_cost(6, {neighbours}) counts {springs} springs, a 6³ grid has {expected}",
+            cause="springs counted twice or the wrong neighbours",
+        )
+        expect(
+            math.isfinite(seconds) and 0 < seconds < 1.0,
+            saw=f"step_cost(6, {neighbours}) reports {num(seconds)} s per step",
+            cause="the total time not divided by the number of steps, or a wrong clock",
+        )

@@ -1,0 +1,58 @@
+"""Instructor-only checks of task 4 (left out of the student release)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from msdlab.course import oracles
+from msdlab.course.feedback import as_array, expect, num
+
+pytestmark = [pytest.mark.task4, pytest.mark.hidden]
+
+
+@pytest.mark.points(2)
+@settings(max_examples=25)
+@given(
+    shape=st.tuples(st.integers(1, 4), st.integers(1, 4), st.integers(1, 4)),
+    neighbours=st.sets(st.sampled_from((1, 2, 3)), min_size=1).map(sorted).map(tuple),
+    spacing=st.floats(0.05, 2.0),
+)
+def test_any_grid_shape_and_neighbours(task4, shape, neighbours, spacing):
+    """grid_springs is right for every shape (1 to 4 per axis) and choice of neighbours."""
+    springs, rest = task4.grid_springs(shape, spacing, neighbours)
+    springs = np.asarray(springs, dtype=np.int64).reshape(-1, 2)
+    rest = as_array(rest, "grid_springs (rest lengths)")
+    body = oracles.grid_body(shape, spacing, 1.0, neighbours)
+    expected = {frozenset(p) for p in zip(body.spring_a.tolist(), body.spring_b.tolist())}
+    found = [frozenset(p) for p in springs.tolist()]
+    expect(
+        len(found) == len(expected) and set(found) == expected,
+        saw=f"for a {shape} grid with neighbours {neighbours}: {len(found)} springs given, "
+        f"{len(expected)} expected ({len(expected - set(found))} missing, "
+        f"{len(set(found) - expected)} wrong)",
+        cause="a loop bound or border test that only works for some grid sizes",
+    )
+    positions = body.positions
+    distance = np.linalg.norm(positions[springs[:, 0]] - positions[springs[:, 1]], axis=1)
+    expect(
+        np.allclose(rest, distance, rtol=1e-9),
+        saw=f"rest lengths differ from the distances at rest by up to "
+        f"{num(np.max(np.abs(rest - distance), initial=0.0))}",
+        cause="rest lengths not scaled by the spacing",
+    )
+
+
+@pytest.mark.points(1)
+def test_cube_tilted_about_x_holds(task4):
+    """Tilted 30° about x, the cube with 26 neighbours keeps its shape."""
+    got = float(task4.drop_rotated_cube((1.0, 0.0, 0.0), 30.0, (1, 2, 3)))
+    expected = oracles.drop_rotated_cube((1.0, 0.0, 0.0), 30.0, (1, 2, 3))
+    expect(
+        got > 0.9 and abs(got - expected) < 0.1,
+        saw=f"tilted 30° about x the flatness ratio is {num(got)} (the experiment gives "
+        f"{num(expected)})",
+        cause="missing diagonal springs",
+    )

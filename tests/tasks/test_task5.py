@@ -1,0 +1,243 @@
+"""Checks of task 5: Verlet with damping, eq. (1.3)-(1.4), as an engine integrator."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import msdlab as msd
+from msdlab.course import oracles
+from msdlab.course.feedback import as_array, expect, matching_variant, num, percent, vec
+
+pytestmark = pytest.mark.task5
+
+GRAVITY = oracles.TEMPLATE_GRAVITY
+
+
+def jelly(n=3, spacing=None, origin=(0.0, 0.0, 0.0)):
+    spacing = 2.0 / n if spacing is None else spacing
+    return oracles.grid_body((n, n, n), spacing, 0.5, (1, 2, 3), origin)
+
+
+def one_step_case(seed=0):
+    """A small deformed, moving body with springs and gravity, and its dynamics."""
+    rng = np.random.default_rng(seed)
+    body = oracles.grid_body((2, 3, 2), 0.5, 0.5, (1, 2, 3), (0.0, 2.0, 0.0))
+    x = body.positions + 0.05 * rng.standard_normal(body.positions.shape)
+    v = 0.1 * rng.standard_normal(x.shape)
+    return msd.Dynamics(body, [msd.Gravity(GRAVITY)]), x, v
+
+
+def step_mistakes(x, v, a, dt, lam):
+    x_old = x - v * dt
+    return {
+        "explicit Euler (x + dt·v), not eq. (1.4)": x + dt * v,
+        "λ is ignored: this is eq. (1.3)": 2 * x - x_old + a * dt**2,
+        "damping applied to the acceleration term, (1 - λ) a dt², instead of to x(t) and "
+        "x(t - dt)": 2 * x - x_old + (1 - lam) * a * dt**2,
+        "damping applied to the positions, (1 - λ)(2 x(t) - x(t - dt)): it pulls every "
+        "particle towards the origin": (1 - lam) * (2 * x - x_old) + a * dt**2,
+        "the signs of λ reversed: (2 + λ) x(t) - (1 + λ) x(t - dt) adds energy": (
+            (2 + lam) * x - (1 + lam) * x_old + a * dt**2
+        ),
+        "x(t - dt) taken as x + v·dt instead of x - v·dt": (
+            (2 - lam) * x - (1 - lam) * (x + v * dt) + a * dt**2
+        ),
+    }
+
+
+@pytest.mark.points(3)
+def test_one_step_is_equation_1_4(task5):
+    """One step gives x(t+dt) = (2-λ)x(t) - (1-λ)x(t-dt) + a(t)dt² and v = (x(t+dt) - x(t))/dt."""
+    dt = 0.4
+    for lam in (0.0, 0.3, 0.9):
+        dynamics, x, v = one_step_case()
+        a = dynamics.acceleration(x, v)
+        expected = (2 - lam) * x - (1 - lam) * (x - v * dt) + a * dt**2
+        result = task5.DampedVerlet(lam).step(x.copy(), v.copy(), dt, dynamics)
+        expect(
+            isinstance(result, tuple) and len(result) == 2,
+            saw=f"step returned {type(result).__name__}, not the pair (x_new, v_new)",
+        )
+        x_new = as_array(result[0], "step (new positions)", x.shape)
+        v_new = as_array(result[1], "step (new velocities)", x.shape)
+        worst = int(np.argmax(np.linalg.norm(x_new - expected, axis=1)))
+        expect(
+            np.allclose(x_new, expected, rtol=1e-12, atol=1e-14),
+            saw=f"with λ = {lam}, dt = {dt}: particle {worst} moves to {vec(x_new[worst], 6)}, "
+            f"eq. (1.4) gives {vec(expected[worst], 6)}",
+            cause=matching_variant(x_new, step_mistakes(x, v, a, dt, lam), rtol=1e-9)
+            or "x(t - dt) = x - v·dt from the stored velocity, a = dynamics.acceleration(x, v)",
+        )
+        expect(
+            np.allclose(v_new, (expected - x) / dt, rtol=1e-9, atol=1e-14),
+            saw=f"with λ = {lam} the returned velocity of particle 0 is {vec(v_new[0])}, but "
+            f"(x(t+dt) - x(t))/dt = {vec((expected[0] - x[0]) / dt)}",
+            cause="returning the old velocity, or a central difference: the next step "
+            "recovers x(t) as x(t+dt) - v·dt, so v must be (x(t+dt) - x(t))/dt",
+        )
+
+
+@pytest.mark.points(3)
+def test_no_damping_reproduces_the_template(task5):
+    """λ = 0 reproduces the template's falling grid step for step (to rounding), floor included."""
+    shape, spacing, origin, steps = (3, 2, 4), 0.1, (-1.0, 1.5, -1.0), 600
+    template = oracles.template_run(
+        oracles.template_positions(shape, spacing, origin).reshape(-1, 3), steps
+    )
+    body = msd.Body.grid(shape, spacing, neighbours=(), origin=origin)
+    forces = [msd.Gravity(GRAVITY), msd.Ground(0.0)]
+    frames = (
+        msd.Simulation(body, task5.DampedVerlet(0.0), oracles.TEMPLATE_DT, forces)
+        .run(steps=steps)
+        .positions
+    )
+    error = np.max(np.abs(frames - template), axis=(1, 2))
+    tolerance = 1e-9  # rounding only: another order of the same arithmetic differs by ~1e-12
+    first = int(np.argmax(error > tolerance))
+    expect(
+        np.all(error <= tolerance),
+        saw=f"with λ = 0 the grid leaves the template's trajectory in step {first} (off by "
+        f"{num(error[first])}; the bottom layer meets the floor in step 548)",
+        cause="a scheme other than eq. (1.3), or a different start: the template begins with "
+        "old = current (zero velocity)"
+        if first < 548
+        else "a velocity that is not (x(t+dt) - x(t))/dt: the floor edits it and the next "
+        "step must recover x(t - dt) from it",
+    )
+
+
+@pytest.mark.points(2)
+def test_damping_outside_0_to_1_is_refused(task5):
+    """λ must be in [0, 1): λ < 0 adds energy, λ >= 1 flips or freezes the motion."""
+    for lam in (-0.1, 1.0, 1.2, math.nan):
+        try:
+            task5.DampedVerlet(lam)
+        except ValueError:
+            continue
+        expect(
+            False,
+            saw=f"DampedVerlet({lam}) was accepted",
+            cause="no range check: raise ValueError unless 0 <= λ < 1 (λ = 1.2 reverses the "
+            "velocity every step; NaN fails every comparison, so test 'not 0 <= λ < 1')",
+        )
+    for lam in (0.0, 0.01, 0.99):
+        try:
+            task5.DampedVerlet(lam)
+        except ValueError as error:
+            expect(
+                False,
+                saw=f"DampedVerlet({lam}) was refused ({error})",
+                cause="a range check that excludes valid values: 0 <= λ < 1 is allowed, "
+                "λ = 0 being no damping at all",
+            )
+
+
+def energy_history(integrator, dt_fraction=0.2, steps=400):
+    """Total energies of a kicked 3³ jelly run with ``integrator``, and dt, limit."""
+    body = jelly()
+    limit = msd.max_stable_dt(body, msd.Verlet())
+    rng = np.random.default_rng(7)
+    body.positions = body.positions + 0.02 * rng.standard_normal(body.positions.shape)
+    dt = dt_fraction * limit
+    frames = msd.Simulation(body, integrator, dt).run(steps=steps).positions
+    return oracles.energies(body, frames, dt), dt, limit
+
+
+@pytest.mark.points(3)
+def test_damping_removes_energy(task5):
+    """λ = 0 keeps the total energy of a wobbling jelly; λ = 0.01 takes it out steadily."""
+    energy, dt, limit = energy_history(task5.DampedVerlet(0.0))
+    drift = float(np.max(np.abs(energy - energy[0])) / energy[0])
+    expect(
+        drift < 0.03,
+        saw=f"without damping the total energy changed by up to {percent(drift)} in "
+        f"{len(energy) + 1} steps at dt = {num(dt)} (the predicted stable limit is "
+        f"{num(limit)})",
+        cause="a first-order scheme (Euler) instead of eq. (1.3), or damping applied when λ = 0",
+    )
+    energy, dt, limit = energy_history(task5.DampedVerlet(0.01))
+    samples = energy[::10]
+    growth = float(np.max(np.diff(samples)) / energy[0])
+    left = float(energy[-1] / energy[0])
+    expect(
+        growth < 0.01 and left < 0.05,
+        saw=f"with λ = 0.01 the total energy rose by up to {percent(max(growth, 0.0))} between "
+        f"samples and {percent(left)} of it is left after {len(energy) + 1} steps at "
+        f"dt = {num(dt)}; velocity damping of 1 % per step should leave about "
+        f"{percent((1 - 0.01) ** (2 * len(energy)))}",
+        cause="damping applied to the wrong term (the acceleration or the positions) or "
+        "with the wrong sign",
+    )
+
+
+@pytest.mark.points(2)
+def test_damping_acts_on_velocity_only(task5):
+    """A free particle at rest stays put; a moving one keeps its direction, speed ×(1-λ) a step."""
+    lam, dt = 0.3, 0.5
+    body = msd.Body.from_arrays([[5.0, 3.0, -2.0], [0.0, 1.0, 0.0]])
+    dynamics = msd.Dynamics(body)
+    x = body.positions.copy()
+    v = np.array([[0.0, 0.0, 0.0], [1.0, -2.0, 0.5]])
+    integrator = task5.DampedVerlet(lam)
+    for _ in range(5):
+        x_new, v_new = integrator.step(x, v, dt, dynamics)
+        x_new, v_new = as_array(x_new, "step", x.shape), as_array(v_new, "step", x.shape)
+        expect(
+            np.allclose(x_new[0], x[0], atol=1e-12),
+            saw=f"a free particle at rest at {vec(x[0])} moved to {vec(x_new[0])} with λ = {lam}",
+            cause="damping applied to the positions, (1 - λ)·x, which pulls particles towards "
+            "the origin; eq. (1.4) damps only the difference x(t) - x(t - dt)",
+        )
+        expected = (1 - lam) * v[1]
+        expect(
+            np.allclose(v_new[1], expected, rtol=1e-9),
+            saw=f"a free particle moving at {vec(v[1])} continues at {vec(v_new[1])} with "
+            f"λ = {lam}; eq. (1.4) gives {vec(expected)}",
+            cause="λ applied to the wrong term or with the wrong sign",
+        )
+        x, v = x_new, v_new
+
+
+@pytest.mark.points(2)
+def test_predicted_stability_limit(task5):
+    """The largest stable dt of a mode ω is √(4 - 2λ)/ω, as for the engine's Verlet."""
+    omega = 2.0
+    for lam in (0.0, 0.5):
+        got = msd.stability_limit(task5.DampedVerlet(lam), msd.Mode(omega))
+        expected = math.sqrt(4 - 2 * lam) / omega
+        hints = {
+            0.0: "explicit Euler: unstable at any dt without damping",
+            2 / omega: "eq. (1.3) without damping: λ is ignored",
+        }
+        nearest = min(hints, key=lambda value: abs(value - got))
+        expect(
+            abs(got - expected) < 1e-6 * expected,
+            saw=f"with λ = {lam} your integrator is stable up to dt = {num(got, 6)} for a mode "
+            f"ω = {omega}; eq. (1.4) is stable up to √(4 - 2λ)/ω = {num(expected, 6)}",
+            cause=hints[nearest] if abs(nearest - got) < 1e-6 else "a scheme other than eq. (1.4)",
+        )
+
+
+@pytest.mark.points(3)
+def test_measured_stable_dt_as_predicted(task5):
+    """measured_stable_dt agrees with √(4 - 2λ)/ω; damping does not allow larger steps."""
+    measured = {}
+    for lam in (0.0, 0.5):
+        measured[lam] = float(task5.measured_stable_dt(lam, 3, 300, 0.01))
+        predicted = msd.max_stable_dt(jelly(), msd.Verlet(lam))
+        expect(
+            abs(measured[lam] / predicted - 1) < 0.06,
+            saw=f"with λ = {lam} you measured a largest stable dt of {num(measured[lam])}, the "
+            f"predicted limit √(4 - 2λ)/ω is {num(predicted)}",
+            cause="a different body than jelly(n), or a measurement that does not use your "
+            "DampedVerlet",
+        )
+    expect(
+        measured[0.5] < measured[0.0],
+        saw=f"the measured stable dt with λ = 0.5 ({num(measured[0.5])}) is not below the one "
+        f"without damping ({num(measured[0.0])})",
+        cause="damping does not raise the linear stability limit; √(4 - 2λ)/ω shrinks with λ",
+    )
