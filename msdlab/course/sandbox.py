@@ -18,6 +18,7 @@ restarted for the next call.
 from __future__ import annotations
 
 import builtins
+import contextlib
 import json
 import os
 import select
@@ -185,16 +186,12 @@ class SandboxProcess:
         """Kill the child (and anything it started) and close the pipes; its objects are gone."""
         if self.process is not None:
             self.generation += 1
-            try:
+            with contextlib.suppress(ProcessLookupError, PermissionError):
                 os.killpg(self.process.pid, signal.SIGKILL)
-            except (ProcessLookupError, PermissionError):
-                pass
             self.process.wait()
             for fd in (self._send_fd, self._recv_fd):
-                try:
+                with contextlib.suppress(OSError):
                     os.close(fd)
-                except OSError:
-                    pass
             self.process = None
 
     def cleanup(self) -> None:
