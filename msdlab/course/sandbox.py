@@ -1,0 +1,406 @@
+"""Running a submission in a separate, restricted process and talking to it as data.
+
+The grader's checks use `RemoteImplementation` like any other implementation
+(``implementation.task(n).some_function(...)``), but the submission's code runs
+only in a child process (`sandbox_child`). Calls cross a pipe as plain data
+(`wire`), so whatever the submission does to its own process (monkeypatching
+numpy or pytest, printing fake results, exiting, looping, eating memory) cannot
+decide a check: the verdict is computed here, from the numbers it sent back.
+
+Isolation, strongest available first: as root with ``unshare`` and ``setpriv``,
+the child gets its own mount namespace where the course's ``solutions/`` and
+``tests/`` are hidden, and runs under its own user id; always: a fresh scratch
+folder, an audit hook limiting files, processes and sockets, memory and file
+size limits, and a per-call time limit after which the process is killed and
+restarted for the next call.
+"""
+
+from __future__ import annotations
+
+import builtins
+import contextlib
+import json
+import os
+import select
+import shlex
+import shutil
+import signal
+import subprocess
+import sys
+import sysconfig
+import tempfile
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..integrators import Integrator
+from . import wire
+
+CHILD = Path(__file__).with_name("sandbox_child.py")
+PACKAGE = Path(__file__).resolve().parents[1]
+CALLBACK_NAMES = frozenset({"acceleration", "force", "masses", "free"})
+
+
+class SandboxError(Exception):
+    """The submission's process could not answer (timeout, crash, broken channel)."""
+
+
+class SubmissionTimeout(SandboxError):
+    """A call into the submission took longer than the time limit."""
+
+
+class SubmissionCrashed(SandboxError):
+    """The submission's process died or broke the channel."""
+
+
+class SubmissionRaised(Exception):
+    """The submission raised an exception that is not a Python built-in one."""
+
+
+class SandboxProcess:
+    """One restricted child process serving one submission folder; restarted after a failure."""
+
+    def __init__(
+        self,
+        folder: Path,
+        *,
+        timeout: float = 60.0,
+        memory_bytes: int = 2 * 2**30,
+        hide: Sequence[Path] = (),
+        uid: int | None = None,
+    ) -> None:
+        self.folder = Path(folder).resolve()
+        self.timeout = timeout
+        self.memory_bytes = memory_bytes
+        self.hide = [Path(p).resolve() for p in hide if Path(p).exists()]
+        self.uid = uid if uid is not None else 65534
+        self.strong = os.geteuid() == 0 and bool(
+            shutil.which("unshare") and shutil.which("setpriv")
+        )
+        self.generation = 0
+        self.process: subprocess.Popen | None = None
+        self.scratch = Path(tempfile.mkdtemp(prefix="msdlab-sandbox-"))
+        self.scratch.chmod(0o755)
+        self.exports: dict[int, Any] = {}
+        self.members: dict[tuple[int, str], wire.Ref] = {}
+
+    @property
+    def isolation(self) -> str:
+        """A short description of the isolation in force."""
+        if self.strong:
+            return "own user and mount namespace, audit hook, resource limits"
+        return "separate process, audit hook, resource limits"
+
+    # ------------------------------------------------------------ lifecycle
+    def start(self) -> None:
+        """Start the child and wait until it answers; fall back to the weaker isolation if
+        the strong one cannot start (e.g. the interpreter is not readable by the sandbox user)."""
+        self._launch()
+        try:
+            self.request({"op": "ping"})
+        except SandboxError:
+            if not self.strong:
+                raise SandboxError(f"cannot start the grading sandbox: {self.log_tail()}") from None
+            self.strong = False
+            self._launch()
+            self.request({"op": "ping"})
+
+    def log_tail(self, limit: int = 2000) -> str:
+        """The end of what the submission printed (its stdout and stderr)."""
+        try:
+            return (self.scratch / "output.log").read_text(errors="replace")[-limit:]
+        except OSError:
+            return ""
+
+    def _launch(self) -> None:
+        self.close()
+        lib = self.scratch / "lib"
+        lib.mkdir(parents=True, exist_ok=True)
+        link = lib / "msdlab"
+        if not link.exists():
+            link.symlink_to(PACKAGE, target_is_directory=True)
+        to_child, self._send_fd = os.pipe()
+        self._recv_fd, from_child = os.pipe()
+        sites = sorted({sysconfig.get_paths()["purelib"], sysconfig.get_paths()["platlib"]})
+        config = {
+            "folder": str(self.folder),
+            "scratch": str(self.scratch),
+            "log": str(self.scratch / "output.log"),
+            "sys_path": [str(lib), *sites],
+            "read_roots": [str(self.folder), str(PACKAGE), sys.prefix, sys.base_prefix, *sites],
+            "memory_bytes": self.memory_bytes,
+            "in_fd": to_child,
+            "out_fd": from_child,
+        }
+        command = [sys.executable, "-I", "-S", "-B", str(CHILD), json.dumps(config)]
+        if self.strong:
+            os.chown(self.scratch, self.uid, self.uid)
+            for path in self.scratch.rglob("*"):
+                os.lchown(path, self.uid, self.uid)
+            command = self._isolated(command)
+        environment = {
+            "PATH": "/usr/bin:/bin",
+            "MSDLAB_KERNEL": "numpy",
+            "OPENBLAS_NUM_THREADS": "1",
+            "OMP_NUM_THREADS": "1",
+            "MKL_NUM_THREADS": "1",
+        }
+        self.process = subprocess.Popen(
+            command,
+            pass_fds=(to_child, from_child),
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            env=environment,
+            start_new_session=True,
+        )
+        os.close(to_child)
+        os.close(from_child)
+        self.exports.clear()
+        self.members.clear()
+
+    def _isolated(self, command: list[str]) -> list[str]:
+        """``command`` wrapped to run in a private mount namespace under ``self.uid``."""
+        mounts = [
+            f"mount -t tmpfs -o size=4k,mode=0555 none {shlex.quote(str(p))}" for p in self.hide
+        ]
+        drop = f'exec setpriv --reuid={self.uid} --regid={self.uid} --clear-groups -- "$@"'
+        script = " && ".join([*mounts, drop])
+        return [
+            "unshare",
+            "--mount",
+            "--propagation",
+            "private",
+            "--",
+            "sh",
+            "-c",
+            script,
+            "sh",
+            *command,
+        ]
+
+    def close(self) -> None:
+        """Kill the child (and anything it started) and close the pipes; its objects are gone."""
+        if self.process is not None:
+            self.generation += 1
+            with contextlib.suppress(ProcessLookupError, PermissionError):
+                os.killpg(self.process.pid, signal.SIGKILL)
+            self.process.wait()
+            for fd in (self._send_fd, self._recv_fd):
+                with contextlib.suppress(OSError):
+                    os.close(fd)
+            self.process = None
+
+    def cleanup(self) -> None:
+        """Close the child and delete its scratch folder."""
+        self.close()
+        shutil.rmtree(self.scratch, ignore_errors=True)
+
+    # ------------------------------------------------------------ requests
+    def request(self, message: dict, generation: int | None = None) -> Any:
+        """Send ``message`` and return the child's answer, serving its callbacks meanwhile."""
+        if generation is not None and generation != self.generation:
+            raise SubmissionCrashed(
+                "this object was lost when the submission's process was restarted after a failure"
+            )
+        if self.process is None:
+            self.start()
+        deadline = time.monotonic() + self.timeout
+        try:
+            wire.write_all(self._send_fd, wire.encode(message, self._export))
+            while True:
+                reply = self._receive(deadline)
+                if isinstance(reply, dict) and "op" in reply:
+                    wire.write_all(self._send_fd, wire.encode(self._serve(reply)))
+                    continue
+                break
+        except SubmissionTimeout:
+            self.close()
+            raise
+        except (EOFError, BrokenPipeError, wire.WireError, ValueError, KeyError) as error:
+            reason = self._death_reason() or f"the channel broke ({error})"
+            self.close()
+            raise SubmissionCrashed(f"the submission's process {reason}") from None
+        if not isinstance(reply, dict) or not ("ok" in reply or "error" in reply):
+            self.close()
+            raise SubmissionCrashed("the submission's process sent a malformed answer")
+        if "error" in reply:
+            _raise(reply["error"])
+        return reply["ok"]
+
+    def _receive(self, deadline: float) -> Any:
+        def read(size: int) -> bytes:
+            chunks, left = [], size
+            while left:
+                remaining = deadline - time.monotonic()
+                ready, _, _ = select.select([self._recv_fd], [], [], max(remaining, 0))
+                if not ready:
+                    raise SubmissionTimeout(
+                        f"the submission did not answer within {self.timeout:g} s "
+                        "(an endless loop, or far too much work?)"
+                    )
+                chunk = os.read(self._recv_fd, min(left, 1 << 20))
+                if not chunk:
+                    raise EOFError
+                chunks.append(chunk)
+                left -= len(chunk)
+            return b"".join(chunks)
+
+        return wire.decode(read)
+
+    def _death_reason(self) -> str:
+        if self.process is None:
+            return ""
+        try:
+            code = self.process.wait(timeout=1.0)
+        except subprocess.TimeoutExpired:
+            return ""
+        if code < 0:
+            name = signal.Signals(-code).name
+            hint = " (memory limit?)" if -code in (signal.SIGKILL, signal.SIGSEGV) else ""
+            return f"was killed by {name}{hint}"
+        return f"exited with status {code}"
+
+    def _export(self, value: Any) -> wire.Ref:
+        """A grader object handed to the submission (only its whitelisted members)."""
+        if isinstance(value, RemoteObject):
+            return value._ref
+        self.exports[id(value)] = value
+        return wire.Ref(id(value), "grader")
+
+    def _serve(self, request: dict) -> dict:
+        """Answer a callback: a whitelisted attribute or a call of an exported callable."""
+        try:
+            target = self.exports[request["ref"].id]
+            if request["op"] == "getattr":
+                name = request["name"]
+                if name not in CALLBACK_NAMES:
+                    raise AttributeError(f"the submission may only use {sorted(CALLBACK_NAMES)}")
+                key = (id(target), name)
+                if key not in self.members:
+                    value = getattr(target, name)
+                    if not callable(value):
+                        return {"ok": _plain(value)}
+                    self.members[key] = self._export(value)
+                return {"ok": self.members[key]}
+            if request["op"] == "call" and callable(target):
+                args = [np.asarray(a, dtype=float) for a in request["args"]]
+                return {"ok": _plain(target(*args))}
+            raise ValueError("unknown callback")
+        except Exception as error:
+            return {"error": f"{type(error).__name__}: {error}"}
+
+
+def _plain(value: Any) -> Any:
+    wire.encode(value)  # raises WireError if it is not plain data
+    return value
+
+
+def _raise(error: dict) -> None:
+    """Raise the submission's error here: built-in types keep their type, others are wrapped."""
+    name, message = str(error.get("type")), str(error.get("message"))
+    where = str(error.get("traceback") or "")
+    text = message + (f"\n(in the submission)\n{where.rstrip()}" if where else "")
+    kind = getattr(builtins, name, None)
+    if (
+        isinstance(kind, type)
+        and issubclass(kind, Exception)
+        and not issubclass(kind, (SystemExit, KeyboardInterrupt, GeneratorExit))
+    ):
+        raise kind(text)
+    raise SubmissionRaised(f"{name}: {text}")
+
+
+class RemoteObject:
+    """An object of the submission: attribute access and calls go to its process."""
+
+    def __init__(self, sandbox: SandboxProcess, ref: wire.Ref) -> None:
+        self._sandbox, self._ref, self._generation = sandbox, ref, sandbox.generation
+
+    def _request(self, message: dict) -> Any:
+        return _wrap(self._sandbox, self._sandbox.request(message, self._generation))
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return self._request({"op": "getattr", "ref": self._ref, "name": name})
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        return self._request({"op": "call", "ref": self._ref, "args": args, "kwargs": kwargs})
+
+    def __repr__(self) -> str:
+        return f"<submission {self._ref.kind}>"
+
+
+class RemoteIntegrator(RemoteObject, Integrator):
+    """A submission's `Integrator`: the engine steps it, each step runs in the sandbox."""
+
+    def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: Any) -> Any:
+        return self.__getattr__("step")(x, v, dt, dynamics)
+
+    def dissipated_energy(self, v: np.ndarray, masses: np.ndarray) -> float:
+        return self.__getattr__("dissipated_energy")(v, masses)
+
+    def velocity_at_positions(self, v: np.ndarray, a: np.ndarray, dt: float) -> np.ndarray:
+        return self.__getattr__("velocity_at_positions")(v, a, dt)
+
+    def __repr__(self) -> str:
+        try:
+            return str(self.__getattr__("__repr__")())
+        except Exception:
+            return "<submission integrator>"
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("__") and name != "__repr__":
+            raise AttributeError(name)
+        return self._request({"op": "getattr", "ref": self._ref, "name": name})
+
+
+def _wrap(sandbox: SandboxProcess, value: Any) -> Any:
+    if isinstance(value, wire.Ref):
+        return (RemoteIntegrator if value.kind == "integrator" else RemoteObject)(sandbox, value)
+    if isinstance(value, list):
+        return [_wrap(sandbox, v) for v in value]
+    if isinstance(value, tuple):
+        return tuple(_wrap(sandbox, v) for v in value)
+    if isinstance(value, dict):
+        return {k: _wrap(sandbox, v) for k, v in value.items()}
+    return value
+
+
+class RemoteTask:
+    """A task module of the submission; survives restarts of the process."""
+
+    def __init__(self, sandbox: SandboxProcess, number: int) -> None:
+        self._sandbox, self._number = sandbox, number
+        self._module: RemoteObject | None = None
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("__"):
+            raise AttributeError(name)
+        if self._module is None or self._module._generation != self._sandbox.generation:
+            self._module = _wrap(
+                self._sandbox, self._sandbox.request({"op": "task", "n": self._number})
+            )
+        return getattr(self._module, name)
+
+    def __repr__(self) -> str:
+        return f"<sandboxed task{self._number}.py of {self._sandbox.folder}>"
+
+
+class RemoteImplementation:
+    """A submission folder whose task modules run in a `SandboxProcess` (see module docstring)."""
+
+    def __init__(self, folder: Path, label: str | None = None, **options: Any) -> None:
+        self.sandbox = SandboxProcess(folder, **options)
+        self.label = label or str(self.sandbox.folder)
+        self._tasks: dict[int, RemoteTask] = {}
+
+    def task(self, number: int) -> RemoteTask:
+        return self._tasks.setdefault(number, RemoteTask(self.sandbox, number))
+
+    def close(self) -> None:
+        self.sandbox.cleanup()

@@ -1,0 +1,235 @@
+"""The sandboxed side of grading: imports a submission and answers calls over pipes.
+
+Run by `msdlab.course.sandbox` as ``python -I -S sandbox_child.py CONFIG_JSON``.
+It imports the trusted libraries first, then installs an audit hook that keeps
+the submission inside its folders (no reading outside the allowed roots, no
+writing outside its scratch folder, no processes, sockets, signals or ctypes),
+then serves requests: import a task, get an attribute, call something. Every
+answer is plain data (see `msdlab.course.wire`) or a reference to an object
+kept here, so nothing the submission builds ever runs in the grader.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import traceback
+from typing import Any
+
+
+def main(config: dict[str, Any]) -> None:
+    sys.path[:0] = config["sys_path"]
+    log = os.open(config["log"], os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
+    os.dup2(log, 1)  # what the submission prints goes to its log, never to the grader
+    os.dup2(log, 2)
+    sys.stdout = os.fdopen(1, "w", buffering=1)
+    sys.stderr = os.fdopen(2, "w", buffering=1)
+    _limit_resources(config["memory_bytes"])
+    import importlib.util
+
+    import numpy  # noqa: F401  trusted libraries load before the guard
+    import scipy.linalg
+    import scipy.sparse  # noqa: F401
+
+    import msdlab  # noqa: F401
+    from msdlab.course import wire
+
+    _install_guard(config["read_roots"], config["scratch"])
+    os.chdir(config["scratch"])
+    Server(config["folder"], config["in_fd"], config["out_fd"], wire, importlib.util).serve()
+
+
+def _limit_resources(memory_bytes: int) -> None:
+    import resource
+
+    for limit, value in (
+        (resource.RLIMIT_AS, memory_bytes),
+        (resource.RLIMIT_FSIZE, 64 * 2**20),
+        (resource.RLIMIT_CORE, 0),
+    ):
+        resource.setrlimit(limit, (value, value))
+
+
+_BLOCKED = {
+    "subprocess.Popen", "os.system", "os.exec", "os.posix_spawn", "os.spawn", "os.fork",
+    "os.forkpty", "pty.spawn", "os.kill", "os.killpg", "signal.pthread_kill",
+    "socket.connect", "socket.bind", "socket.sendto", "socket.sendmsg", "socket.getaddrinfo",
+    "ctypes.dlopen", "ctypes.dlsym", "ctypes.call_function", "ctypes.cdata",
+    "ctypes.cdata/buffer", "ctypes.string_at", "ctypes.wstring_at", "ctypes.addressof",
+    "resource.setrlimit", "resource.prlimit", "sys.remote_exec", "os.setuid", "os.setgid",
+    "webbrowser.open", "urllib.Request",
+}  # fmt: skip
+_WRITES = {
+    "os.remove", "os.rename", "os.rmdir", "os.mkdir", "os.chmod", "os.chown", "os.link",
+    "os.symlink", "os.truncate", "os.utime", "shutil.rmtree", "shutil.move", "shutil.copyfile",
+    "shutil.copytree", "os.chflags", "os.lchflags", "os.setxattr", "os.removexattr",
+}  # fmt: skip
+_LISTS = {"os.listdir", "os.scandir", "glob.glob", "glob.glob/2", "os.chdir"}
+_WRITE_FLAGS = os.O_WRONLY | os.O_RDWR | os.O_CREAT | os.O_TRUNC | os.O_APPEND
+
+
+def _install_guard(read_roots: list[str], scratch: str) -> None:
+    """Audit hook: the submission reads only under ``read_roots`` and writes only in ``scratch``."""
+    realpath, fspath, sep = os.path.realpath, os.fspath, os.sep
+    readable = tuple(realpath(r) for r in [*read_roots, scratch])
+    writable = (realpath(scratch),)
+
+    def inside(path: object, roots: tuple[str, ...]) -> bool:
+        if path is None or isinstance(path, int):
+            return True  # an already open descriptor
+        real = realpath(fspath(path))
+        return any(real == r or real.startswith(r + sep) for r in roots)
+
+    def guard(event: str, args: tuple) -> None:
+        if event == "open":
+            path, mode, flags = args
+            writing = bool(mode and any(c in str(mode) for c in "wax+")) or bool(
+                isinstance(flags, int) and flags & _WRITE_FLAGS
+            )
+            if not inside(path, writable if writing else readable):
+                what = "write" if writing else "read"
+                raise PermissionError(f"grading sandbox: submissions may not {what} {path}")
+        elif event in _BLOCKED or event.startswith("ctypes."):
+            raise PermissionError(f"grading sandbox: submissions may not use {event}")
+        elif event in _WRITES:
+            for path in args[:2]:
+                if isinstance(path, (str, bytes, os.PathLike)) and not inside(path, writable):
+                    raise PermissionError(f"grading sandbox: submissions may not change {path}")
+        elif event in _LISTS and args and not inside(args[0] or ".", readable):
+            raise PermissionError(f"grading sandbox: submissions may not look at {args[0]}")
+
+    sys.addaudithook(guard)
+
+
+class Server:
+    """Answers the grader's requests; keeps the submission's objects in a table of references."""
+
+    def __init__(self, folder: str, in_fd: int, out_fd: int, wire: Any, importer: Any) -> None:
+        self.folder, self.out_fd, self.wire, self.importer = folder, out_fd, wire, importer
+        self.read = wire.reader(in_fd)
+        self.objects: dict[int, Any] = {}
+        self.modules: dict[int, Any] = {}
+        self.grader_objects: dict[int, GraderObject] = {}
+
+    def serve(self) -> None:
+        while True:
+            try:
+                request = self.wire.decode(self.read)
+            except EOFError:
+                return
+            self.send(self.answer(request))
+
+    def answer(self, request: dict) -> dict:
+        try:
+            op = request["op"]
+            if op == "ping":
+                value = "pong"
+            elif op == "task":
+                value = self.task(int(request["n"]))
+            elif op == "getattr":
+                value = getattr(self.objects[request["ref"].id], request["name"])
+            elif op == "call":
+                target = self.objects[request["ref"].id]
+                value = target(*self.local(request["args"]), **self.local(request["kwargs"]))
+            elif op == "release":
+                for ref in request["refs"]:
+                    self.objects.pop(ref.id, None)
+                value = None
+            else:
+                raise ValueError(f"unknown request {op!r}")
+            return {"ok": value}
+        except BaseException as error:  # the submission's failure is an answer, not our crash
+            return {"error": _describe(error, self.folder)}
+
+    def task(self, number: int) -> Any:
+        if number not in self.modules:
+            path = os.path.join(self.folder, f"task{number}.py")
+            if not os.path.isfile(path):
+                raise FileNotFoundError(f"task{number}.py is missing from the submission")
+            spec = self.importer.spec_from_file_location(f"submission_task{number}", path)
+            module = self.importer.module_from_spec(spec)
+            sys.modules[spec.name] = module
+            spec.loader.exec_module(module)
+            self.modules[number] = module
+        return self.modules[number]
+
+    def local(self, value: Any) -> Any:
+        """Arguments with the grader's references turned into proxies that call back."""
+        if isinstance(value, self.wire.Ref):
+            if value.kind != "grader":
+                return self.objects[value.id]
+            if value.id not in self.grader_objects:
+                self.grader_objects[value.id] = GraderObject(self, value)
+            return self.grader_objects[value.id]
+        if isinstance(value, (list, tuple)):
+            return type(value)(self.local(v) for v in value)
+        if isinstance(value, dict):
+            return {k: self.local(v) for k, v in value.items()}
+        return value
+
+    def reference(self, value: Any) -> Any:
+        """Keep a non-data value here and describe it to the grader."""
+        import types
+
+        import msdlab
+
+        self.objects[id(value)] = value
+        if isinstance(value, msdlab.Integrator):
+            kind = "integrator"
+        elif isinstance(value, types.ModuleType):
+            kind = "module"
+        else:
+            kind = "callable" if callable(value) else "object"
+        return self.wire.Ref(id(value), kind)
+
+    def send(self, message: dict) -> None:
+        try:
+            data = self.wire.encode(message, self.reference)
+        except Exception as error:  # e.g. a result that is too large
+            data = self.wire.encode({"error": _describe(error, self.folder)})
+        self.wire.write_all(self.out_fd, data)
+
+    def callback(self, message: dict) -> Any:
+        """Send a request to the grader (during a call) and return its answer."""
+        self.send(message)
+        reply = self.wire.decode(self.read)
+        if "error" in reply:
+            raise RuntimeError(f"grader: {reply['error']}")
+        return self.local(reply["ok"])
+
+
+class GraderObject:
+    """An object of the grader handed to the submission (e.g. the dynamics of a step)."""
+
+    def __init__(self, server: Server, ref: Any) -> None:
+        self._server, self._ref = server, ref
+        self._methods: dict[str, GraderObject] = {}
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("_"):
+            raise AttributeError(name)
+        if name in self._methods:
+            return self._methods[name]
+        value = self._server.callback({"op": "getattr", "ref": self._ref, "name": name})
+        if isinstance(value, GraderObject):
+            self._methods[name] = value
+        return value
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        message = {"op": "call", "ref": self._ref, "args": args, "kwargs": kwargs}
+        return self._server.callback(message)
+
+
+def _describe(error: BaseException, folder: str) -> dict:
+    frames = [f for f in traceback.extract_tb(error.__traceback__) if f.filename.startswith(folder)]
+    where = "".join(traceback.format_list(frames[-5:]))
+    if isinstance(error, SystemExit):
+        message = f"the submission called sys.exit({error.code!r})"
+    else:
+        message = str(error)
+    return {"type": type(error).__name__, "message": message[:4000], "traceback": where[:4000]}
+
+
+if __name__ == "__main__":
+    main(json.loads(sys.argv[1]))
