@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -42,6 +43,26 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         metavar="IMPL",
         help="implementation under test: 'solutions', 'assignments' or a folder laid out "
         f"like assignments/ (default: ${ENV_IMPL}, else solutions where they exist)",
+    )
+    group.addoption(
+        "--sandbox",
+        action="store_true",
+        help="run the implementation in a restricted child process and judge only the data it "
+        "returns (what `msdlab grade` does)",
+    )
+    group.addoption(
+        "--sandbox-timeout",
+        type=float,
+        default=60.0,
+        metavar="S",
+        help="with --sandbox: seconds one call into the implementation may take (default 60)",
+    )
+    group.addoption(
+        "--sandbox-memory",
+        type=int,
+        default=2048,
+        metavar="MB",
+        help="with --sandbox: memory limit of the implementation's process (default 2048 MB)",
     )
     group.addoption(
         "--msdlab-report",
@@ -67,10 +88,28 @@ def implementation_spec(config: pytest.Config) -> str:
 
 
 @pytest.fixture(scope="session")
-def implementation(pytestconfig: pytest.Config) -> loader.Implementation:
-    """The implementation under test (see ``--impl``)."""
+def implementation(pytestconfig: pytest.Config) -> Iterator[loader.Implementation]:
+    """The implementation under test (see ``--impl`` and ``--sandbox``)."""
     spec = implementation_spec(pytestconfig)
-    return loader.load(spec, loader.course_root(pytestconfig.rootpath))
+    root = loader.course_root(pytestconfig.rootpath)
+    if not pytestconfig.getoption("sandbox"):
+        yield loader.load(spec, root)
+        return
+    from .sandbox import RemoteImplementation, course_secrets
+
+    uid = os.environ.get("MSDLAB_SANDBOX_UID")
+    remote = RemoteImplementation(
+        loader.resolve(spec, root),
+        label=str(spec),
+        timeout=pytestconfig.getoption("sandbox_timeout"),
+        memory_bytes=pytestconfig.getoption("sandbox_memory") * 2**20,
+        hide=course_secrets(root),
+        uid=None if uid is None else int(uid),
+    )
+    try:
+        yield remote
+    finally:
+        remote.close()
 
 
 def _task_fixture(number: int):

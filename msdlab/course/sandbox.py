@@ -44,6 +44,14 @@ PACKAGE = Path(__file__).resolve().parents[1]
 CALLBACK_NAMES = frozenset({"acceleration", "force", "masses", "free"})
 
 
+def course_secrets(*roots: Path) -> list[Path]:
+    """The folders a submission must not see: ``solutions/`` and ``tests/`` of the course
+    roots and of the project this package belongs to."""
+    names = ("solutions", "tests")
+    folders = {Path(root).resolve() / name for root in (*roots, PACKAGE.parent) for name in names}
+    return sorted(folder for folder in folders if folder.is_dir())
+
+
 class SandboxError(Exception):
     """The submission's process could not answer (timeout, crash, broken channel)."""
 
@@ -75,7 +83,10 @@ class SandboxProcess:
         self.folder = Path(folder).resolve()
         self.timeout = timeout
         self.memory_bytes = memory_bytes
-        self.hide = [Path(p).resolve() for p in hide if Path(p).exists()]
+        hidden = [Path(p).resolve() for p in hide if Path(p).exists()]
+        self.hide = [
+            p for p in hidden if not self.folder.is_relative_to(p)
+        ]  # never the folder graded
         self.uid = uid if uid is not None else 65534
         self.strong = os.geteuid() == 0 and bool(
             shutil.which("unshare") and shutil.which("setpriv")
