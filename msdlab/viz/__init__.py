@@ -4,10 +4,11 @@ from msdlab import viz
 viz.plot_body(sim.body)                        # springs coloured by strain
 viz.plot_energy(trajectory.energies)
 viz.save_animation(trajectory, "run.gif")      # or .mp4 (needs ffmpeg), .html
+HTML(viz.to_html(trajectory))                  # in Jupyter: inline, with play controls
 viz.show(sim)                                  # window: drag particles with the mouse
 """
 
-from .animation import FORMATS, animate, save_animation
+from .animation import FORMATS, animate, save_animation, to_html
 from .energy import plot_energy
 from .interactive import Dragger, show
 from .view import BodyView, new_axes, plot_body, spheres_of, strains
@@ -24,4 +25,5 @@ __all__ = [
     "show",
     "spheres_of",
     "strains",
+    "to_html",
 ]

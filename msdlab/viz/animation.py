@@ -52,6 +52,34 @@ def animate(
     return _build(trajectory, max_frames, fps, view, up, time_unit, title, spheres)[0]
 
 
+def to_html(
+    trajectory: Trajectory,
+    *,
+    max_frames: int = 100,
+    fps: float = 20.0,
+    view: Sequence[float] | None = None,
+    up: str = "z",
+    time_unit: str = "s",
+    title: str = "",
+    spheres: Sequence[tuple[int, float]] = (),
+    dpi: float = 72.0,
+) -> str:
+    """The animation of ``trajectory`` as self-contained HTML (frames embedded, play controls).
+
+    For Jupyter: ``IPython.display.HTML(to_html(trajectory))`` (needs no ffmpeg).
+    Options as in `animate`, frames drawn at ``dpi``; the figure is closed, so no
+    still picture shows up as well.
+    """
+    import matplotlib.pyplot as plt
+
+    animation, figure = _build(trajectory, max_frames, fps, view, up, time_unit, title, spheres)
+    figure.set_dpi(dpi)
+    try:
+        return animation.to_jshtml(fps=fps)
+    finally:
+        plt.close(figure)
+
+
 def _build(
     trajectory: Trajectory,
     max_frames: int,
@@ -66,7 +94,9 @@ def _build(
     frames = trajectory.positions[picks]
     body = trajectory.body
     sample = frames[:: max(1, len(frames) // 10)]
-    limit = max(1e-3, float(max(np.percentile(np.abs(strains(body, f)), 99) for f in sample)))
+    limit = 1e-3  # the strain drawn at full colour
+    if body.n_springs:
+        limit = max(limit, float(max(np.percentile(np.abs(strains(body, f)), 99) for f in sample)))
     ax = new_axes(body, size=5.0)
     drawing = BodyView(ax, body, frames[0], strain_limit=limit, view=view, up=up, spheres=spheres)
     drawing.fit(frames)

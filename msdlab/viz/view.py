@@ -83,7 +83,8 @@ class BodyView:
         segments = self._segments(positions)
         if self.is_3d:
             self.springs = Line3DCollection(segments, **style)
-            ax.add_collection3d(self.springs)
+            if body.n_springs:  # an empty 3-D collection breaks matplotlib's autoscaling
+                ax.add_collection3d(self.springs)
             azimuth, elevation = (45.0, 30.0) if view is None else view
             ax.view_init(elev=elevation, azim=azimuth - 90.0, vertical_axis=up)
         else:

@@ -6,6 +6,7 @@ import pytest
 from matplotlib.animation import FFMpegWriter, FuncAnimation
 from PIL import Image
 
+import msdlab as msd
 from msdlab import viz
 from msdlab.scenes import gallery, jelly
 
@@ -33,6 +34,23 @@ def test_html_is_self_contained(rope_run, tmp_path):
     page = path.read_text()
     assert "<script" in page and page.count("data:image/png;base64") == 4
     assert 'src="http' not in page
+
+
+def test_to_html_is_inline_html_and_leaves_no_figure_open(rope_run):
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+    page = viz.to_html(rope_run, max_frames=3)
+    assert "<script" in page and page.count("data:image/png;base64") == 3
+    assert plt.get_fignums() == []  # Jupyter shows no stray still picture
+
+
+def test_a_body_without_springs_animates():
+    """The template's falling grid (course task 1) has particles only."""
+    body = msd.Body.from_arrays([[0.0, 1.0, 0.0], [0.5, 2.0, 0.0]])
+    sim = msd.Simulation(body, msd.Verlet(), 0.1, [msd.Gravity((0, -0.01, 0)), msd.Ground(0.0)])
+    page = viz.to_html(sim.run(steps=50, record_every=10), max_frames=3, up="y")
+    assert page.count("data:image/png;base64") == 3
 
 
 def test_3d_animation_with_y_up(tmp_path):
