@@ -1,0 +1,171 @@
+"""Build the notebooks from their sources: ``notebooks/src/NAME.py`` -> ``notebooks/NAME.ipynb``.
+
+A source is a Python file in the percent format: ``# %%`` starts a code cell,
+``# %% [markdown]`` a Markdown cell whose lines are comments (``# text``).
+Each notebook is run against the reference solutions (nbclient, a kernel of
+this Python, working folder ``notebooks/``) and saved with its text outputs,
+which nbval compares in the cells marked ``# NBVAL_CHECK_OUTPUT``. Pictures and
+animations are left out of the saved files so that they stay small and diff
+cleanly: run a notebook to see them.
+
+    python notebooks/build.py              # build and run every notebook
+    python notebooks/build.py task2 tour   # only those whose name contains one of the words
+    python notebooks/build.py --check      # exit 1 if a notebook is not what its source makes
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import os
+import re
+import sys
+from pathlib import Path
+
+import nbformat
+from nbformat import NotebookNode
+
+HERE = Path(__file__).resolve().parent
+SOURCES = HERE / "src"
+ROOT = HERE.parent
+MARKER = re.compile(r"# %%(?P<markdown> \[markdown\])?\s*$")
+METADATA = {
+    "kernelspec": {"display_name": "Python 3", "language": "python", "name": "python3"},
+    "language_info": {"name": "python"},
+}
+TEXT_ONLY = {"text/plain"}  # output data kept in the saved notebooks
+
+
+def cells(text: str) -> list[NotebookNode]:
+    """The cells of a percent-format source, with ids made from their content."""
+    chunks: list[tuple[bool, list[str]]] = []
+    for number, line in enumerate(text.splitlines(), 1):
+        marker = MARKER.match(line)
+        if marker:
+            chunks.append((bool(marker["markdown"]), []))
+        elif chunks:
+            chunks[-1][1].append(line)
+        elif line.strip():
+            raise ValueError(f"line {number}: text before the first '# %%' cell marker")
+    made, seen = [], set()
+    for markdown, lines in chunks:
+        source = "\n".join(_markdown(lines) if markdown else lines).strip("\n")
+        if not source.strip():
+            continue
+        digest = hashlib.sha1(source.encode()).hexdigest()[:8]
+        cell_id = digest if digest not in seen else f"{digest}-{len(made)}"
+        seen.add(cell_id)
+        new = nbformat.v4.new_markdown_cell if markdown else nbformat.v4.new_code_cell
+        made.append(new(source, id=cell_id))
+    return made
+
+
+def _markdown(lines: list[str]) -> list[str]:
+    """Comment lines ``# text`` -> ``text``."""
+    for line in lines:
+        if line.strip() and not line.startswith("#"):
+            raise ValueError(f"a Markdown cell holds a line that is not a comment: {line!r}")
+    return [line[2:] if line.startswith("# ") else line[1:] for line in lines]
+
+
+def skeleton(source: Path) -> NotebookNode:
+    """The notebook of ``source``, not yet run."""
+    notebook = nbformat.v4.new_notebook(metadata=METADATA)
+    notebook.cells = cells(source.read_text(encoding="utf-8"))
+    return notebook
+
+
+def execute(notebook: NotebookNode) -> None:
+    """Run every cell in a fresh kernel of this Python, in ``notebooks/``; stop at an error."""
+    from jupyter_client.manager import KernelManager
+    from nbclient import NotebookClient
+    from nbval.kernel import CURRENT_ENV_KERNEL_NAME, NbvalKernelspecManager
+
+    manager = KernelManager(
+        kernel_name=CURRENT_ENV_KERNEL_NAME, kernel_spec_manager=NbvalKernelspecManager()
+    )
+    NotebookClient(
+        notebook,
+        km=manager,
+        timeout=600,
+        record_timing=False,
+        resources={"metadata": {"path": str(HERE)}},
+    ).execute()
+
+
+def keep_text(notebook: NotebookNode) -> None:
+    """Drop pictures, animations and widgets from the outputs; keep text, reset the metadata."""
+    notebook.metadata = nbformat.from_dict(METADATA)
+    for cell in notebook.cells:
+        if cell.cell_type != "code":
+            continue
+        cell.outputs = [
+            output
+            for output in cell.outputs
+            if "data" not in output or set(output["data"]) <= TEXT_ONLY
+        ]
+        for output in cell.outputs:
+            if str(ROOT) in str(output):
+                raise ValueError(f"an output shows this machine's path {ROOT}: {output}")
+
+
+def build(source: Path) -> Path:
+    """Make, run and save the notebook of ``source``; return its path."""
+    notebook = skeleton(source)
+    execute(notebook)
+    keep_text(notebook)
+    path = HERE / f"{source.stem}.ipynb"
+    nbformat.write(notebook, path)
+    return path
+
+
+def stale() -> list[str]:
+    """Names of the notebooks that are missing, orphaned or not what their source makes.
+
+    Compares the cells (type, id, source); outputs come from running the notebook.
+    """
+    sources = {path.stem: path for path in SOURCES.glob("*.py")}
+    saved = {path.stem: path for path in HERE.glob("*.ipynb")}
+    names = []
+    for name in sorted(sources.keys() | saved.keys()):
+        if name not in sources or name not in saved:
+            names.append(name)
+            continue
+        wanted = skeleton(sources[name]).cells
+        found = nbformat.read(saved[name], as_version=4).cells
+        if _shape(wanted) != _shape(found):
+            names.append(name)
+    return names
+
+
+def _shape(cells: list[NotebookNode]) -> list[tuple[str, str, str]]:
+    return [(cell.cell_type, cell.get("id", ""), cell.source) for cell in cells]
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("words", nargs="*", help="build only notebooks whose name contains one")
+    parser.add_argument(
+        "--check", action="store_true", help="compare only: exit 1 if a notebook is stale"
+    )
+    args = parser.parse_args(argv)
+    if args.check:
+        names = stale()
+        for name in names:
+            print(f"notebooks/{name}.ipynb is not what notebooks/src/{name}.py makes")
+        if names:
+            print("run: python notebooks/build.py")
+        return 1 if names else 0
+    os.environ["MSDLAB_IMPL"] = "solutions"  # the saved outputs are those of the reference
+    sources = sorted(SOURCES.glob("*.py"))
+    chosen = [s for s in sources if not args.words or any(w in s.stem for w in args.words)]
+    for orphan in set(HERE.glob("*.ipynb")) - {HERE / f"{s.stem}.ipynb" for s in sources}:
+        print(f"{orphan.relative_to(ROOT)} has no source: removed")
+        orphan.unlink()
+    for source in chosen:
+        print(f"building {build(source).relative_to(ROOT)}", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,163 @@
+# %% [markdown]
+# # The 2-D springs gallery
+#
+# A p5.js teaching page builds its examples from two pieces: particles and
+# springs with Hooke's law $F = -k\,x$, rest length = the distance at creation.
+# Its units are pixels and animation frames ($\Delta t = 1$ frame), masses are 1,
+# and each frame it does
+#
+# $$\mathbf{v} \mathrel{+}= \mathbf{F}/m, \qquad \mathbf{v} \mathrel{*}= d, \qquad
+#   \lVert\mathbf{v}\rVert \le 10\ \text{px/frame}, \qquad \mathbf{x} \mathrel{+}= \mathbf{v}$$
+#
+# with a velocity factor $d$ (0.96 to start; "never higher than 1"), optional
+# hard or periodic walls, and the user dragging the nearest particle with the
+# mouse. `msdlab.scenes.gallery` has every example, each with two models:
+# `model="frame"` is the page's own update (`FrameEuler`), `model="physical"`
+# (default) steps Newton's law with velocity Verlet and turns $d$ into the exact
+# drag $\mathbf{v} \leftarrow \mathbf{v}\,e^{-r\Delta t}$ with $r = -\ln d$ per frame.
+# Here $y$ points up (the page's points down).
+
+# %%
+import importlib.util
+
+import matplotlib.pyplot as plt
+import numpy as np
+from IPython import get_ipython
+from IPython.display import HTML, display
+from scipy.optimize import curve_fit
+
+import msdlab as msd
+from msdlab import viz
+from msdlab.scenes import SCENES, gallery
+
+# %% [markdown]
+# ## The gallery after 300 frames
+
+# %%
+scenes = [scene for scene in SCENES.values() if scene.unit == "frames"]
+fig, axes = plt.subplots(2, 5, figsize=(16, 6))
+for scene, ax in zip(scenes, axes.flat):
+    sim = scene.build()
+    sim.run(steps=300, record_every=300)
+    viz.BodyView(ax, sim.body, colorbar=False)
+    ax.set(xlim=(0, gallery.WIDTH), ylim=(0, gallery.HEIGHT), title=scene.name)
+plt.show()
+
+# %% [markdown]
+# ## Two models, one equilibrium
+#
+# The page's update is not Newton's law in time (its damping depends on the
+# frame rate, the speed cap clips what the forces say), but at rest the forces
+# balance the same way: a particle hanging from a fixed one by a spring of
+# $k = 0.1$ under gravity $g = 0.5$ px/frame² stretches it by $mg/k = 5$ px.
+
+# %%
+# NBVAL_CHECK_OUTPUT
+for model in gallery.MODELS:
+    sim = gallery.hanging_particle(model=model)
+    sim.run(steps=2000, record_every=2000)
+    stretch = np.linalg.norm(np.diff(sim.body.positions, axis=0)) - 100.0
+    print(f"{model:<8} model: the spring stretches by {stretch:.2f} px")
+
+# %% [markdown]
+# ## The hanging rope is a catenary
+#
+# A chain fixed at both ends settles where gravity and tension balance. An
+# inextensible chain hangs as $y = y_0 + a\,(\cosh((x - x_0)/a) - 1)$; this one
+# is elastic (18 particles, links of rest length 40 px over a 400 px span), and
+# still fits the curve to within 1 % of its sag:
+
+# %%
+# NBVAL_CHECK_OUTPUT
+sim = gallery.hanging_rope()
+sim.run(steps=5000, record_every=5000)
+x, y = sim.body.positions.T
+
+
+def catenary(xs: np.ndarray, a: float, x0: float, y0: float) -> np.ndarray:
+    return y0 + a * (np.cosh((xs - x0) / a) - 1.0)
+
+
+(a, x0, y0), _ = curve_fit(catenary, x, y, p0=(200.0, 300.0, y.min()))
+sag = y[0] - y.min()
+print(f"sag {sag:.1f} px, lowest point at x = {x0:.1f} px (the middle of the span)")
+miss = np.max(np.abs(catenary(x, a, x0, y0) - y))
+print(f"fits a catenary to within 1 % of the sag: {miss < 0.01 * sag}")
+
+# %%
+fig, ax = plt.subplots(figsize=(7, 3))
+fine = np.linspace(x.min(), x.max(), 200)
+ax.plot(fine, catenary(fine, a, x0, y0), label=f"catenary, a = {a:.0f} px")
+ax.plot(x, y, "o", label="the rope's particles")
+ax.set(xlabel="x (px)", ylabel="y (px)", aspect="equal")
+ax.legend()
+plt.show()
+
+# %% [markdown]
+# ## The speed cap hides the instability
+#
+# The page warns that a large $k$ "explodes" under its Euler update. With
+# $k = 1.5$ the rope's stiffest mode has $\omega\,\Delta t = 2.4 > 2$: no explicit
+# scheme is stable at one step per frame. The physical model stops and says
+# so; the page's update never blows up, because the speed cap holds every
+# particle at 10 px per frame, but the rope it draws is torn apart.
+
+# %%
+try:
+    gallery.rope(stiffness=1.5, damping=1.0).run(steps=400)
+except msd.SimulationDiverged as error:
+    print(error)
+
+# %%
+# NBVAL_CHECK_OUTPUT
+capped = gallery.rope(stiffness=1.5, damping=1.0, model="frame")
+run = capped.run(steps=400, record_every=1, record_velocities=True)
+links = np.linalg.norm(np.diff(run.positions[-100:], axis=1), axis=2)
+print(f"frame model, largest speed: {np.linalg.norm(run.velocities, axis=2).max():.1f} px/frame")
+print(f"links stretched or squeezed by more than 20 %: {np.max(np.abs(links / 40.0 - 1.0)) > 0.2}")
+
+# %% [markdown]
+# ## A bouncing blob
+#
+# Sixty points on a circle, each joined to its 3rd, 5th, 7th and 11th
+# neighbour, falling in hard walls:
+
+# %%
+run = gallery.blob().run(steps=400, record_every=5)
+HTML(viz.to_html(run, max_frames=60, time_unit="frames"))
+
+# %% [markdown]
+# ## Dragging
+#
+# On the page you grab the nearest particle and drag it. `viz.show(sim)` does
+# the same in a matplotlib window, and in Jupyter with
+# [ipympl](https://matplotlib.org/ipympl/) (`pip install ipympl`, then restart
+# the kernel): the next cell opens the mesh for dragging where ipympl is
+# installed. Without it, the cell plays a drag by script: the top-right corner
+# of the mesh is taken in hand, pulled 150 px to the left, and let go. It uses
+# the same `msd.Grab` as the mouse: while held, the particle follows the hand;
+# let go, it keeps the hand's velocity, not the spring forces it held against
+# (the page set the position only, so a released particle flung away).
+
+# %%
+sim = gallery.mesh()
+if importlib.util.find_spec("ipympl"):
+    get_ipython().run_line_magic("matplotlib", "widget")
+    dragger = viz.show(sim, steps_per_frame=2)
+else:
+    corner = int(np.argmax(sim.body.positions.sum(axis=1)))
+    grab = msd.Grab()
+    sim.constraints.append(grab)
+    grab.hold(sim.body, corner)
+    start = sim.body.positions[corner].copy()
+
+    def hand(sim: msd.Simulation) -> None:
+        """Pull the corner 150 px to the left in 60 frames, then let go."""
+        if sim.step_count < 60:
+            grab.move(start + sim.step_count / 60 * np.array([-150.0, 0.0]))
+        elif grab.particle is not None:
+            grab.release()
+
+    run = sim.run(steps=240, record_every=3, callback=hand)
+    print("ipympl is not installed: a scripted drag instead of the mouse")
+    display(HTML(viz.to_html(run, max_frames=60, time_unit="frames")))

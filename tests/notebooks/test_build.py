@@ -1,0 +1,78 @@
+"""The committed notebooks are what ``notebooks/build.py`` makes from ``notebooks/src``, and
+they hold the outputs that nbval compares."""
+
+import importlib.util
+from pathlib import Path
+
+import nbformat
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
+
+
+def load_build():
+    spec = importlib.util.spec_from_file_location("notebook_build", ROOT / "notebooks" / "build.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+build = load_build()
+
+
+def test_committed_notebooks_are_built_from_their_sources():
+    stale = build.stale()
+    assert not stale, f"stale notebooks {stale}: run python notebooks/build.py"
+
+
+def test_every_task_and_scene_has_a_notebook():
+    names = {path.stem for path in NOTEBOOKS}
+    wanted = {"00_tour", "stability", "scene_trampoline", "scene_cloth", "scene_gallery"}
+    assert wanted | {f"task{n}" for n in range(1, 6)} <= names
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)
+def test_checked_cells_hold_their_outputs(path):
+    """A checked cell saved without outputs would compare nothing: a silent pass."""
+    notebook = nbformat.read(path, as_version=4)
+    code = [c for c in notebook.cells if c.cell_type == "code"]
+    checked = [c for c in code if "NBVAL_CHECK_OUTPUT" in c.source]
+    assert checked, f"{path.name} checks no output"
+    for cell in checked:
+        assert cell.outputs, f"{path.name}: a checked cell has no saved output:\n{cell.source}"
+    for cell in code:
+        assert all(output.output_type != "error" for output in cell.outputs), cell.source
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)
+def test_saved_outputs_are_text_and_say_nothing_of_this_machine(path):
+    text = path.read_text(encoding="utf-8")
+    assert "image/png" not in text and "text/html" not in text
+    assert str(ROOT) not in text
+    assert " at 0x" not in text  # memory addresses
+    notebook = nbformat.read(path, as_version=4)
+    assert all("execution" not in cell.metadata for cell in notebook.cells)  # no timings
+
+
+def test_percent_format_makes_markdown_and_code_cells():
+    source = "# %% [markdown]\n# # Title\n#\n# Some $x$.\n\n# %%\nx = 1\n\n\n# %%\nprint(x)\n"
+    cells = build.cells(source)
+    assert [c.cell_type for c in cells] == ["markdown", "code", "code"]
+    assert cells[0].source == "# Title\n\nSome $x$."
+    assert cells[1].source == "x = 1"
+    assert len({c.id for c in cells}) == 3
+
+
+def test_cell_ids_follow_the_content_not_the_position():
+    first = build.cells("# %%\na = 1\n# %%\nb = 2\n")
+    inserted = build.cells("# %%\nz = 0\n# %%\na = 1\n# %%\nb = 2\n")
+    assert [c.id for c in first] == [c.id for c in inserted[1:]]
+
+
+@pytest.mark.parametrize(
+    "source", ["x = 1\n# %%\ny = 2\n", "# %% [markdown]\nnot a comment\n"], ids=["before", "md"]
+)
+def test_malformed_sources_are_refused(source):
+    with pytest.raises(ValueError):
+        build.cells(source)
