@@ -97,6 +97,7 @@ class SandboxProcess:
         self.scratch.chmod(0o755)
         self.exports: dict[int, Any] = {}
         self.members: dict[tuple[int, str], wire.Ref] = {}
+        self.timed_out: dict[str, str] = {}  # name -> message, until `forgive` (next check)
 
     @property
     def isolation(self) -> str:
@@ -211,8 +212,18 @@ class SandboxProcess:
         shutil.rmtree(self.scratch, ignore_errors=True)
 
     # ------------------------------------------------------------ requests
-    def request(self, message: dict, generation: int | None = None) -> Any:
-        """Send ``message`` and return the child's answer, serving its callbacks meanwhile."""
+    def forgive(self) -> None:
+        """Let functions that timed out run again (called before each check)."""
+        self.timed_out.clear()
+
+    def request(self, message: dict, generation: int | None = None, name: str = "") -> Any:
+        """Send ``message`` and return the child's answer, serving its callbacks meanwhile.
+
+        A call of ``name`` that timed out is not run again until `forgive`: it fails
+        at once with the same message, so one endless function costs one time limit.
+        """
+        if name in self.timed_out:
+            raise SubmissionTimeout(self.timed_out[name] + " (not run again in this check)")
         if generation is not None and generation != self.generation:
             raise SubmissionCrashed(
                 "this object was lost when the submission's process was restarted after a failure"
@@ -228,8 +239,10 @@ class SandboxProcess:
                     wire.write_all(self._send_fd, wire.encode(self._serve(reply)))
                     continue
                 break
-        except SubmissionTimeout:
+        except SubmissionTimeout as error:
             self.close()
+            if name:
+                self.timed_out[name] = f"{name}: {error}"
             raise
         except (EOFError, BrokenPipeError, wire.WireError, ValueError, KeyError) as error:
             reason = self._death_reason() or f"the channel broke ({error})"
@@ -328,19 +341,23 @@ def _raise(error: dict) -> None:
 class RemoteObject:
     """An object of the submission: attribute access and calls go to its process."""
 
-    def __init__(self, sandbox: SandboxProcess, ref: wire.Ref) -> None:
-        self._sandbox, self._ref, self._generation = sandbox, ref, sandbox.generation
+    def __init__(self, sandbox: SandboxProcess, ref: wire.Ref, name: str) -> None:
+        self._sandbox, self._ref, self._name = sandbox, ref, name
+        self._generation = sandbox.generation
 
-    def _request(self, message: dict) -> Any:
-        return _wrap(self._sandbox, self._sandbox.request(message, self._generation))
+    def _request(self, message: dict, name: str) -> Any:
+        value = self._sandbox.request(message, self._generation, self._name)
+        return _wrap(self._sandbox, value, name)
 
     def __getattr__(self, name: str) -> Any:
         if name.startswith("__"):
             raise AttributeError(name)
-        return self._request({"op": "getattr", "ref": self._ref, "name": name})
+        message = {"op": "getattr", "ref": self._ref, "name": name}
+        return self._request(message, f"{self._name}.{name}")
 
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
-        return self._request({"op": "call", "ref": self._ref, "args": args, "kwargs": kwargs})
+        message = {"op": "call", "ref": self._ref, "args": args, "kwargs": kwargs}
+        return self._request(message, f"{self._name}()")
 
     def __repr__(self) -> str:
         return f"<submission {self._ref.kind}>"
@@ -367,18 +384,21 @@ class RemoteIntegrator(RemoteObject, Integrator):
     def __getattr__(self, name: str) -> Any:
         if name.startswith("__") and name != "__repr__":
             raise AttributeError(name)
-        return self._request({"op": "getattr", "ref": self._ref, "name": name})
+        message = {"op": "getattr", "ref": self._ref, "name": name}
+        return self._request(message, f"{self._name}.{name}")
 
 
-def _wrap(sandbox: SandboxProcess, value: Any) -> Any:
+def _wrap(sandbox: SandboxProcess, value: Any, name: str) -> Any:
+    """Answers as they are, with references to the submission's objects as proxies."""
     if isinstance(value, wire.Ref):
-        return (RemoteIntegrator if value.kind == "integrator" else RemoteObject)(sandbox, value)
+        kind = RemoteIntegrator if value.kind == "integrator" else RemoteObject
+        return kind(sandbox, value, name)
     if isinstance(value, list):
-        return [_wrap(sandbox, v) for v in value]
+        return [_wrap(sandbox, v, name) for v in value]
     if isinstance(value, tuple):
-        return tuple(_wrap(sandbox, v) for v in value)
+        return tuple(_wrap(sandbox, v, name) for v in value)
     if isinstance(value, dict):
-        return {k: _wrap(sandbox, v) for k, v in value.items()}
+        return {k: _wrap(sandbox, v, name) for k, v in value.items()}
     return value
 
 
@@ -393,9 +413,8 @@ class RemoteTask:
         if name.startswith("__"):
             raise AttributeError(name)
         if self._module is None or self._module._generation != self._sandbox.generation:
-            self._module = _wrap(
-                self._sandbox, self._sandbox.request({"op": "task", "n": self._number})
-            )
+            answer = self._sandbox.request({"op": "task", "n": self._number})
+            self._module = _wrap(self._sandbox, answer, f"task{self._number}")
         return getattr(self._module, name)
 
     def __repr__(self) -> str:
@@ -412,6 +431,10 @@ class RemoteImplementation:
 
     def task(self, number: int) -> RemoteTask:
         return self._tasks.setdefault(number, RemoteTask(self.sandbox, number))
+
+    def forgive(self) -> None:
+        """A new check starts: functions that timed out may run again."""
+        self.sandbox.forgive()
 
     def close(self) -> None:
         self.sandbox.cleanup()
