@@ -377,7 +377,8 @@ class Body:
         start, springs = self.incident_springs()
         counts = start[particles + 1] - start[particles]
         first = np.repeat(start[particles] - (np.cumsum(counts) - counts), counts)
-        return np.unique(springs[first + np.arange(counts.sum())])
+        found = np.sort(springs[first + np.arange(counts.sum())])
+        return found[np.concatenate(([True], found[1:] != found[:-1]))] if len(found) else found
 
     def _dim_or_3(self) -> int:
         return self.dim or 3

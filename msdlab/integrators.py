@@ -107,6 +107,8 @@ class Verlet(Integrator):
 
     def dissipated_energy(self, v: np.ndarray, masses: np.ndarray) -> float:
         """Kinetic energy λ removes per step: (1 - (1 - λ)²)·½ Σ m v²."""
+        if self.damping == 0.0:
+            return 0.0
         kinetic = 0.5 * np.sum(masses * np.einsum("ij,ij->i", v, v))
         return float((1.0 - (1.0 - self.damping) ** 2) * kinetic)
 
