@@ -59,6 +59,7 @@ class Dynamics:
 
             self._compiled = CompiledKernels()
         self.max_stretch = 0.0  # largest |d|/l seen in the last force evaluation
+        self._pattern: kernels.JacobianPattern | None = None
 
     @property
     def masses(self) -> np.ndarray:
@@ -120,8 +121,13 @@ class Dynamics:
         return total[particles] * (free / self.body.masses[particles])[:, None]
 
     def jacobians(self, x: np.ndarray, v: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
-        """∂F/∂x and ∂F/∂v, sparse (N·d × N·d), for implicit integrators."""
-        jx, jv = kernels.spring_jacobians(self.body, x)
+        """∂F/∂x and ∂F/∂v, sparse (N·d × N·d), for implicit integrators.
+
+        The sparsity pattern of the springs is built once per topology and refilled.
+        """
+        if self._pattern is None or self._pattern.topology_version != self.body.topology_version:
+            self._pattern = kernels.JacobianPattern(self.body)
+        jx, jv = kernels.spring_jacobians(self.body, x, self._pattern)
         for force in self.forces:
             fx, fv = force.jacobians(self.body, x, v)
             jx = jx if fx is None else jx + fx
