@@ -9,7 +9,8 @@ the springs one by one and computes the same formula (eq. 1.2 plus the dashpot)
 adds f to particle a and -f to particle b (eq. 1.1), and keeps the largest
 stretch |d|/l on the way, with no temporary arrays. Large bodies split the
 springs between the threads, each summing into its own force buffer (no two
-threads write the same memory), and the buffers are then added per particle.
+threads write the same memory; the first one writes the result), and the
+buffers are then added per particle.
 
 The functions are compiled on first use and cached on disk (``cache=True``), so
 compiling is paid once per machine and numba version. Set the number of
@@ -24,6 +25,8 @@ from typing import TYPE_CHECKING
 import numba
 import numpy as np
 
+from .integrators import ExplicitEuler, SymplecticEuler, Verlet
+
 if TYPE_CHECKING:
     from .body import Body
 
@@ -35,10 +38,11 @@ PARALLEL_MIN_SPRINGS = 50_000
 def _add_spring_forces(x, v, a, b, k, rest, c, first, stop, out):
     """Add the forces of springs ``first`` to ``stop - 1`` to ``out`` (2-D or 3-D).
 
-    Returns the largest stretch |d|/l over those springs.
+    Returns the largest stretch |d|/l and the dashpot power (W) of those springs.
     """
     three = x.shape[1] == 3
     stretch = 0.0
+    power = 0.0
     for s in range(first, stop):
         i, j = a[s], b[s]
         d0 = x[i, 0] - x[j, 0]
@@ -55,6 +59,8 @@ def _add_spring_forces(x, v, a, b, k, rest, c, first, stop, out):
             if three:
                 closing += (v[i, 2] - v[j, 2]) * d2
             magnitude -= c[s] * closing / length
+            rate = closing / length
+            power += c[s] * rate * rate
         scale = magnitude / length
         out[i, 0] += scale * d0
         out[j, 0] -= scale * d0
@@ -63,33 +69,41 @@ def _add_spring_forces(x, v, a, b, k, rest, c, first, stop, out):
         if three:
             out[i, 2] += scale * d2
             out[j, 2] -= scale * d2
-    return stretch
+    return stretch, power
 
 
 @numba.njit(cache=True)
 def _spring_forces_serial(x, v, a, b, k, rest, c, out):
-    """One thread: add every spring's force to ``out``; return the largest stretch."""
+    """One thread: add every spring's force to ``out``; return (largest stretch, dashpot power)."""
     return _add_spring_forces(x, v, a, b, k, rest, c, 0, len(a), out)
 
 
 @numba.njit(cache=True, parallel=True)
 def _spring_forces_parallel(x, v, a, b, k, rest, c, partial, out):
-    """Threads: spring block t is summed into ``partial[t]``, then the blocks are added to out."""
-    blocks = partial.shape[0]
+    """Threads: spring block 0 is summed into ``out``, block t > 0 into ``partial[t - 1]``.
+
+    The partial buffers are then added to ``out`` particle by particle.
+    """
+    blocks = len(partial) + 1
     count = len(a)
     stretches = np.zeros(blocks)
+    powers = np.zeros(blocks)
     for t in numba.prange(blocks):
-        partial[t] = 0.0
         first, stop = t * count // blocks, (t + 1) * count // blocks
-        stretches[t] = _add_spring_forces(x, v, a, b, k, rest, c, first, stop, partial[t])
+        if t == 0:
+            sums = _add_spring_forces(x, v, a, b, k, rest, c, first, stop, out)
+        else:
+            partial[t - 1] = 0.0
+            sums = _add_spring_forces(x, v, a, b, k, rest, c, first, stop, partial[t - 1])
+        stretches[t], powers[t] = sums
     n, dim = out.shape
     for i in numba.prange(n):
         for q in range(dim):
             total = out[i, q]
-            for t in range(blocks):
+            for t in range(blocks - 1):
                 total += partial[t, i, q]
             out[i, q] = total
-    return stretches.max()
+    return stretches.max(), powers.sum()
 
 
 @numba.njit(cache=True, inline="always")
@@ -167,11 +181,44 @@ def _divide_by_masses(forces, masses, fixed):
             forces[i, q] *= inverse
 
 
+@numba.njit(cache=True)
+def _verlet_update(x, v, forces, masses, fixed, dt, dt2, lam, x_new, v_new):
+    """`Verlet.step` after the forces: a = F/m (0 if fixed), x_old = x - v dt,
+    x_new = (2 - λ) x - (1 - λ) x_old + a dt², v_new = (x_new - x)/dt; ``dt2`` is dt**2."""
+    for i in range(len(masses)):
+        inverse = 0.0 if fixed[i] else 1.0 / masses[i]
+        for q in range(x.shape[1]):
+            a = forces[i, q] * inverse
+            x_old = x[i, q] - v[i, q] * dt
+            x_new[i, q] = (2.0 - lam) * x[i, q] - (1.0 - lam) * x_old + a * dt2
+            v_new[i, q] = (x_new[i, q] - x[i, q]) / dt
+
+
+@numba.njit(cache=True)
+def _symplectic_euler_update(x, v, forces, masses, fixed, dt, x_new, v_new):
+    """`SymplecticEuler.step` after the forces: v_new = v + dt a, x_new = x + dt v_new."""
+    for i in range(len(masses)):
+        inverse = 0.0 if fixed[i] else 1.0 / masses[i]
+        for q in range(x.shape[1]):
+            v_new[i, q] = v[i, q] + dt * (forces[i, q] * inverse)
+            x_new[i, q] = x[i, q] + dt * v_new[i, q]
+
+
+@numba.njit(cache=True)
+def _explicit_euler_update(x, v, forces, masses, fixed, dt, x_new, v_new):
+    """`ExplicitEuler.step` after the forces: x_new = x + dt v, v_new = v + dt a."""
+    for i in range(len(masses)):
+        inverse = 0.0 if fixed[i] else 1.0 / masses[i]
+        for q in range(x.shape[1]):
+            x_new[i, q] = x[i, q] + dt * v[i, q]
+            v_new[i, q] = v[i, q] + dt * (forces[i, q] * inverse)
+
+
 class CompiledKernels:
     """The compiled kernels for one body, with what they need kept between calls.
 
     Keeps int32 copies of the spring ends (half the memory traffic of int64)
-    and one force buffer per thread, rebuilt when the springs change
+    and one force buffer per extra thread, rebuilt when the springs change
     (``body.topology_version``). Stiffness, rest lengths and dashpots are read
     from the body at every call, so edits to them count at once. ``springs``
     (indices) restricts a computation to some springs, on one thread.
@@ -181,6 +228,7 @@ class CompiledKernels:
         self._version = -1
         self._a = self._b = np.zeros(0, dtype=np.int32)
         self._partial: np.ndarray | None = None
+        self._new: tuple[np.ndarray, np.ndarray] | None = None
 
     def add_spring_forces(
         self,
@@ -189,8 +237,11 @@ class CompiledKernels:
         v: np.ndarray,
         out: np.ndarray,
         springs: np.ndarray | None = None,
-    ) -> float:
-        """Add the spring and dashpot forces (N) to ``out`` (N, d); return the largest |d|/l."""
+    ) -> tuple[float, float]:
+        """Add the spring and dashpot forces (N) to ``out`` (N, d).
+
+        Returns the largest stretch |d|/l and the power (W) the dashpots take.
+        """
         a, b = self._ends(body)
         arrays = (a, b, body.stiffness, body.rest_lengths, body.spring_damping)
         if springs is not None:
@@ -204,7 +255,7 @@ class CompiledKernels:
         a, b = self._ends(body)
         if self._partial is None:
             return _dashpot_power_serial(x, v, a, b, body.spring_damping)
-        return _dashpot_power_parallel(x, v, a, b, body.spring_damping, len(self._partial))
+        return _dashpot_power_parallel(x, v, a, b, body.spring_damping, len(self._partial) + 1)
 
     def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
         """Energy (J) stored in the springs (or in the given ones) at positions x."""
@@ -214,7 +265,39 @@ class CompiledKernels:
             return _elastic_energy_serial(x, *(array[springs] for array in arrays))
         if self._partial is None:
             return _elastic_energy_serial(x, *arrays)
-        return _elastic_energy_parallel(x, *arrays, len(self._partial))
+        return _elastic_energy_parallel(x, *arrays, len(self._partial) + 1)
+
+    @staticmethod
+    def has_update(integrator: object) -> bool:
+        """True for exactly `Verlet`, `SymplecticEuler`, `ExplicitEuler` (a subclass may
+        change `step`)."""
+        return type(integrator) in (Verlet, SymplecticEuler, ExplicitEuler)
+
+    def update(
+        self,
+        body: Body,
+        integrator: Verlet | SymplecticEuler | ExplicitEuler,
+        x: np.ndarray,
+        v: np.ndarray,
+        forces: np.ndarray,
+        dt: float,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The new (x, v) of ``integrator.step`` given the forces at (x, v).
+
+        The arrays returned are buffers reused by the next call.
+        """
+        kind = type(integrator)
+        if self._new is None or self._new[0].shape != x.shape:
+            self._new = (np.empty_like(x), np.empty_like(x))
+        x_new, v_new = self._new
+        args = (x, v, forces, body.masses, body.fixed, dt)
+        if kind is Verlet:
+            _verlet_update(*args, dt**2, integrator.damping, x_new, v_new)
+        elif kind is SymplecticEuler:
+            _symplectic_euler_update(*args, x_new, v_new)
+        else:
+            _explicit_euler_update(*args, x_new, v_new)
+        return x_new, v_new
 
     @staticmethod
     def divide_by_masses(body: Body, forces: np.ndarray) -> None:
@@ -229,6 +312,7 @@ class CompiledKernels:
             self._b = body.spring_b.astype(index)
             threads = numba.get_num_threads()
             parallel = body.n_springs >= PARALLEL_MIN_SPRINGS and threads > 1
-            self._partial = np.empty((threads, *body.positions.shape)) if parallel else None
+            shape = (threads - 1, *body.positions.shape)
+            self._partial = np.empty(shape) if parallel else None
             self._version = body.topology_version
         return self._a, self._b

@@ -60,6 +60,7 @@ class Dynamics:
             self._compiled = CompiledKernels()
         self.max_stretch = 0.0  # largest |d|/l seen in the last force evaluation
         self._pattern: kernels.JacobianPattern | None = None
+        self._forces: np.ndarray | None = None  # force buffer of `compiled_step`
 
     @property
     def masses(self) -> np.ndarray:
@@ -77,7 +78,7 @@ class Dynamics:
         if self._compiled is None:
             _, self.max_stretch = kernels.spring_forces(self.body, x, v, out=total)
         else:
-            self.max_stretch = self._compiled.add_spring_forces(self.body, x, v, total)
+            self.max_stretch, _ = self._compiled.add_spring_forces(self.body, x, v, total)
         for force in self.forces:
             force.add_to(self.body, x, v, total)
         return total
@@ -90,6 +91,28 @@ class Dynamics:
             return total
         inverse_mass = np.where(self.body.fixed, 0.0, 1.0 / self.body.masses)
         return self.force(x, v) * inverse_mass[:, None]
+
+    def compiled_step(
+        self, integrator: object, x: np.ndarray, v: np.ndarray, dt: float
+    ) -> tuple[np.ndarray, np.ndarray, float] | None:
+        """``integrator.step(x, v, dt, self)`` in compiled passes, or None if there is none.
+
+        There is one for exactly `Verlet`, `SymplecticEuler` and `ExplicitEuler`
+        with the "numba" kernel: the spring kernel, the forces, then one loop
+        over the particles doing what the class's `step` does. Returns the new
+        x and v (buffers reused at the next call) and the dashpot power (W) at (x, v).
+        """
+        if self._compiled is None or not self._compiled.has_update(integrator):
+            return None
+        if self._forces is None or self._forces.shape != x.shape:
+            self._forces = np.empty_like(x)
+        total = self._forces
+        total.fill(0.0)
+        self.max_stretch, power = self._compiled.add_spring_forces(self.body, x, v, total)
+        for force in self.forces:
+            force.add_to(self.body, x, v, total)
+        x_new, v_new = self._compiled.update(self.body, integrator, x, v, total, dt)
+        return x_new, v_new, power
 
     def dashpot_power(self, x: np.ndarray, v: np.ndarray) -> float:
         """Power (W) the spring dashpots take out of the body at (x, v), Σ c ((v_a - v_b)·n)²."""

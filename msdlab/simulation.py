@@ -115,11 +115,16 @@ class Simulation:
         """Advance the body by one step of ``dt``."""
         body, dt = self.body, self.dt
         x, v = body.positions, body.velocities
+        integrated = self.dynamics.compiled_step(self.integrator, x, v, dt)
+        if integrated is None:
+            power = self.dynamics.dashpot_power(x, v)
+            x_new, v_new = self._checked(self.integrator.step(x, v, dt, self.dynamics), x)
+        else:
+            x_new, v_new, power = integrated
         booked = {
-            "dashpot": self.dynamics.dashpot_power(x, v) * dt,
+            "dashpot": power * dt,
             "integrator": self.integrator.dissipated_energy(v, body.masses),
         }
-        x_new, v_new = self._checked(self.integrator.step(x, v, dt, self.dynamics), x)
         fixed = body.fixed
         if fixed.any():
             x_new[fixed] = x[fixed]

@@ -49,11 +49,12 @@ def test_forces_match_numpy_kernel_and_spring_objects(dim: int) -> None:
     x, v = body.positions, body.velocities
     expected, stretch = kernels.spring_forces(body, x, v)
     fast = np.zeros_like(x)
-    fast_stretch = compiled.CompiledKernels().add_spring_forces(body, x, v, fast)
+    fast_stretch, power = compiled.CompiledKernels().add_spring_forces(body, x, v, fast)
     scale = np.abs(expected).max()
     assert_close(fast, expected, scale)
     assert_close(per_spring_forces(body), expected, scale)
     assert fast_stretch == pytest.approx(stretch, rel=RTOL)
+    assert power == pytest.approx(kernels.dashpot_power(body, x, v), rel=RTOL)
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -68,17 +69,18 @@ def test_threaded_blocks_match_one_thread(dim: int) -> None:
         body.spring_damping,
     )
     serial, threaded = np.zeros_like(x), np.ones_like(x)
-    stretch = compiled._spring_forces_serial(x, v, *arrays, serial)
-    partial = np.empty((3, *x.shape))  # more blocks than threads is allowed
-    threaded_stretch = compiled._spring_forces_parallel(x, v, *arrays, partial, threaded)
+    stretch, power = compiled._spring_forces_serial(x, v, *arrays, serial)
+    partial = np.empty((3, *x.shape))  # four blocks: more blocks than threads is allowed
+    threaded_sums = compiled._spring_forces_parallel(x, v, *arrays, partial, threaded)
     assert_close(threaded - 1.0, serial, np.abs(serial).max())
-    assert threaded_stretch == stretch
+    assert threaded_sums[0] == stretch
+    assert threaded_sums[1] == pytest.approx(power, rel=RTOL)
     power = compiled._dashpot_power_serial(x, v, *arrays[:2], arrays[4])
-    assert compiled._dashpot_power_parallel(x, v, *arrays[:2], arrays[4], 3) == pytest.approx(
+    assert compiled._dashpot_power_parallel(x, v, *arrays[:2], arrays[4], 4) == pytest.approx(
         power, rel=RTOL
     )
     energy = compiled._elastic_energy_serial(x, *arrays[:4])
-    assert compiled._elastic_energy_parallel(x, *arrays[:4], 3) == pytest.approx(energy, rel=RTOL)
+    assert compiled._elastic_energy_parallel(x, *arrays[:4], 4) == pytest.approx(energy, rel=RTOL)
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -113,7 +115,55 @@ def test_accelerations_match_including_subsets(dim: int) -> None:
     )
 
 
+class SlowVerlet(msd.Verlet):
+    """A subclass may change `step`, so it never gets the compiled update."""
+
+    def step(
+        self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: Dynamics
+    ) -> tuple[np.ndarray, np.ndarray]:
+        x_new, v_new = super().step(x, v, dt, dynamics)
+        return x_new + 1.0, v_new
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize(
+    "integrator",
+    [msd.Verlet(), msd.Verlet(damping=0.05), msd.SymplecticEuler(), msd.ExplicitEuler()],
+    ids=repr,
+)
+def test_compiled_update_is_the_readable_step(dim: int, integrator: msd.Integrator) -> None:
+    """The fused compiled update computes exactly what the integrator class's `step` says."""
+    body = deformed_body(dim, seed=6)
+    x, v = body.positions, body.velocities
+    forces = [msd.Gravity((0.0, -9.81, 0.0)[:dim])]
+    fast = Dynamics(body, forces, kernel="numba")
+    x_new, v_new, power = fast.compiled_step(integrator, x, v, 1e-3)
+    for kernel in ("numba", "numpy"):
+        readable = Dynamics(body, forces, kernel=kernel)
+        x_ref, v_ref = integrator.step(x, v, 1e-3, readable)
+        assert_close(x_new, x_ref, np.abs(x_ref).max())
+        assert_close(v_new, v_ref, np.abs(v_ref).max())
+        assert fast.max_stretch == pytest.approx(readable.max_stretch, rel=RTOL)
+    x_ref, v_ref = integrator.step(x, v, 1e-3, Dynamics(body, forces, kernel="numba"))
+    np.testing.assert_array_equal(x_new, x_ref)  # same kernel: the same bits
+    np.testing.assert_array_equal(v_new, v_ref)
+    assert power == pytest.approx(kernels.dashpot_power(body, x, v), rel=RTOL)
+
+
+def test_no_compiled_update_for_other_integrators() -> None:
+    body = deformed_body(2)
+    dynamics = Dynamics(body, kernel="numba")
+    x, v = body.positions, body.velocities
+    for integrator in (SlowVerlet(), msd.VelocityVerlet(), msd.RK4(), msd.ImplicitEuler()):
+        assert dynamics.compiled_step(integrator, x, v, 1e-3) is None
+    assert Dynamics(body, kernel="numpy").compiled_step(msd.Verlet(), x, v, 1e-3) is None
+    start = body.positions.copy()
+    msd.Simulation(body, SlowVerlet(), dt=1e-3, kernel="numba").step()
+    assert np.all(body.positions[~body.fixed] > start[~body.fixed] + 0.5)  # its own step ran
+
+
 INTEGRATORS = [
+    msd.ExplicitEuler(),
     msd.Verlet(),
     msd.Verlet(damping=0.05),
     msd.SymplecticEuler(),
