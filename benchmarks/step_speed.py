@@ -25,6 +25,10 @@ build s is the time of `Body.grid`.
     python benchmarks/step_speed.py                 # n = 20, 40, 60, 100
     python benchmarks/step_speed.py --n 20 40 --repeats 5
     python benchmarks/step_speed.py --skip-100      # without the 1 M particle grid
+
+It ends with the ImplicitEuler step on a 20³ grid and 10 000 steps of a small
+2-D body, in the air and resting on the ground (where the ground's energy
+bookkeeping runs every step).
 """
 
 from __future__ import annotations
@@ -162,6 +166,37 @@ def compile_seconds() -> float:
     return time.perf_counter() - start
 
 
+def small_body_seconds(kernel: str, resting: bool, steps: int = 10_000) -> float:
+    """Seconds for ``steps`` steps of a 2-D gallery body: 20×15 particles, (1, 2) springs
+    with dashpots, 3 fixed, gravity, ground, drag; in the air or resting on the ground."""
+    body = msd.Body.grid(
+        (20, 15), spacing=0.1, stiffness=50.0, neighbours=(1, 2), origin=(0, 0.5 if resting else 50)
+    )
+    body.fixed[:3] = True
+    body.spring_damping[:] = 0.05
+    forces = [msd.Gravity((0, -9.81)), msd.Ground(), msd.Drag(0.1)]
+    sim = msd.Simulation(body, msd.Verlet(0.01), dt=1e-3, forces=forces, kernel=kernel)
+    sim.run(steps=500)  # warm up, and land when resting
+    start = time.perf_counter()
+    for _ in range(steps):
+        sim.step()
+    return time.perf_counter() - start
+
+
+def implicit_ms(n: int = 20, repeats: int = 5) -> float:
+    """Median ms per `ImplicitEuler` step on an n³ grid with (1, 2, 3) (dt = 10 ms)."""
+    body = make_grid(n)[0]
+    forces = [msd.Gravity(GRAVITY), msd.Ground()]
+    sim = msd.Simulation(body, msd.ImplicitEuler(), dt=1e-2, forces=forces)
+    sim.step()
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        sim.step()
+        times.append(time.perf_counter() - start)
+    return 1e3 * float(np.median(times))
+
+
 def child(arguments: list[str], env: dict | None = None) -> dict:
     """Run this script in a fresh process and return the JSON it prints."""
     command = [sys.executable, os.path.abspath(__file__), "--child", *arguments]
@@ -212,10 +247,19 @@ def main() -> None:
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--implementation", help=argparse.SUPPRESS)
     parser.add_argument("--compile", action="store_true", help=argparse.SUPPRESS)
+    parser.add_argument("--small", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
         if args.compile:
             print(json.dumps({"seconds": compile_seconds()}))
+        elif args.small:
+            rows = {
+                f"{kernel}, {where}": small_body_seconds(kernel, where == "resting on the ground")
+                for kernel in ("numba", "numpy")
+                for where in ("in the air", "resting on the ground")
+            }
+            rows["implicit"] = implicit_ms()
+            print(json.dumps(rows))
         else:
             print(json.dumps(measure(args.implementation, args.n[0], args.repeats, args.warmup)))
         return
@@ -239,6 +283,12 @@ def main() -> None:
             print(f"  measured {implementation} n={n}", file=sys.stderr)
     print(table(rows))
     print("~: Spring.force loop timed on a sample of springs and scaled to all of them.")
+    small = child(["--small"])
+    print(f"ImplicitEuler, 20³ grid with (1, 2, 3): {small.pop('implicit'):.0f} ms per step")
+    print("10 000 steps of a 2-D body (300 particles, 1 097 springs with dashpots, 3 fixed,")
+    print("gravity, ground, drag, Verlet λ = 0.01), seconds:")
+    for name, seconds in small.items():
+        print(f"  {name}: {seconds:.2f} s ({100 * seconds:.0f} µs per step)")
 
 
 if __name__ == "__main__":
