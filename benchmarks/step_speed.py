@@ -217,7 +217,8 @@ def machine() -> str:
     return (
         f"CPU {cpu}, {os.cpu_count()} cores, numba threads {numba.get_num_threads()}; "
         f"Python {platform.python_version()}, numpy {np.__version__}, scipy {scipy.__version__}, "
-        f"numba {numba.__version__}, msdlab {msd.__version__}, {platform.system()}"
+        f"numba {numba.__version__}, msdlab {msd.__version__}, {platform.system()}; "
+        f"load average {os.getloadavg()[0]:.2f} (other programs running slow the timings)"
     )
 
 
@@ -282,6 +283,7 @@ def main() -> None:
             rows.append(child(arguments))
             print(f"  measured {implementation} n={n}", file=sys.stderr)
     print(table(rows))
+    print(f"load average at the end: {os.getloadavg()[0]:.2f}")
     print("~: Spring.force loop timed on a sample of springs and scaled to all of them.")
     small = child(["--small"])
     print(f"ImplicitEuler, 20³ grid with (1, 2, 3): {small.pop('implicit'):.0f} ms per step")

@@ -210,8 +210,8 @@ class Body:
     ) -> np.ndarray:
         """Add springs between index pairs (E, 2); rest lengths default to current distances."""
         pairs = np.asarray(pairs)
-        if pairs.size == 0:
-            pairs = pairs.reshape(0, 2)
+        if pairs.size == 0:  # also () and [], which numpy makes float
+            pairs = pairs.reshape(0, 2).astype(np.int64)
         if pairs.ndim != 2 or pairs.shape[1] != 2:
             raise ValueError(f"spring pairs must have shape (E, 2), got shape {pairs.shape}")
         if not np.issubdtype(pairs.dtype, np.integer):

@@ -221,3 +221,12 @@ def test_kernel_follows_topology_and_parameter_changes() -> None:
     x, v = body.positions, body.velocities
     expected, _ = kernels.spring_forces(body, x, v)
     assert_close(dynamics.force(x, v), expected, np.abs(expected).max())
+
+
+@pytest.mark.parametrize("kernel", ["numba", "numpy"])
+def test_bodies_without_springs(kernel: str) -> None:
+    body = msd.Body.from_arrays([[0.0, 1.0], [1.0, 2.0]], velocities=[[1.0, 0.0], [0.0, 0.0]])
+    sim = msd.Simulation(body, msd.Verlet(), dt=0.1, forces=[msd.Gravity((0, -1.0))], kernel=kernel)
+    sim.step()
+    np.testing.assert_allclose(body.positions, [[0.1, 0.99], [1.0, 1.99]], rtol=1e-14)
+    assert sim.dynamics.elastic_energy(body.positions) == 0.0
