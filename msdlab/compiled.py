@@ -1,4 +1,4 @@
-"""Compiled (numba) spring kernel: the physics of `kernels.spring_forces` in one pass.
+"""Compiled (numba) kernels: the physics of `kernels.spring_forces` in one pass, and more.
 
 `kernels.spring_forces` is the readable numpy version: it builds (E, d) arrays
 of spring vectors and forces, then sums them per particle. The loop here takes
@@ -10,7 +10,10 @@ adds f to particle a and -f to particle b (eq. 1.1), and keeps the largest
 stretch |d|/l on the way, with no temporary arrays. Large bodies split the
 springs between the threads, each summing into its own force buffer (no two
 threads write the same memory; the first one writes the result), and the
-buffers are then added per particle.
+buffers are then added per particle. Dashpot power and elastic energy are
+compiled the same way, and so are the updates of `Verlet`, `SymplecticEuler`
+and `ExplicitEuler` after the forces, each one loop over the particles with the
+operations of the class's `step` in the same order.
 
 The functions are compiled on first use and cached on disk (``cache=True``), so
 compiling is paid once per machine and numba version. Set the number of
