@@ -9,7 +9,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import kernels
 from .body import Body
 from .constraints import Constraint, StepState
 from .dynamics import Dynamics
@@ -45,6 +44,7 @@ class Simulation:
     integrator step. Each step pins the fixed particles, keeps an energy
     ledger, and raises `SimulationDiverged` in the step where the state stops
     being finite or a spring is stretched past ``max_stretch`` times its rest length.
+    ``kernel`` picks the spring kernel, "numba" or "numpy" (see `Dynamics`).
     """
 
     def __init__(
@@ -55,6 +55,7 @@ class Simulation:
         forces: Sequence[Force | Constraint] = (),
         *,
         max_stretch: float | None = 100.0,
+        kernel: str | None = None,
     ) -> None:
         if not isinstance(body, Body):
             raise TypeError(f"Simulation needs a msdlab.Body, got {type(body).__name__}")
@@ -89,7 +90,7 @@ class Simulation:
                     "nor a msdlab.Constraint (Ground, Drag, Walls, ...)"
                 )
             item.check(body)
-        self.dynamics = Dynamics(body, field_forces)
+        self.dynamics = Dynamics(body, field_forces, kernel=kernel)
         self.time = 0.0
         self.step_count = 0
         self.dissipated: dict[str, float] = defaultdict(float)
@@ -114,15 +115,20 @@ class Simulation:
         """Advance the body by one step of ``dt``."""
         body, dt = self.body, self.dt
         x, v = body.positions, body.velocities
+        integrated = self.dynamics.compiled_step(self.integrator, x, v, dt)
+        if integrated is None:
+            power = self.dynamics.dashpot_power(x, v)
+            x_new, v_new = self._checked(self.integrator.step(x, v, dt, self.dynamics), x)
+        else:
+            x_new, v_new, power = integrated
         booked = {
-            "dashpot": kernels.dashpot_power(body, x, v) * dt,
+            "dashpot": power * dt,
             "integrator": self.integrator.dissipated_energy(v, body.masses),
         }
         for force in self.forces:
-            power = force.dissipated_power(body, x, v)
-            if power:
-                booked[force.ledger_name] = booked.get(force.ledger_name, 0.0) + power * dt
-        x_new, v_new = self._checked(self.integrator.step(x, v, dt, self.dynamics), x)
+            lost = force.dissipated_power(body, x, v)
+            if lost:
+                booked[force.ledger_name] = booked.get(force.ledger_name, 0.0) + lost * dt
         fixed = body.fixed
         if fixed.any():
             x_new[fixed] = x[fixed]
@@ -171,7 +177,7 @@ class Simulation:
                 self.step_count,
                 self.time,
                 kinetic_energy(self.body, v),
-                kernels.elastic_energy(self.body, x),
+                self.dynamics.elastic_energy(x),
                 sum(f.potential_energy(self.body, x) for f in self.forces),
                 {k: e - start.get(k, 0.0) for k, e in self.dissipated.items()},
             )
@@ -228,14 +234,17 @@ class Simulation:
         energy plus the elastic energy of the springs touching them. The kinetic
         part uses the velocity at the time of x (see `Integrator.velocity_at_positions`)."""
         body, dynamics, integrator = self.body, self.dynamics, self.integrator
+        last: list = [None, None]  # constraints ask before and after a change: find springs once
 
         def energy(particles: np.ndarray) -> float:
-            a = dynamics.acceleration_of(particles, x, v)
+            if last[0] is not particles:
+                last[:] = particles, body.springs_touching(particles)
+            touching = last[1]
+            a = dynamics.acceleration_of(particles, x, v, touching)
             u = integrator.velocity_at_positions(v[particles], a, self.dt)
             kinetic = 0.5 * np.sum(body.masses[particles] * np.einsum("ij,ij->i", u, u))
             potential = sum(f.potential_energy(body, x, particles) for f in self.forces)
-            touching = body.springs_touching(particles)
-            return float(kinetic + potential + kernels.elastic_energy(body, x, touching))
+            return float(kinetic + potential + dynamics.elastic_energy(x, touching))
 
         return energy
 
