@@ -42,6 +42,7 @@ from . import wire
 CHILD = Path(__file__).with_name("sandbox_child.py")
 PACKAGE = Path(__file__).resolve().parents[1]
 CALLBACK_NAMES = frozenset({"acceleration", "force", "masses", "free"})
+STARTUP_SECONDS = 60.0  # the interpreter and numpy/scipy must load, even on a busy machine
 
 
 def course_secrets(*roots: Path) -> list[Path]:
@@ -97,7 +98,7 @@ class SandboxProcess:
         self.scratch.chmod(0o755)
         self.exports: dict[int, Any] = {}
         self.members: dict[tuple[int, str], wire.Ref] = {}
-        self.timed_out: dict[str, str] = {}  # name -> message, until `forgive` (next check)
+        self.broken: dict[str, SandboxError] = {}  # name -> its failure, until `forgive`
 
     @property
     def isolation(self) -> str:
@@ -112,13 +113,13 @@ class SandboxProcess:
         the strong one cannot start (e.g. the interpreter is not readable by the sandbox user)."""
         self._launch()
         try:
-            self.request({"op": "ping"})
+            self.request({"op": "ping"}, timeout=STARTUP_SECONDS)
         except SandboxError:
             if not self.strong:
                 raise SandboxError(f"cannot start the grading sandbox: {self.log_tail()}") from None
             self.strong = False
             self._launch()
-            self.request({"op": "ping"})
+            self.request({"op": "ping"}, timeout=STARTUP_SECONDS)
 
     def log_tail(self, limit: int = 2000) -> str:
         """The end of what the submission printed (its stdout and stderr)."""
@@ -213,41 +214,52 @@ class SandboxProcess:
 
     # ------------------------------------------------------------ requests
     def forgive(self) -> None:
-        """Let functions that timed out run again (called before each check)."""
-        self.timed_out.clear()
+        """Let functions that timed out or crashed run again (called before each check)."""
+        self.broken.clear()
 
-    def request(self, message: dict, generation: int | None = None, name: str = "") -> Any:
+    def request(
+        self,
+        message: dict,
+        generation: int | None = None,
+        name: str = "",
+        timeout: float | None = None,
+    ) -> Any:
         """Send ``message`` and return the child's answer, serving its callbacks meanwhile.
 
-        A call of ``name`` that timed out is not run again until `forgive`: it fails
-        at once with the same message, so one endless function costs one time limit.
+        The answer must come within ``timeout`` (default: the call time limit). A
+        call of ``name`` that timed out or killed the process is not run again until
+        `forgive`: it fails at once the same way, so one endless or crashing function
+        costs one time limit or one restart per check, however often the check calls it.
         """
-        if name in self.timed_out:
-            raise SubmissionTimeout(self.timed_out[name] + " (not run again in this check)")
+        if name in self.broken:
+            error = self.broken[name]
+            raise type(error)(f"{name}: {error} (not run again in this check)")
         if generation is not None and generation != self.generation:
             raise SubmissionCrashed(
                 "this object was lost when the submission's process was restarted after a failure"
             )
         if self.process is None:
             self.start()
-        deadline = time.monotonic() + self.timeout
+        limit = self.timeout if timeout is None else timeout
+        deadline = time.monotonic() + limit
         try:
             wire.write_all(self._send_fd, wire.encode(message, self._export))
             while True:
-                reply = self._receive(deadline)
+                reply = self._receive(deadline, limit)
                 if isinstance(reply, dict) and "op" in reply:
                     wire.write_all(self._send_fd, wire.encode(self._serve(reply)))
                     continue
                 break
         except SubmissionTimeout as error:
             self.close()
-            if name:
-                self.timed_out[name] = f"{name}: {error}"
+            self._remember(name, error)
             raise
         except (EOFError, BrokenPipeError, wire.WireError, ValueError, KeyError) as error:
             reason = self._death_reason() or f"the channel broke ({error})"
             self.close()
-            raise SubmissionCrashed(f"the submission's process {reason}") from None
+            crash = SubmissionCrashed(f"the submission's process {reason}")
+            self._remember(name, crash)
+            raise crash from None
         if not isinstance(reply, dict) or not ("ok" in reply or "error" in reply):
             self.close()
             raise SubmissionCrashed("the submission's process sent a malformed answer")
@@ -255,7 +267,11 @@ class SandboxProcess:
             _raise(reply["error"])
         return reply["ok"]
 
-    def _receive(self, deadline: float) -> Any:
+    def _remember(self, name: str, error: SandboxError) -> None:
+        if name:
+            self.broken[name] = error
+
+    def _receive(self, deadline: float, limit: float) -> Any:
         def read(size: int) -> bytes:
             chunks, left = [], size
             while left:
@@ -263,7 +279,7 @@ class SandboxProcess:
                 ready, _, _ = select.select([self._recv_fd], [], [], max(remaining, 0))
                 if not ready:
                     raise SubmissionTimeout(
-                        f"the submission did not answer within {self.timeout:g} s "
+                        f"the submission did not answer within {limit:g} s "
                         "(an endless loop, or far too much work?)"
                     )
                 chunk = os.read(self._recv_fd, min(left, 1 << 20))
