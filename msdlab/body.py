@@ -10,7 +10,7 @@ from typing import Generic, TypeVar
 import numpy as np
 
 from .errors import as_vectors, check_non_negative, check_positive
-from .lattice import grid_pairs, grid_positions, neighbour_offsets
+from .lattice import grid_pair_blocks, grid_pair_count, grid_positions, neighbour_offsets
 from .particle import Particle
 from .spring import Spring
 
@@ -210,13 +210,13 @@ class Body:
     ) -> np.ndarray:
         """Add springs between index pairs (E, 2); rest lengths default to current distances."""
         pairs = np.asarray(pairs)
-        if pairs.size == 0:
-            pairs = np.zeros((0, 2), dtype=np.int64)
+        if pairs.size == 0:  # also () and [], which numpy makes float
+            pairs = pairs.reshape(0, 2).astype(np.int64)
         if pairs.ndim != 2 or pairs.shape[1] != 2:
             raise ValueError(f"spring pairs must have shape (E, 2), got shape {pairs.shape}")
         if not np.issubdtype(pairs.dtype, np.integer):
             raise TypeError(f"spring ends must be integer particle indices, got {pairs.dtype}")
-        pairs = pairs.astype(np.int64)
+        pairs = pairs.astype(np.int64, copy=False)
         bad = np.flatnonzero(np.any((pairs < 0) | (pairs >= self._n), axis=1))
         if len(bad):
             a, b = pairs[bad[0]]
@@ -308,16 +308,12 @@ class Body:
         if origin.shape != (len(shape),):
             raise ValueError(f"origin must have {len(shape)} coordinates, got {origin.tolist()}")
         offsets = neighbour_offsets(len(shape), neighbours)
-        pairs, kinds = grid_pairs(shape, offsets)
-        rest = spacing * np.sqrt((offsets**2).sum(axis=1).astype(float))[kinds]
-        body = cls.from_arrays(
-            grid_positions(shape, spacing, origin),
-            pairs,
-            masses=mass,
-            stiffness=stiffness,
-            rest_lengths=rest,
-            damping=damping,
-        )
+        body = cls()
+        body.add_particles(grid_positions(shape, spacing, origin), masses=mass)
+        body._reserve_springs(grid_pair_count(shape, offsets))  # exactly: no regrowth
+        for offset, pairs in zip(offsets, grid_pair_blocks(shape, offsets)):
+            rest = spacing * math.sqrt(float(offset @ offset))
+            body.add_springs(pairs, stiffness, rest, damping)
         body.grid_shape = shape
         return body
 
@@ -377,7 +373,8 @@ class Body:
         start, springs = self.incident_springs()
         counts = start[particles + 1] - start[particles]
         first = np.repeat(start[particles] - (np.cumsum(counts) - counts), counts)
-        return np.unique(springs[first + np.arange(counts.sum())])
+        found = np.sort(springs[first + np.arange(counts.sum())])
+        return found[np.concatenate(([True], found[1:] != found[:-1]))] if len(found) else found
 
     def _dim_or_3(self) -> int:
         return self.dim or 3

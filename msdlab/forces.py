@@ -59,7 +59,9 @@ class Gravity(Force):
         _check_dim("Gravity g", self.g, body)
 
     def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-        out += body.masses[:, None] * self.g
+        for axis, g in enumerate(self.g):  # per axis: much faster than broadcasting m[:, None] * g
+            if g != 0.0:
+                out[:, axis] += g * body.masses
 
     def potential_energy(
         self, body: Body, x: np.ndarray, particles: np.ndarray | None = None

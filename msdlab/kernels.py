@@ -72,7 +72,48 @@ def dashpot_power(body: Body, x: np.ndarray, v: np.ndarray) -> float:
     return float(np.sum(body.spring_damping * rate**2))
 
 
-def spring_jacobians(body: Body, x: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+class JacobianPattern:
+    """Sparsity of the spring Jacobians (N·d × N·d, CSR), built once per topology.
+
+    Holds the rows and columns of every (a, a), (b, b), (a, b), (b, a) block and
+    of the whole diagonal, sorted and merged once, and a sparse map ``assemble``
+    that sums the per-spring blocks (E·d·d values) into the CSR ``data``, -B on
+    (a, a) and (b, b), +B on (a, b) and (b, a): refilling is one sparse product.
+    """
+
+    def __init__(self, body: Body) -> None:
+        dim = body.dim or 3
+        n_dof = body.n_particles * dim
+        rows, cols = _block_indices(body.spring_a, body.spring_b, dim)
+        diagonal = np.arange(n_dof, dtype=np.int64)
+        keys = np.concatenate([rows * n_dof + cols, diagonal * (n_dof + 1)])
+        unique, inverse = np.unique(keys, return_inverse=True)
+        self.topology_version = body.topology_version
+        self.shape = (n_dof, n_dof)
+        index = np.int32 if len(unique) < 2**31 else np.int64  # what scipy would convert to
+        self.indices = (unique % max(n_dof, 1)).astype(index)
+        self.indptr = np.zeros(n_dof + 1, dtype=index)
+        np.cumsum(np.bincount(unique // max(n_dof, 1), minlength=n_dof), out=self.indptr[1:])
+        block_entries = body.n_springs * dim * dim
+        signs = np.repeat([-1.0, -1.0, 1.0, 1.0], block_entries)
+        entry = np.tile(np.arange(block_entries), 4)
+        self.assemble = sp.csr_matrix(
+            (signs, (inverse[: len(rows)], entry)), shape=(len(unique), block_entries)
+        )
+
+    def matrices(self, *blocks: np.ndarray) -> list[sp.csr_matrix]:
+        """One CSR matrix per array of spring blocks (E, d, d), on this pattern."""
+        values = np.stack([block.ravel() for block in blocks], axis=1)
+        data = self.assemble @ values
+        return [
+            sp.csr_matrix((data[:, i], self.indices, self.indptr), shape=self.shape, copy=False)
+            for i in range(len(blocks))
+        ]
+
+
+def spring_jacobians(
+    body: Body, x: np.ndarray, pattern: JacobianPattern | None = None
+) -> tuple[sp.csr_matrix, sp.csr_matrix]:
     """∂F/∂x and ∂F/∂v (N·d × N·d, sparse) of the spring and dashpot forces.
 
     Per spring with n = d/|d|, the stiffness block is
@@ -80,8 +121,9 @@ def spring_jacobians(body: Body, x: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_m
     for compressed springs, as Baraff & Witkin do, so -∂F/∂x stays positive
     semi-definite) and the dashpot block is C = c n nᵀ. Both enter as
     -B on the (a, a) and (b, b) blocks and +B on (a, b) and (b, a).
+    ``pattern`` reuses the sparsity of an earlier call on the same springs.
     """
-    n_dof = x.size
+    pattern = JacobianPattern(body) if pattern is None else pattern
     dim = x.shape[1]
     d, length = spring_vectors(body, x)
     safe = np.where(length > 0, length, np.inf)
@@ -91,11 +133,7 @@ def spring_jacobians(body: Body, x: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_m
     eye = np.eye(dim)[None]
     stiff = body.stiffness[:, None, None] * (outer + transverse[:, None, None] * (eye - outer))
     damp = body.spring_damping[:, None, None] * outer
-    rows, cols = _block_indices(body.spring_a, body.spring_b, dim)
-    shape = (n_dof, n_dof)
-    signs = np.array([-1.0, -1.0, 1.0, 1.0])[:, None, None, None]
-    jx = sp.csr_matrix(((signs * stiff[None]).ravel(), (rows, cols)), shape=shape)
-    jv = sp.csr_matrix(((signs * damp[None]).ravel(), (rows, cols)), shape=shape)
+    jx, jv = pattern.matrices(stiff, damp)
     return jx, jv
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 
 import numpy as np
 
@@ -52,21 +52,36 @@ def grid_positions(shape: Sequence[int], spacing: float, origin: Sequence[float]
     return np.asarray(origin, dtype=float) + spacing * coords
 
 
-def grid_pairs(shape: Sequence[int], offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Particle index pairs (E, 2) joined by ``offsets``, and each pair's offset index (E,).
+def grid_pair_blocks(shape: Sequence[int], offsets: np.ndarray) -> Iterator[np.ndarray]:
+    """For each offset, the particle index pairs (E_o, 2) it joins, one block at a time.
 
     Particle (i, j, k) has index ``np.ravel_multi_index((i, j, k), shape)``; a pair
     (p, q) has q at p's grid coordinates plus the offset. Border particles get
-    only the neighbours that exist.
+    only the neighbours that exist, so an offset o makes Π max(0, n - |o|) pairs.
     """
     index = np.arange(math.prod(shape), dtype=np.int64).reshape(shape)
-    pairs, kinds = [], []
-    for kind, offset in enumerate(offsets):
+    for offset in offsets:
         source = tuple(slice(max(0, -o), n - max(0, o)) for o, n in zip(offset, shape))
         target = tuple(slice(max(0, o), n - max(0, -o)) for o, n in zip(offset, shape))
-        first, second = index[source].ravel(), index[target].ravel()
-        pairs.append(np.stack([first, second], axis=1))
-        kinds.append(np.full(len(first), kind, dtype=np.int64))
-    if not pairs:
+        block = np.empty((*index[source].shape, 2), dtype=np.int64)
+        block[..., 0], block[..., 1] = index[source], index[target]
+        yield block.reshape(-1, 2)
+
+
+def grid_pair_count(shape: Sequence[int], offsets: np.ndarray) -> int:
+    """Number of pairs `grid_pair_blocks` makes, Σ over offsets of Π max(0, n - |o|)."""
+    return sum(
+        math.prod(max(0, n - abs(int(o))) for o, n in zip(offset, shape)) for offset in offsets
+    )
+
+
+def grid_pairs(shape: Sequence[int], offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Particle index pairs (E, 2) joined by ``offsets``, and each pair's offset index (E,).
+
+    The blocks of `grid_pair_blocks`, one after the other.
+    """
+    blocks = list(grid_pair_blocks(shape, offsets))
+    if not blocks:
         return np.zeros((0, 2), dtype=np.int64), np.zeros(0, dtype=np.int64)
-    return np.concatenate(pairs), np.concatenate(kinds)
+    kinds = np.repeat(np.arange(len(blocks)), [len(block) for block in blocks])
+    return np.concatenate(blocks), kinds

@@ -9,7 +9,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import kernels
 from .body import Body
 from .constraints import Constraint, StepState
 from .dynamics import Dynamics
@@ -37,6 +36,11 @@ class Trajectory:
         return len(self.times)
 
 
+def _unbooked(particles: np.ndarray) -> float:
+    """The energy constraints see when the ledger is off: nothing is booked."""
+    return 0.0
+
+
 class Simulation:
     """A body, an integrator, a time step ``dt`` (s) and the forces acting on it.
 
@@ -45,6 +49,10 @@ class Simulation:
     integrator step. Each step pins the fixed particles, keeps an energy
     ledger, and raises `SimulationDiverged` in the step where the state stops
     being finite or a spring is stretched past ``max_stretch`` times its rest length.
+    ``kernel`` picks the spring kernel, "numba" or "numpy" (see `Dynamics`).
+    ``ledger=False`` skips booking the energy each mechanism takes out (its cost
+    matters for small bodies in contact); frames still record the energies, and
+    every loss then shows as drift.
     """
 
     def __init__(
@@ -55,6 +63,8 @@ class Simulation:
         forces: Sequence[Force | Constraint] = (),
         *,
         max_stretch: float | None = 100.0,
+        kernel: str | None = None,
+        ledger: bool = True,
     ) -> None:
         if not isinstance(body, Body):
             raise TypeError(f"Simulation needs a msdlab.Body, got {type(body).__name__}")
@@ -76,6 +86,7 @@ class Simulation:
         self.integrator = integrator
         self.dt = dt
         self.max_stretch = max_stretch
+        self.ledger = ledger
         self.constraints: list[Constraint] = []
         field_forces: list[Force] = []
         for item in forces:
@@ -89,7 +100,7 @@ class Simulation:
                     "nor a msdlab.Constraint (Ground, Drag, Walls, ...)"
                 )
             item.check(body)
-        self.dynamics = Dynamics(body, field_forces)
+        self.dynamics = Dynamics(body, field_forces, kernel=kernel)
         self.time = 0.0
         self.step_count = 0
         self.dissipated: dict[str, float] = defaultdict(float)
@@ -114,23 +125,23 @@ class Simulation:
         """Advance the body by one step of ``dt``."""
         body, dt = self.body, self.dt
         x, v = body.positions, body.velocities
-        booked = {
-            "dashpot": kernels.dashpot_power(body, x, v) * dt,
-            "integrator": self.integrator.dissipated_energy(v, body.masses),
-        }
-        for force in self.forces:
-            power = force.dissipated_power(body, x, v)
-            if power:
-                booked[force.ledger_name] = booked.get(force.ledger_name, 0.0) + power * dt
-        x_new, v_new = self._checked(self.integrator.step(x, v, dt, self.dynamics), x)
+        integrated = self.dynamics.compiled_step(self.integrator, x, v, dt)
+        if integrated is None:
+            power = self.dynamics.dashpot_power(x, v) if self.ledger else 0.0
+            x_new, v_new = self._checked(self.integrator.step(x, v, dt, self.dynamics), x)
+        else:
+            x_new, v_new, power = integrated
+        booked = self._dissipation(x, v, power) if self.ledger else {}
         fixed = body.fixed
         if fixed.any():
             x_new[fixed] = x[fixed]
             v_new[fixed] = 0.0
-        state = StepState(body, x, x_new, v_new, self.time + dt, dt, self._energy_of(x_new, v_new))
+        energy_of = self._energy_of(x_new, v_new) if self.ledger else _unbooked
+        state = StepState(body, x, x_new, v_new, self.time + dt, dt, energy_of)
         for constraint in self.constraints:
-            name = constraint.ledger_name
-            booked[name] = booked.get(name, 0.0) + constraint.apply(state)
+            removed = constraint.apply(state)
+            if self.ledger:
+                booked[constraint.ledger_name] = booked.get(constraint.ledger_name, 0.0) + removed
         self._check_divergence(x, x_new, v_new)
         x[...] = x_new
         v[...] = v_new
@@ -138,6 +149,20 @@ class Simulation:
         self.step_count += 1
         for name, energy in booked.items():
             self.dissipated[name] += energy
+
+    def _dissipation(self, x: np.ndarray, v: np.ndarray, dashpot_power: float) -> dict[str, float]:
+        """Energy (J) the dashpots, the integrator's damping and dissipative forces take out
+        in this step, by source."""
+        dt = self.dt
+        booked = {
+            "dashpot": dashpot_power * dt,
+            "integrator": self.integrator.dissipated_energy(v, self.body.masses),
+        }
+        for force in self.forces:
+            lost = force.dissipated_power(self.body, x, v)
+            if lost:
+                booked[force.ledger_name] = booked.get(force.ledger_name, 0.0) + lost * dt
+        return booked
 
     def run(
         self,
@@ -171,7 +196,7 @@ class Simulation:
                 self.step_count,
                 self.time,
                 kinetic_energy(self.body, v),
-                kernels.elastic_energy(self.body, x),
+                self.dynamics.elastic_energy(x),
                 sum(f.potential_energy(self.body, x) for f in self.forces),
                 {k: e - start.get(k, 0.0) for k, e in self.dissipated.items()},
             )
@@ -228,14 +253,22 @@ class Simulation:
         energy plus the elastic energy of the springs touching them. The kinetic
         part uses the velocity at the time of x (see `Integrator.velocity_at_positions`)."""
         body, dynamics, integrator = self.body, self.dynamics, self.integrator
+        last: list = [None, None]  # constraints ask before and after a change: find springs once
+        synchronising = (
+            type(integrator).velocity_at_positions is not Integrator.velocity_at_positions
+        )
 
         def energy(particles: np.ndarray) -> float:
-            a = dynamics.acceleration_of(particles, x, v)
-            u = integrator.velocity_at_positions(v[particles], a, self.dt)
+            if last[0] is not particles:
+                last[:] = particles, body.springs_touching(particles)
+            touching = last[1]
+            u = v[particles]
+            if synchronising:
+                a = dynamics.acceleration_of(particles, x, v, touching)
+                u = integrator.velocity_at_positions(u, a, self.dt)
             kinetic = 0.5 * np.sum(body.masses[particles] * np.einsum("ij,ij->i", u, u))
             potential = sum(f.potential_energy(body, x, particles) for f in self.forces)
-            touching = body.springs_touching(particles)
-            return float(kinetic + potential + kernels.elastic_energy(body, x, touching))
+            return float(kinetic + potential + dynamics.elastic_energy(x, touching))
 
         return energy
 

@@ -24,8 +24,9 @@ class Spring:
         f_a = k (l - |x_a - x_b|) n  -  c ((v_a - v_b) · n) n,     f_b = -f_a
 
     ``rest_length=None`` takes the distance between the particles when the spring
-    is added to a body. `Body.spring_forces` computes exactly this for all springs
-    at once; this class is the readable one-spring version.
+    is added to a body. `kernels.spring_forces` (numpy) and `compiled` (numba)
+    compute exactly this for all springs at once; this class is the readable
+    one-spring version.
     """
 
     def __init__(

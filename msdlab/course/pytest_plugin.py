@@ -23,16 +23,23 @@ import os
 import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 
 from . import TASKS, loader
 from .report import CheckReport, CheckResult
 
+if TYPE_CHECKING:
+    from .sandbox import RemoteImplementation
+else:  # the sandbox is imported only when --sandbox is given
+    RemoteImplementation = object
+
 ENV_IMPL = "MSDLAB_IMPL"
 _REPORT = pytest.StashKey[CheckReport]()
 _STARTED = pytest.StashKey[float]()
 _GRADED = pytest.StashKey[tuple[int, int, bool]]()
+_REMOTE = pytest.StashKey[RemoteImplementation]()
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -106,10 +113,18 @@ def implementation(pytestconfig: pytest.Config) -> Iterator[loader.Implementatio
         hide=course_secrets(root),
         uid=None if uid is None else int(uid),
     )
+    pytestconfig.stash[_REMOTE] = remote
     try:
         yield remote
     finally:
         remote.close()
+
+
+def pytest_runtest_setup(item: pytest.Item) -> None:
+    """Each check starts afresh: a function that timed out in an earlier check runs again."""
+    remote = item.config.stash.get(_REMOTE, None)
+    if remote is not None:
+        remote.forgive()
 
 
 def _task_fixture(number: int):

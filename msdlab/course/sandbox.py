@@ -42,6 +42,7 @@ from . import wire
 CHILD = Path(__file__).with_name("sandbox_child.py")
 PACKAGE = Path(__file__).resolve().parents[1]
 CALLBACK_NAMES = frozenset({"acceleration", "force", "masses", "free"})
+STARTUP_SECONDS = 60.0  # the interpreter and numpy/scipy must load, even on a busy machine
 
 
 def course_secrets(*roots: Path) -> list[Path]:
@@ -97,6 +98,7 @@ class SandboxProcess:
         self.scratch.chmod(0o755)
         self.exports: dict[int, Any] = {}
         self.members: dict[tuple[int, str], wire.Ref] = {}
+        self.broken: dict[str, SandboxError] = {}  # name -> its failure, until `forgive`
 
     @property
     def isolation(self) -> str:
@@ -111,13 +113,13 @@ class SandboxProcess:
         the strong one cannot start (e.g. the interpreter is not readable by the sandbox user)."""
         self._launch()
         try:
-            self.request({"op": "ping"})
+            self.request({"op": "ping"}, timeout=STARTUP_SECONDS)
         except SandboxError:
             if not self.strong:
                 raise SandboxError(f"cannot start the grading sandbox: {self.log_tail()}") from None
             self.strong = False
             self._launch()
-            self.request({"op": "ping"})
+            self.request({"op": "ping"}, timeout=STARTUP_SECONDS)
 
     def log_tail(self, limit: int = 2000) -> str:
         """The end of what the submission printed (its stdout and stderr)."""
@@ -211,30 +213,53 @@ class SandboxProcess:
         shutil.rmtree(self.scratch, ignore_errors=True)
 
     # ------------------------------------------------------------ requests
-    def request(self, message: dict, generation: int | None = None) -> Any:
-        """Send ``message`` and return the child's answer, serving its callbacks meanwhile."""
+    def forgive(self) -> None:
+        """Let functions that timed out or crashed run again (called before each check)."""
+        self.broken.clear()
+
+    def request(
+        self,
+        message: dict,
+        generation: int | None = None,
+        name: str = "",
+        timeout: float | None = None,
+    ) -> Any:
+        """Send ``message`` and return the child's answer, serving its callbacks meanwhile.
+
+        The answer must come within ``timeout`` (default: the call time limit). A
+        call of ``name`` that timed out or killed the process is not run again until
+        `forgive`: it fails at once the same way, so one endless or crashing function
+        costs one time limit or one restart per check, however often the check calls it.
+        """
+        if name in self.broken:
+            error = self.broken[name]
+            raise type(error)(f"{name}: {error} (not run again in this check)")
         if generation is not None and generation != self.generation:
             raise SubmissionCrashed(
                 "this object was lost when the submission's process was restarted after a failure"
             )
         if self.process is None:
             self.start()
-        deadline = time.monotonic() + self.timeout
+        limit = self.timeout if timeout is None else timeout
+        deadline = time.monotonic() + limit
         try:
             wire.write_all(self._send_fd, wire.encode(message, self._export))
             while True:
-                reply = self._receive(deadline)
+                reply = self._receive(deadline, limit)
                 if isinstance(reply, dict) and "op" in reply:
                     wire.write_all(self._send_fd, wire.encode(self._serve(reply)))
                     continue
                 break
-        except SubmissionTimeout:
+        except SubmissionTimeout as error:
             self.close()
+            self._remember(name, error)
             raise
         except (EOFError, BrokenPipeError, wire.WireError, ValueError, KeyError) as error:
             reason = self._death_reason() or f"the channel broke ({error})"
             self.close()
-            raise SubmissionCrashed(f"the submission's process {reason}") from None
+            crash = SubmissionCrashed(f"the submission's process {reason}")
+            self._remember(name, crash)
+            raise crash from None
         if not isinstance(reply, dict) or not ("ok" in reply or "error" in reply):
             self.close()
             raise SubmissionCrashed("the submission's process sent a malformed answer")
@@ -242,7 +267,11 @@ class SandboxProcess:
             _raise(reply["error"])
         return reply["ok"]
 
-    def _receive(self, deadline: float) -> Any:
+    def _remember(self, name: str, error: SandboxError) -> None:
+        if name:
+            self.broken[name] = error
+
+    def _receive(self, deadline: float, limit: float) -> Any:
         def read(size: int) -> bytes:
             chunks, left = [], size
             while left:
@@ -250,7 +279,7 @@ class SandboxProcess:
                 ready, _, _ = select.select([self._recv_fd], [], [], max(remaining, 0))
                 if not ready:
                     raise SubmissionTimeout(
-                        f"the submission did not answer within {self.timeout:g} s "
+                        f"the submission did not answer within {limit:g} s "
                         "(an endless loop, or far too much work?)"
                     )
                 chunk = os.read(self._recv_fd, min(left, 1 << 20))
@@ -328,19 +357,23 @@ def _raise(error: dict) -> None:
 class RemoteObject:
     """An object of the submission: attribute access and calls go to its process."""
 
-    def __init__(self, sandbox: SandboxProcess, ref: wire.Ref) -> None:
-        self._sandbox, self._ref, self._generation = sandbox, ref, sandbox.generation
+    def __init__(self, sandbox: SandboxProcess, ref: wire.Ref, name: str) -> None:
+        self._sandbox, self._ref, self._name = sandbox, ref, name
+        self._generation = sandbox.generation
 
-    def _request(self, message: dict) -> Any:
-        return _wrap(self._sandbox, self._sandbox.request(message, self._generation))
+    def _request(self, message: dict, name: str) -> Any:
+        value = self._sandbox.request(message, self._generation, self._name)
+        return _wrap(self._sandbox, value, name)
 
     def __getattr__(self, name: str) -> Any:
         if name.startswith("__"):
             raise AttributeError(name)
-        return self._request({"op": "getattr", "ref": self._ref, "name": name})
+        message = {"op": "getattr", "ref": self._ref, "name": name}
+        return self._request(message, f"{self._name}.{name}")
 
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
-        return self._request({"op": "call", "ref": self._ref, "args": args, "kwargs": kwargs})
+        message = {"op": "call", "ref": self._ref, "args": args, "kwargs": kwargs}
+        return self._request(message, f"{self._name}()")
 
     def __repr__(self) -> str:
         return f"<submission {self._ref.kind}>"
@@ -367,18 +400,21 @@ class RemoteIntegrator(RemoteObject, Integrator):
     def __getattr__(self, name: str) -> Any:
         if name.startswith("__") and name != "__repr__":
             raise AttributeError(name)
-        return self._request({"op": "getattr", "ref": self._ref, "name": name})
+        message = {"op": "getattr", "ref": self._ref, "name": name}
+        return self._request(message, f"{self._name}.{name}")
 
 
-def _wrap(sandbox: SandboxProcess, value: Any) -> Any:
+def _wrap(sandbox: SandboxProcess, value: Any, name: str) -> Any:
+    """Answers as they are, with references to the submission's objects as proxies."""
     if isinstance(value, wire.Ref):
-        return (RemoteIntegrator if value.kind == "integrator" else RemoteObject)(sandbox, value)
+        kind = RemoteIntegrator if value.kind == "integrator" else RemoteObject
+        return kind(sandbox, value, name)
     if isinstance(value, list):
-        return [_wrap(sandbox, v) for v in value]
+        return [_wrap(sandbox, v, name) for v in value]
     if isinstance(value, tuple):
-        return tuple(_wrap(sandbox, v) for v in value)
+        return tuple(_wrap(sandbox, v, name) for v in value)
     if isinstance(value, dict):
-        return {k: _wrap(sandbox, v) for k, v in value.items()}
+        return {k: _wrap(sandbox, v, name) for k, v in value.items()}
     return value
 
 
@@ -393,9 +429,8 @@ class RemoteTask:
         if name.startswith("__"):
             raise AttributeError(name)
         if self._module is None or self._module._generation != self._sandbox.generation:
-            self._module = _wrap(
-                self._sandbox, self._sandbox.request({"op": "task", "n": self._number})
-            )
+            answer = self._sandbox.request({"op": "task", "n": self._number})
+            self._module = _wrap(self._sandbox, answer, f"task{self._number}")
         return getattr(self._module, name)
 
     def __repr__(self) -> str:
@@ -412,6 +447,10 @@ class RemoteImplementation:
 
     def task(self, number: int) -> RemoteTask:
         return self._tasks.setdefault(number, RemoteTask(self.sandbox, number))
+
+    def forgive(self) -> None:
+        """A new check starts: functions that timed out may run again."""
+        self.sandbox.forgive()
 
     def close(self) -> None:
         self.sandbox.cleanup()

@@ -19,6 +19,7 @@ from typing import Any
 
 
 def main(config: dict[str, Any]) -> None:
+    _die_with_parent()
     sys.path[:0] = config["sys_path"]
     log = os.open(config["log"], os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
     os.dup2(log, 1)  # what the submission prints goes to its log, never to the grader
@@ -38,6 +39,18 @@ def main(config: dict[str, Any]) -> None:
     _install_guard(config["read_roots"], config["scratch"])
     os.chdir(config["scratch"])
     Server(config["folder"], config["in_fd"], config["out_fd"], wire, importlib.util).serve()
+
+
+def _die_with_parent() -> None:
+    """Ask Linux to kill this process when the grader that started it dies."""
+    import contextlib
+    import ctypes
+    import signal
+
+    with contextlib.suppress(OSError, AttributeError):  # not Linux: time limits still apply
+        ctypes.CDLL(None).prctl(1, int(signal.SIGKILL))  # PR_SET_PDEATHSIG
+    if os.getppid() == 1:  # the grader died before we asked
+        os._exit(1)
 
 
 def _limit_resources(memory_bytes: int) -> None:

@@ -129,3 +129,19 @@ def test_energy_functions_on_a_known_state():
     assert msd.gravitational_energy(body, (0, -9.81, 0)) == pytest.approx(9.81 * (1 + 2 * 3))
     np.testing.assert_allclose(msd.momentum(body), [1.0, 4.0, 0.0])
     np.testing.assert_allclose(msd.angular_momentum(body), [0, 0, -1.0 + 2 * 2 * 2])
+
+
+def test_without_the_ledger_the_run_is_the_same_and_losses_show_as_drift():
+    def run(ledger: bool) -> tuple[msd.Body, msd.EnergyLedger]:
+        body = msd.Body.grid((3, 3), spacing=0.2, stiffness=200.0, neighbours=(1, 2), damping=0.2)
+        body.positions = body.positions + [0.0, 0.3]
+        forces = [msd.Gravity((0, -9.81)), msd.Ground(0.0), msd.Drag(0.3)]
+        sim = msd.Simulation(body, msd.Verlet(0.01), 1e-3, forces, ledger=ledger)
+        return body, sim.run(duration=1.0, record_every=100).energies
+
+    booked_body, booked = run(True)
+    plain_body, plain = run(False)
+    np.testing.assert_array_equal(plain_body.positions, booked_body.positions)
+    np.testing.assert_allclose(plain.total, booked.total)
+    assert plain.dissipated == {} and set(booked.dissipated) >= {"ground", "drag", "dashpot"}
+    np.testing.assert_allclose(plain.drift, booked.drift - booked.total_dissipated)

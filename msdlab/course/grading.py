@@ -1,0 +1,305 @@
+"""Grading folders of submissions: each in its own workspace, judge and sandbox.
+
+For every submission a fresh workspace gets a copy of its task files and of the
+instructor's checks; a judge process (pytest with ``--sandbox``) runs the checks,
+calling the submission only through `sandbox`, under a time limit, and writes a
+JSON `CheckReport`. The grade is read from that report alone. Whatever happens
+(a crash, a timeout, a file that does not import) the submission gets a row,
+with the reason in its notes.
+"""
+
+from __future__ import annotations
+
+import collections
+import contextlib
+import csv
+import os
+import queue
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from . import TASKS
+from .report import CheckReport
+
+MAX_FILE_BYTES = 1_000_000
+FIRST_UID = 61000  # sandboxes run as FIRST_UID + slot when grading as root
+
+
+@dataclass
+class Submission:
+    """A folder laid out like ``assignments/`` and the name its row gets."""
+
+    name: str
+    folder: Path
+
+
+@dataclass
+class Grade:
+    """The outcome of grading one submission."""
+
+    submission: str
+    report: CheckReport | None
+    notes: list[str] = field(default_factory=list)
+    seconds: float = 0.0
+
+    @property
+    def graded(self) -> bool:
+        """True if the checks ran to the end and produced a report."""
+        return self.report is not None
+
+    def points(self, task: int) -> int:
+        if self.report is None:
+            return 0
+        return sum(c.earned for c in self.report.checks if c.task == task)
+
+    @property
+    def total(self) -> int:
+        return sum(self.points(task) for task in TASKS)
+
+    def row(self) -> dict[str, object]:
+        """The CSV row: submission, task1 ... task5, total, notes."""
+        row: dict[str, object] = {"submission": self.submission}
+        row.update({f"task{task}": self.points(task) for task in TASKS})
+        row.update(total=self.total, notes="; ".join(self.notes))
+        return row
+
+
+def find_submissions(paths: Iterable[Path]) -> list[Submission]:
+    """One `Submission` per folder, named by the folder (made unique if names repeat)."""
+    submissions, seen = [], collections.Counter()
+    for path in paths:
+        folder = Path(path)
+        if not folder.is_dir():
+            raise FileNotFoundError(f"submission folder {folder} does not exist")
+        name = folder.resolve().name
+        seen[name] += 1
+        submissions.append(Submission(name if seen[name] == 1 else f"{name}-{seen[name]}", folder))
+    if not submissions:
+        raise ValueError("give at least one submission folder")
+    return submissions
+
+
+def grade(
+    submission: Submission,
+    checks: Path,
+    *,
+    timeout: float = 600.0,
+    call_timeout: float = 60.0,
+    memory_mb: int = 2048,
+    slot: int = 0,
+) -> Grade:
+    """Grade one submission with the checks in ``checks`` (see the module docstring)."""
+    started = time.monotonic()
+    workspace = Path(tempfile.mkdtemp(prefix="msdlab-grade-"))
+    try:
+        notes = _copy_submission(submission.folder, workspace / "submission")
+        shutil.copytree(checks, workspace / "checks", ignore=shutil.ignore_patterns("__pycache__"))
+        os.chmod(workspace, 0o711)  # the sandbox may reach its submission, not list or write here
+        os.chmod(workspace / "checks", 0o700)
+        report_path = workspace / "report.json"
+        command = [
+            sys.executable, "-m", "pytest", str(workspace / "checks"), "-q", "--no-header",
+            "-p", "no:cacheprovider", "-p", "no:nbval", "--confcutdir", str(workspace / "checks"),
+            "--rootdir", str(workspace), "-o", "addopts=", "--impl", str(workspace / "submission"),
+            "--sandbox", "--sandbox-timeout", str(call_timeout), "--sandbox-memory", str(memory_mb),
+            "--msdlab-report", str(report_path),
+        ]  # fmt: skip
+        # the checks' bodies are small: the numpy kernel spares each judge the JIT start-up
+        environment = dict(os.environ, PYTHONDONTWRITEBYTECODE="1", MSDLAB_KERNEL="numpy")
+        environment["MSDLAB_SANDBOX_UID"] = str(FIRST_UID + slot)
+        failure = _run_judge(command, workspace, environment, timeout)
+        _kill_user(FIRST_UID + slot)
+        report = _read_report(report_path) if failure is None else None
+        if report is None:
+            notes.append(failure or "the checks ended without a report")
+        else:
+            notes += _problems(report)
+        return Grade(submission.name, report, notes, time.monotonic() - started)
+    except Exception as error:  # never lose a row: the reason goes to its notes
+        return Grade(submission.name, None, [f"not graded: {error}"], time.monotonic() - started)
+    finally:
+        shutil.rmtree(workspace, ignore_errors=True)
+
+
+def grade_all(
+    submissions: Sequence[Submission],
+    checks: Path,
+    *,
+    jobs: int = 2,
+    progress: Callable[[Grade, int, int], None] | None = None,
+    **limits: float,
+) -> list[Grade]:
+    """Grade ``submissions``, ``jobs`` at a time; ``progress(grade, done, count)`` as each ends."""
+    slots: queue.Queue[int] = queue.Queue()
+    for slot in range(max(1, jobs)):
+        slots.put(slot)
+    finished: list[Grade] = []
+    lock = threading.Lock()
+
+    def one(submission: Submission) -> Grade:
+        slot = slots.get()
+        try:
+            result = grade(submission, checks, slot=slot, **limits)
+        finally:
+            slots.put(slot)
+        with lock:
+            finished.append(result)
+            if progress is not None:
+                progress(result, len(finished), len(submissions))
+        return result
+
+    with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+        return list(pool.map(one, submissions))
+
+
+def write_csv(grades: Sequence[Grade], path: Path) -> None:
+    """One row per submission: submission, task1 ... task5, total, notes."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    columns = ["submission", *(f"task{t}" for t in TASKS), "total", "notes"]
+    with path.open("w", newline="", encoding="utf-8") as handle:
+        writer = csv.DictWriter(handle, fieldnames=columns)
+        writer.writeheader()
+        writer.writerows(grade.row() for grade in grades)
+
+
+def feedback(grade: Grade) -> str:
+    """The feedback text of one submission: its points, each check, and what failed and why."""
+    lines = [f"# {grade.submission}", ""]
+    if grade.report is None:
+        lines += ["Your submission could not be graded:", *[f"- {n}" for n in grade.notes]]
+        return "\n".join(lines) + "\n"
+    points = ", ".join(f"task{t} {grade.points(t)}" for t in TASKS)
+    lines += [f"{grade.total}/{grade.report.points} points ({points})", ""]
+    lines += [f"Note: {note}" for note in grade.notes]
+    lines += ["", "```", grade.report.table(), "```", ""]
+    details = grade.report.details()
+    if details:
+        lines += ["## What the failing checks saw", "", "```", details, "```"]
+    return "\n".join(lines) + "\n"
+
+
+def summary(grades: Sequence[Grade], seconds: float) -> str:
+    """Count, mean points per task, and failures by reason."""
+    graded = [g for g in grades if g.graded]
+    lines = [f"graded {len(graded)} of {len(grades)} submissions in {seconds:.0f} s"]
+    if graded:
+        possible = {t: sum(c.points for c in graded[0].report.checks if c.task == t) for t in TASKS}
+        means = [
+            f"task{t} {sum(g.points(t) for g in graded) / len(graded):.1f}/{possible[t]}"
+            for t in TASKS
+        ]
+        total = sum(g.total for g in graded) / len(graded)
+        lines.append(f"mean: {', '.join(means)}; total {total:.1f}/{sum(possible.values())}")
+    reasons = collections.Counter(_reason(note) for g in grades for note in g.notes)
+    if reasons:
+        lines.append("problems: " + ", ".join(f"{r} ×{n}" for r, n in reasons.most_common()))
+    return "\n".join(lines)
+
+
+def _copy_submission(source: Path, target: Path) -> list[str]:
+    """Copy the task files (regular files only, not too large); return notes on what was left."""
+    notes = []
+    target.mkdir(mode=0o755)
+    for path in sorted(source.glob("*.py")):
+        if path.is_symlink() or not path.is_file():
+            notes.append(f"{path.name} is not a regular file and was ignored")
+        elif path.stat().st_size > MAX_FILE_BYTES:
+            notes.append(f"{path.name} is larger than {MAX_FILE_BYTES} bytes and was ignored")
+        else:
+            shutil.copyfile(path, target / path.name)
+            (target / path.name).chmod(0o644)
+    missing = [f"task{t}.py" for t in TASKS if not (target / f"task{t}.py").exists()]
+    if missing:
+        notes.append(f"missing: {', '.join(missing)}")
+    return notes
+
+
+def _run_judge(
+    command: list[str], workspace: Path, environment: dict, timeout: float
+) -> str | None:
+    """Run the judge; None if it finished, else why not. The whole process group is killed."""
+    process = subprocess.Popen(
+        command,
+        cwd=workspace,
+        env=environment,
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        start_new_session=True,
+    )
+    try:
+        _, errors = process.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(process.pid, signal.SIGKILL)
+        process.communicate()
+        return f"grading timed out after {timeout:g} s"
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(process.pid, signal.SIGKILL)  # and anything left behind
+    if process.returncode not in (0, 1):  # 1: some checks failed, which is a normal grade
+        tail = errors.decode(errors="replace").strip().splitlines()[-3:]
+        return f"the checks could not run (pytest exit {process.returncode}): {' | '.join(tail)}"
+    return None
+
+
+def _kill_user(uid: int) -> None:
+    """As root, kill every process still running as ``uid`` (a sandbox left behind)."""
+    if os.geteuid() != 0:
+        return
+    for status in Path("/proc").glob("[0-9]*/status"):
+        with contextlib.suppress(OSError, ValueError, IndexError):
+            fields = dict(line.split(":", 1) for line in status.read_text().splitlines())
+            if int(fields["Uid"].split()[0]) == uid:
+                os.kill(int(status.parent.name), signal.SIGKILL)
+
+
+def _read_report(path: Path) -> CheckReport | None:
+    try:
+        return CheckReport.read(path)
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+_KNOWN = {
+    "SubmissionTimeout": "a call timed out (endless loop?)",
+    "SubmissionCrashed": "the submission's process died",
+    "MemoryError": "ran out of memory",
+    "SyntaxError": "syntax error",
+    "PermissionError": "tried something the sandbox forbids",
+}
+
+
+def _problems(report: CheckReport) -> list[str]:
+    """Short notes on what went wrong beyond wrong answers, one per task and kind."""
+    notes = []
+    for task in report.tasks():
+        checks = [c for c in report.checks if c.task == task]
+        if all(c.exception == "NotImplementedError" for c in checks):
+            notes.append(f"task{task}: not attempted")
+            continue
+        kinds = []
+        for check in checks:
+            text = check.message.strip().splitlines()[0] if check.message.strip() else ""
+            if check.exception in _KNOWN:
+                kinds.append(_KNOWN[check.exception])
+            elif check.exception == "SubmissionRaised" and "sys.exit" in text:
+                kinds.append("called sys.exit")
+            elif check.exception in ("SubmissionError", "FileNotFoundError"):
+                kinds.append(text or "task file could not be loaded")
+        notes += [f"task{task}: {kind}" for kind in dict.fromkeys(kinds)]
+    return notes
+
+
+def _reason(note: str) -> str:
+    """The kind of problem a note describes, for the summary's counts."""
+    return note.split(": ", 1)[-1] if note.startswith("task") else note.split(":", 1)[0]
