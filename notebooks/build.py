@@ -94,19 +94,24 @@ def execute(notebook: NotebookNode) -> None:
 
 
 def keep_text(notebook: NotebookNode) -> None:
-    """Drop pictures, animations and widgets from the outputs; keep text, reset the metadata."""
+    """Drop pictures, animations and widgets from the outputs, join the pieces of text a cell
+    printed (how the kernel splits them depends on timing), reset the metadata."""
     notebook.metadata = nbformat.from_dict(METADATA)
     for cell in notebook.cells:
         if cell.cell_type != "code":
             continue
-        cell.outputs = [
-            output
-            for output in cell.outputs
-            if "data" not in output or set(output["data"]) <= TEXT_ONLY
-        ]
+        kept: list[NotebookNode] = []
         for output in cell.outputs:
+            if "data" in output and not set(output["data"]) <= TEXT_ONLY:
+                continue
             if str(ROOT) in str(output):
                 raise ValueError(f"an output shows this machine's path {ROOT}: {output}")
+            previous = kept[-1] if kept else None
+            if output.output_type == "stream" and previous and previous.get("name") == output.name:
+                previous.text += output.text
+            else:
+                kept.append(output)
+        cell.outputs = kept
 
 
 def build(source: Path) -> Path:

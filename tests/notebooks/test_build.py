@@ -76,3 +76,18 @@ def test_cell_ids_follow_the_content_not_the_position():
 def test_malformed_sources_are_refused(source):
     with pytest.raises(ValueError):
         build.cells(source)
+
+
+def test_saved_outputs_keep_the_text_joined_and_drop_pictures():
+    cell = nbformat.v4.new_code_cell("print(1); plt.show(); print(2)")
+    stream = nbformat.v4.new_output
+    cell.outputs = [
+        stream("stream", name="stdout", text="1\n"),
+        stream("display_data", data={"image/png": "iVBO", "text/plain": "<Figure size 1x1>"}),
+        stream("stream", name="stdout", text="2\n"),
+    ]
+    notebook = nbformat.v4.new_notebook(cells=[cell])
+    build.keep_text(notebook)
+    assert [dict(output) for output in cell.outputs] == [
+        {"output_type": "stream", "name": "stdout", "text": "1\n2\n"}
+    ]
