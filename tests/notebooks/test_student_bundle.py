@@ -24,7 +24,8 @@ TASKS = range(1, 6)
 def bundle(tmp_path_factory) -> Path:
     folder = tmp_path_factory.mktemp("bundle")
     shutil.copytree(ROOT / "assignments", folder / "assignments")
-    shutil.copytree(ROOT / "tests" / "tasks", folder / "tests" / "tasks")
+    hidden = shutil.ignore_patterns("*_hidden.py", "__pycache__")  # left out of the release
+    shutil.copytree(ROOT / "tests" / "tasks", folder / "tests" / "tasks", ignore=hidden)
     (folder / "notebooks").mkdir()
     for task in TASKS:
         notebook = nbformat.read(ROOT / "notebooks" / f"task{task}.ipynb", as_version=4)
