@@ -135,7 +135,7 @@ def drop_rotated_cube(
     body.positions = rotate_layout(body.positions, axis, angle_degrees)
     body.positions[:, 1] += LIFT - body.positions[:, 1].min()
     before = flatness(body.positions)
-    forces = [msd.Gravity(GRAVITY), msd.Ground(0.0)]
-    msd.Simulation(body, msd.Verlet(), DT, forces).run(steps=steps, record_every=steps)
+    simulation = msd.Simulation(body, msd.Verlet(), DT, [msd.Gravity(GRAVITY), msd.Ground(0.0)])
+    simulation.run(steps=steps, record_every=steps)
     return flatness(body.positions) / before
     ### END SOLUTION

@@ -128,8 +128,8 @@ def drop_rotated_cube(
     springs, rest = grid_springs((N, N, N), 2.0 / N, squared_distances)
     body = msd.Body.from_arrays(positions, springs, stiffness=STIFFNESS, rest_lengths=rest)
     before = flatness(body.positions)
-    forces = [msd.Gravity(GRAVITY), msd.Ground(0.0)]
-    msd.Simulation(body, msd.Verlet(), DT, forces).run(steps=steps, record_every=steps)
+    simulation = msd.Simulation(body, msd.Verlet(), DT, [msd.Gravity(GRAVITY), msd.Ground(0.0)])
+    simulation.run(steps=steps, record_every=steps)
     return flatness(body.positions) / before
     ### END SOLUTION
 
@@ -147,9 +147,8 @@ def step_cost(
     ### BEGIN SOLUTION
     # TODO: build the body, time `steps` simulation steps, return (springs, seconds per step).
     springs, rest = grid_springs((n, n, n), 2.0 / n, squared_distances)
-    body = msd.Body.from_arrays(
-        grid_positions((n, n, n), 2.0 / n), springs, stiffness=STIFFNESS, rest_lengths=rest
-    )
+    positions = grid_positions((n, n, n), 2.0 / n)
+    body = msd.Body.from_arrays(positions, springs, stiffness=STIFFNESS, rest_lengths=rest)
     simulation = msd.Simulation(body, msd.Verlet(), DT, [msd.Gravity(GRAVITY)])
     start = time.perf_counter()
     simulation.run(steps=steps, record_every=steps)

@@ -43,13 +43,13 @@ class DampedVerlet(msd.Integrator):
         """Store the damping λ; raise ValueError unless 0 <= λ < 1 (λ >= 1 flips the motion)."""
         ### BEGIN SOLUTION
         # TODO: check that 0 <= damping < 1 (else raise ValueError) and store it as self.damping.
-        damping = float(damping)
-        if not 0.0 <= damping < 1.0:
+        lam = float(damping)
+        if not 0.0 <= lam < 1.0:
             raise ValueError(
-                f"damping λ must be in [0, 1), got {damping}: λ = 0 is no damping, and "
+                f"damping λ must be in [0, 1), got {lam}: λ = 0 is no damping, and "
                 "λ >= 1 would flip or freeze the velocity every step"
             )
-        self.damping = damping
+        self.damping = lam
         ### END SOLUTION
 
     def step(
@@ -64,10 +64,10 @@ class DampedVerlet(msd.Integrator):
         ### BEGIN SOLUTION
         # TODO: recover x(t - dt), apply eq. (1.4), return the new positions and velocities.
         lam = self.damping
-        x_old = x - v * dt
-        a = dynamics.acceleration(x, v)
-        x_new = (2.0 - lam) * x - (1.0 - lam) * x_old + a * dt**2
-        return x_new, (x_new - x) / dt
+        old, current = x - v * dt, x  # x(t - dt) and x(t): the template's old and current
+        acceleration = dynamics.acceleration(current, v)
+        new = (2.0 - lam) * current - (1.0 - lam) * old + acceleration * dt**2
+        return new, (new - current) / dt
         ### END SOLUTION
 
 

@@ -4,7 +4,9 @@
   solutions (``solutions/``) by replacing each marked solution block.
 - `loader`: load the task modules of a submission (a folder laid out like ``assignments/``).
 - `feedback`: the physics messages of failing checks.
-- `oracles`: independent references the checks compare with (template, engine runs, energies).
+- `oracles`: what the public checks compare with besides the engine (the template's loop,
+  energies, engine-made variants of typical mistakes); no answers.
+- `release_rules`: which files ship to students, and the solution lines none may contain.
 - `report`: the machine-readable result of a check run, and its text table.
 - `pytest_plugin`: ``--impl``, the task fixtures, markers, points and the JSON report.
 """

@@ -13,6 +13,7 @@ from __future__ import annotations
 import collections
 import contextlib
 import csv
+import fcntl
 import os
 import queue
 import shutil
@@ -22,7 +23,7 @@ import sys
 import tempfile
 import threading
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -31,7 +32,7 @@ from . import TASKS
 from .report import CheckReport
 
 MAX_FILE_BYTES = 1_000_000
-FIRST_UID = 61000  # sandboxes run as FIRST_UID + slot when grading as root
+FIRST_UID = 61000  # as root, sandboxes run as reserved user ids from here on
 
 
 @dataclass
@@ -95,9 +96,16 @@ def grade(
     timeout: float = 600.0,
     call_timeout: float = 60.0,
     memory_mb: int = 2048,
-    slot: int = 0,
+    uid: int | None = None,
 ) -> Grade:
-    """Grade one submission with the checks in ``checks`` (see the module docstring)."""
+    """Grade one submission with the checks in ``checks`` (see the module docstring).
+
+    As root the sandbox runs as user ``uid`` (default: one reserved for this call).
+    """
+    if uid is None and os.geteuid() == 0:
+        with reserved_uids(1) as (reserved,):
+            return grade(submission, checks, timeout=timeout, call_timeout=call_timeout,
+                         memory_mb=memory_mb, uid=reserved)  # fmt: skip
     started = time.monotonic()
     workspace = Path(tempfile.mkdtemp(prefix="msdlab-grade-"))
     try:
@@ -115,9 +123,11 @@ def grade(
         ]  # fmt: skip
         # the checks' bodies are small: the numpy kernel spares each judge the JIT start-up
         environment = dict(os.environ, PYTHONDONTWRITEBYTECODE="1", MSDLAB_KERNEL="numpy")
-        environment["MSDLAB_SANDBOX_UID"] = str(FIRST_UID + slot)
+        if uid is not None:
+            environment["MSDLAB_SANDBOX_UID"] = str(uid)
         failure = _run_judge(command, workspace, environment, timeout)
-        _kill_user(FIRST_UID + slot)
+        if uid is not None:
+            _kill_user(uid)
         report = _read_report(report_path) if failure is None else None
         if report is None:
             notes.append(failure or "the checks ended without a report")
@@ -139,26 +149,56 @@ def grade_all(
     **limits: float,
 ) -> list[Grade]:
     """Grade ``submissions``, ``jobs`` at a time; ``progress(grade, done, count)`` as each ends."""
-    slots: queue.Queue[int] = queue.Queue()
-    for slot in range(max(1, jobs)):
-        slots.put(slot)
+    jobs = max(1, jobs)
+    slots: queue.Queue[int | None] = queue.Queue()
     finished: list[Grade] = []
     lock = threading.Lock()
 
     def one(submission: Submission) -> Grade:
-        slot = slots.get()
+        uid = slots.get()
         try:
-            result = grade(submission, checks, slot=slot, **limits)
+            result = grade(submission, checks, uid=uid, **limits)
         finally:
-            slots.put(slot)
+            slots.put(uid)
         with lock:
             finished.append(result)
             if progress is not None:
                 progress(result, len(finished), len(submissions))
         return result
 
-    with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+    with reserved_uids(jobs) as uids, ThreadPoolExecutor(max_workers=jobs) as pool:
+        for uid in uids:
+            slots.put(uid)
         return list(pool.map(one, submissions))
+
+
+@contextlib.contextmanager
+def reserved_uids(count: int) -> Iterator[list[int | None]]:
+    """``count`` sandbox user ids that no other grading run on this machine holds.
+
+    Each is held by an exclusive lock on a file in the temporary folder for as
+    long as the ``with`` block lasts, so two runs never kill each other's
+    sandboxes. Without root, sandboxes keep the grader's user: ``None``.
+    """
+    if os.geteuid() != 0:
+        yield [None] * count
+        return
+    handles, uids, uid = [], [], FIRST_UID
+    try:
+        while len(uids) < count:
+            handle = open(Path(tempfile.gettempdir()) / f"msdlab-sandbox-{uid}.lock", "a")  # noqa: SIM115
+            try:
+                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                handle.close()
+            else:
+                handles.append(handle)
+                uids.append(uid)
+            uid += 1
+        yield uids
+    finally:
+        for handle in handles:
+            handle.close()
 
 
 def write_csv(grades: Sequence[Grade], path: Path) -> None:

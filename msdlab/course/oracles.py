@@ -1,7 +1,10 @@
-"""Independent references for the checks: the template written again, engine runs, energies.
+"""Independent references for the public checks: the template's given loop, engine runs, energies.
 
-Nothing here comes from a task file: the checks compare a submission with
-these, with the engine, or with analytic results and conservation laws.
+Nothing here is an answer to a task: the checks compare a submission with the
+engine, with the template the students are given, or with analytic results and
+conservation laws, and name the usual cause of a wrong answer from variants of
+the engine's results. This module ships with the package; references that are
+answers (for the hidden checks) stay with the instructor's checks.
 """
 
 from __future__ import annotations
@@ -48,17 +51,6 @@ def template_run(
     return np.array(frames)
 
 
-def first_floor_contact(y0: float, dt: float, g: float, limit: int = 1_000_000) -> int:
-    """Steps of the template until a particle at rest at height y0 first reaches y <= 0."""
-    y_old = y = float(y0)
-    for step in range(1, limit + 1):
-        v = (y - y_old) / dt + dt * g
-        y_old, y = y, y + dt * v
-        if y <= 0.0:
-            return step
-    raise ValueError(f"no floor contact within {limit} steps (y0 = {y0}, dt = {dt}, g = {g})")
-
-
 def grid_body(
     shape: Sequence[int],
     spacing: float,
@@ -101,29 +93,6 @@ def flatness(positions: np.ndarray) -> float:
     return float(np.sqrt(max(np.linalg.eigvalsh(gyration)[0], 0.0)))
 
 
-def drop_rotated_cube(
-    axis: Sequence[float],
-    angle_degrees: float,
-    neighbours: Sequence[int],
-    n: int = 4,
-    steps: int = 1500,
-    stiffness: float = 0.5,
-    lift: float = 0.05,
-) -> float:
-    """Flatness after / before of an n³ cube (spacing 2/n) rotated, put on the floor and run.
-
-    Template setting: msd.Verlet(), dt = 0.1, gravity (0, -0.001, 0), floor y = 0;
-    the rotated cube is shifted up so its lowest particle is at y = ``lift``.
-    """
-    body = grid_body((n, n, n), 2.0 / n, stiffness, neighbours)
-    body.rotate(msd.rotation_matrix(angle_degrees, axis))
-    body.positions[:, 1] += lift - body.positions[:, 1].min()
-    before = flatness(body.positions)
-    forces = [msd.Gravity(TEMPLATE_GRAVITY), msd.Ground(0.0)]
-    msd.Simulation(body, msd.Verlet(), TEMPLATE_DT, forces).run(steps=steps, record_every=steps)
-    return flatness(body.positions) / before
-
-
 def random_rotation(rng: np.random.Generator) -> np.ndarray:
     """A uniformly random proper rotation matrix (3, 3)."""
     q, r = np.linalg.qr(rng.standard_normal((3, 3)))
@@ -133,68 +102,87 @@ def random_rotation(rng: np.random.Generator) -> np.ndarray:
     return q
 
 
-def pair_acceleration(
-    positions: np.ndarray,
-    pairs: np.ndarray,
-    rest_lengths: np.ndarray | float,
-    stiffness: float,
-    reaction: bool = True,
-) -> np.ndarray:
-    """Eq. (1.1)-(1.2) over index pairs (E, 2) of positions (N, 3), unit masses.
+# ----------------------------------------------------------------- typical mistakes, by the engine
+# The checks name the usual cause of a wrong answer by comparing it with what the
+# mistake gives. Each variant below is the engine's result, transformed or run on a
+# changed body: none of them is an implementation of a task.
 
-    ``reaction=False`` leaves out the force on the second particle of each pair
-    (a typical mistake that the checks recognise).
+
+def spring_body(
+    positions: np.ndarray, springs: np.ndarray, rest_lengths: np.ndarray | float, stiffness: float
+) -> msd.Body:
+    """The engine's body of unit-mass particles at ``positions`` joined by index pairs (E, 2)."""
+    return msd.Body.from_arrays(
+        np.asarray(positions, dtype=float),
+        np.asarray(springs, dtype=np.int64).reshape(-1, 2),
+        stiffness=stiffness,
+        rest_lengths=rest_lengths,
+    )
+
+
+def force_of_each_spring(
+    positions: np.ndarray, springs: np.ndarray, rest_lengths: np.ndarray | float, stiffness: float
+) -> np.ndarray:
+    """The force (E, 3) of every spring on its first end, eq. (1.2), unit masses.
+
+    By the engine: every spring alone in a body of its own two particles.
+    """
+    springs = np.asarray(springs, dtype=np.int64).reshape(-1, 2)
+    ends = np.asarray(positions, dtype=float)[springs.ravel()]
+    own = np.arange(len(ends)).reshape(-1, 2)
+    return spring_acceleration(spring_body(ends, own, rest_lengths, stiffness), ends)[0::2]
+
+
+def one_sided_acceleration(
+    positions: np.ndarray, springs: np.ndarray, rest_lengths: np.ndarray | float, stiffness: float
+) -> np.ndarray:
+    """Accelerations (N, 3) when each spring acts on its first end only (the reaction is lost).
+
+    By the engine: the second end of every spring is a detached copy of that particle.
     """
     positions = np.asarray(positions, dtype=float)
-    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
-    d = positions[pairs[:, 0]] - positions[pairs[:, 1]]
-    length = np.linalg.norm(d, axis=1, keepdims=True)
-    direction = np.divide(d, length, out=np.zeros_like(d), where=length > 0)
-    rest = np.broadcast_to(np.asarray(rest_lengths, dtype=float), (len(pairs),))[:, None]
-    f = stiffness * (rest - length) * direction
-    a = np.zeros_like(positions)
-    np.add.at(a, pairs[:, 0], f)
-    if reaction:
-        np.subtract.at(a, pairs[:, 1], f)
-    return a
+    springs = np.asarray(springs, dtype=np.int64).reshape(-1, 2)
+    n = len(positions)
+    copies = n + np.arange(len(springs))
+    body = spring_body(
+        np.concatenate([positions, positions[springs[:, 1]]]),
+        np.stack([springs[:, 0], copies], axis=1),
+        rest_lengths,
+        stiffness,
+    )
+    return spring_acceleration(body, body.positions)[:n]
 
 
-def axis_pairs(shape: Sequence[int], periodic: bool = False) -> np.ndarray:
-    """Index pairs (E, 2) of axis neighbours (i, i + 1 along each axis) of a C-order grid.
-
-    ``periodic=True`` also joins the last particle of each line to the first,
-    as ``np.roll`` does (a typical mistake at the border).
-    """
+def wrapped_border_pairs(shape: Sequence[int]) -> np.ndarray:
+    """The extra springs (E, 2) that ``np.roll`` adds to a C-order grid: from the last
+    particle of each line to the first (a typical mistake at the border)."""
     index = np.arange(int(np.prod(shape))).reshape(shape)
-    pairs = []
-    for axis, n in enumerate(shape):
-        if periodic:
-            pairs.append(np.stack([index.ravel(), np.roll(index, -1, axis).ravel()], axis=1))
-        elif n > 1:
-            first = np.take(index, np.arange(n - 1), axis=axis).ravel()
-            second = np.take(index, np.arange(1, n), axis=axis).ravel()
-            pairs.append(np.stack([first, second], axis=1))
+    pairs = [
+        np.stack([np.take(index, -1, axis=axis).ravel(), np.take(index, 0, axis=axis).ravel()], 1)
+        for axis, n in enumerate(shape)
+        if n > 1  # a line of one particle would be joined to itself: no force
+    ]
     return np.concatenate(pairs) if pairs else np.zeros((0, 2), dtype=np.int64)
 
 
 def axis_spring_mistakes(x: np.ndarray, spacing: float, stiffness: float) -> dict[str, np.ndarray]:
     """Accelerations (nx, ny, nz, 3) that typical mistakes in task 2 give, by cause."""
     shape = x.shape[:3]
-    flat = x.reshape(-1, 3)
-    pairs = axis_pairs(shape)
-    right = pair_acceleration(flat, pairs, spacing, stiffness).reshape(x.shape)
+    flat = np.asarray(x, dtype=float).reshape(-1, 3)
+    body = grid_body(shape, spacing, stiffness)
+    springs = np.stack([body.spring_a, body.spring_b], axis=1)
+    right = spring_acceleration(body, flat).reshape(x.shape)
+    wrapped = spring_body(flat, wrapped_border_pairs(shape), spacing, stiffness)
     border = np.ones(shape, dtype=bool)
     border[tuple(slice(1, -1) if n > 2 else slice(0, 0) for n in shape)] = False
     mistakes = {
         "the sign: eq. (1.2) is k (l - |x_i - x_j|) times the unit vector from x_j to x_i; "
         "with either factor reversed a stretched spring pushes its ends apart": -right,
         "np.roll (or a modulo index) wraps around the grid: border particles got springs "
-        "to the opposite face": pair_acceleration(
-            flat, axis_pairs(shape, periodic=True), spacing, stiffness
-        ).reshape(x.shape),
+        "to the opposite face": right + spring_acceleration(wrapped, flat).reshape(x.shape),
         "only one end of each spring gets its force: particle j needs -f_ij too (each "
-        "particle has neighbours on both sides)": pair_acceleration(
-            flat, pairs, spacing, stiffness, reaction=False
+        "particle has neighbours on both sides)": one_sided_acceleration(
+            flat, springs, spacing, stiffness
         ).reshape(x.shape),
         "each spring is counted twice (once from each end, then its reaction added again)": (
             2 * right
@@ -206,5 +194,5 @@ def axis_spring_mistakes(x: np.ndarray, spacing: float, stiffness: float) -> dic
         mistakes[
             "rest length 1 in world units: 'rest length 1' means one grid spacing, "
             f"l = spacing = {spacing:g}"
-        ] = pair_acceleration(flat, pairs, 1.0, stiffness).reshape(x.shape)
+        ] = spring_acceleration(spring_body(flat, springs, 1.0, stiffness), flat).reshape(x.shape)
     return mistakes

@@ -136,8 +136,8 @@ MISTAKES = [
     Mistake(
         "damping on the acceleration",
         5,
-        "x_new = (2.0 - lam) * x - (1.0 - lam) * x_old + a * dt**2",
-        "x_new = 2.0 * x - x_old + (1.0 - lam) * a * dt**2",
+        "new = (2.0 - lam) * current - (1.0 - lam) * old + acceleration * dt**2",
+        "new = 2.0 * current - old + (1.0 - lam) * acceleration * dt**2",
         {
             "one_step_is_equation_1_4": "damping applied to the acceleration",
             "damping_acts_on_velocity_only": "continues at",
@@ -146,15 +146,15 @@ MISTAKES = [
     Mistake(
         "damping out of range accepted",
         5,
-        "if not 0.0 <= damping < 1.0:",
-        "if damping > 10:",
+        "if not 0.0 <= lam < 1.0:",
+        "if lam > 10:",
         {"damping_outside_0_to_1_is_refused": "was accepted"},
     ),
     Mistake(
         "explicit Euler",
         5,
-        "return x_new, (x_new - x) / dt",
-        "return x + dt * v, v + dt * a",
+        "return new, (new - current) / dt",
+        "return x + dt * v, v + dt * acceleration",
         {
             "one_step_is_equation_1_4": "explicit Euler",
             "predicted_stability_limit": "explicit Euler",
@@ -163,8 +163,8 @@ MISTAKES = [
     Mistake(
         "old velocity returned",
         5,
-        "return x_new, (x_new - x) / dt",
-        "return x_new, v",
+        "return new, (new - current) / dt",
+        "return new, v",
         {
             "one_step_is_equation_1_4": "returning the old velocity",
             "no_damping_reproduces_the_template": "leaves the template's trajectory",

@@ -102,12 +102,13 @@ def test_rest_lengths_unstressed(task4):
     )
     distance = np.linalg.norm(positions[springs[:, 0]] - positions[springs[:, 1]], axis=1)
     worst = int(np.argmax(np.abs(rest - distance)))
-    a = oracles.pair_acceleration(positions, springs, rest, 0.5)
+    stiffness = 0.5
     expect(
         np.allclose(rest, distance, rtol=1e-12),
         saw=f"spring {worst} joins particles {springs[worst].tolist()} at distance "
         f"{num(distance[worst])} but has rest length {num(rest[worst])}: the body at rest is "
-        f"pre-stressed (accelerations up to {num(np.max(np.abs(a)))})",
+        f"pre-stressed (with k = {stiffness} that spring pulls or pushes with "
+        f"{num(stiffness * abs(rest[worst] - distance[worst]))})",
         cause="rest lengths in grid units (1, √2, √3) instead of times the spacing, or the "
         "same rest length for every kind of spring",
     )
@@ -118,11 +119,10 @@ def test_rotated_cube_holds_its_shape(task4):
     """Tilted 45° about z, a cube with 1, √2, √3 springs stands; with axis springs only it folds."""
     axis, angle = (0.0, 0.0, 1.0), 45.0
     held = float(task4.drop_rotated_cube(axis, angle, (1, 2, 3)))
-    expected = oracles.drop_rotated_cube(axis, angle, (1, 2, 3))
     expect(
-        held > 0.9 and abs(held - expected) < 0.1,
+        held > 0.9,
         saw=f"with 26 neighbours, tilted {angle}° about z, the cube kept {percent(held)} of its "
-        f"thickness (the experiment as described gives {percent(expected)})",
+        "thickness; the diagonal springs give it the shear stiffness to stand",
         cause="missing diagonal springs or wrong rest lengths, or a different experiment",
     )
     folded = float(task4.drop_rotated_cube(axis, angle, (1,)))

@@ -1,0 +1,95 @@
+"""The student release: the engine, the templates, the notebooks and the public checks.
+
+`build` copies what ships (see `release_rules`) into a new folder, strips the
+notebooks' outputs (they were made with the solutions), writes the students'
+README and pyproject, and refuses to finish if any line of a solution block
+turns up anywhere in the bundle.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+from .release_rules import shipped_files, solution_leaks, solution_lines
+
+STUDENT_README = """\
+# msdlab: mass-spring-damper course
+
+Elastic bodies as particles joined by springs, integrated in time. You will
+turn a template that drops a grid of particles onto the floor into a jelly
+cube, in five staged tasks.
+
+## Quick start
+
+```bash
+pip install -e . && msdlab demo
+pip install -e ".[test]" && msdlab check
+```
+
+The first command installs msdlab and drops a jelly cube on the floor (it
+prints the energy ledger and saves an animation in `msdlab-output/`). The
+second runs the checks of all five tasks on your files in `assignments/`:
+until you write them, each check says what is still to do.
+
+## Your work
+
+| task | file | what you write |
+| --- | --- | --- |
+| 1 | `assignments/task1.py` | answers about the template's `msd_kernel` (eq. 1.3) |
+| 2 | `assignments/task2.py` | the spring acceleration of eq. (1.1)-(1.2), rest length 1 |
+| 3 | `assignments/task3.py` | a rotated layout, and what axis springs alone do with it |
+| 4 | `assignments/task4.py` | √2 and √3 neighbours, and what they cost |
+| 5 | `assignments/task5.py` | Verlet with damping, eq. (1.3)-(1.4), as an integrator |
+
+Fill in the lines that raise `NotImplementedError`, keeping names and
+signatures, then check one task at a time: `msdlab check 2`. The notebooks in
+`notebooks/` (`pip install jupyterlab && jupyter lab notebooks`) walk through
+each task with plots and animations.
+"""
+
+
+class ReleaseError(RuntimeError):
+    """The bundle would contain something students must not get."""
+
+
+def build(out: Path, root: Path, force: bool = False) -> list[Path]:
+    """Write the student release of the course at ``root`` into ``out``; return its files."""
+    out, root = Path(out).resolve(), Path(root).resolve()
+    if out == root or root in out.parents:
+        raise ValueError(f"write the release outside the course folder {root}")
+    if out.exists() and any(out.iterdir()):
+        if not force:
+            raise FileExistsError(f"{out} is not empty; give another folder or --force")
+        shutil.rmtree(out)
+    written = []
+    for source in shipped_files(root):
+        target = out / source.relative_to(root)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        if source.suffix == ".ipynb":
+            _write_stripped(source, target)
+        else:
+            shutil.copyfile(source, target)
+        written.append(target)
+    if not (out / "pyproject.toml").exists():
+        shutil.copyfile(root / "pyproject.toml", out / "pyproject.toml")
+        written.append(out / "pyproject.toml")
+    (out / "README.md").write_text(STUDENT_README, encoding="utf-8")
+    written.append(out / "README.md")
+    leaks = solution_leaks(written, solution_lines(root / "solutions"))
+    if leaks:
+        shutil.rmtree(out)
+        found = "\n  ".join(str(leak).replace(f"{out}/", "") for leak in leaks)
+        raise ReleaseError(f"solution text found in the release:\n  {found}")
+    return sorted(written)
+
+
+def _write_stripped(source: Path, target: Path) -> None:
+    """Copy a notebook without outputs or execution counts (they came from the solutions)."""
+    notebook = json.loads(source.read_text(encoding="utf-8"))
+    for cell in notebook["cells"]:
+        if cell["cell_type"] == "code":
+            cell["outputs"] = []
+            cell["execution_count"] = None
+    target.write_text(json.dumps(notebook, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
