@@ -1,18 +1,19 @@
-"""The task notebooks in a student's folder: templates unfinished, no solutions anywhere.
+"""The task notebooks in a student's bundle: templates unfinished, no solutions anywhere.
 
-The folder is laid out like the released bundle (``assignments/``,
-``tests/tasks/``, ``notebooks/`` with the outputs stripped, no ``solutions/``),
-and nothing chooses the implementation: the notebooks must find the
-assignments themselves, explain each unwritten function instead of raising,
-and still run to the end, check cell included.
+The bundle is the one ``msdlab release`` builds (``msdlab/``, ``assignments/``,
+``tests/tasks/`` without the hidden checks, ``notebooks/`` without outputs, no
+``solutions/``), and nothing chooses the implementation: the notebooks must find
+the assignments themselves, explain each unwritten function instead of raising,
+and still run to the end, check cell included. (The kernel imports the installed
+msdlab, as it would after ``pip install -e .`` in the bundle.)
 """
 
-import shutil
 from pathlib import Path
 
 import nbformat
 import pytest
 
+from msdlab.course import release
 from msdlab.course.loader import SubmissionError
 from msdlab.course.notebook import Course
 
@@ -22,17 +23,9 @@ TASKS = range(1, 6)
 
 @pytest.fixture(scope="module")
 def bundle(tmp_path_factory) -> Path:
-    folder = tmp_path_factory.mktemp("bundle")
-    shutil.copytree(ROOT / "assignments", folder / "assignments")
-    hidden = shutil.ignore_patterns("*_hidden.py", "__pycache__")  # left out of the release
-    shutil.copytree(ROOT / "tests" / "tasks", folder / "tests" / "tasks", ignore=hidden)
-    (folder / "notebooks").mkdir()
-    for task in TASKS:
-        notebook = nbformat.read(ROOT / "notebooks" / f"task{task}.ipynb", as_version=4)
-        for cell in notebook.cells:
-            if cell.cell_type == "code":
-                cell.outputs, cell.execution_count = [], None
-        nbformat.write(notebook, folder / "notebooks" / f"task{task}.ipynb")
+    folder = tmp_path_factory.mktemp("release") / "bundle"
+    release.build(folder, ROOT)
+    assert not (folder / "solutions").exists()
     return folder
 
 
