@@ -58,8 +58,12 @@ def is_shipped(relative: PurePosixPath | str) -> bool:
     if any(part in NOT_SHIPPED_PARTS for part in path.parts) or path.suffix in NOT_SHIPPED_SUFFIXES:
         return False
     top = path.parts[0] if path.parts else ""
-    if top in ("msdlab", "notebooks"):
+    if top == "msdlab":
         return len(path.parts) > 1
+    if (
+        top == "notebooks"
+    ):  # the notebooks themselves; their sources and build script need solutions/
+        return len(path.parts) == 2 and path.suffix == ".ipynb"
     if top == "assignments":
         return len(path.parts) == 2 and path.suffix == ".py"
     if path.parent == PurePosixPath("tests/tasks"):

@@ -54,7 +54,6 @@ def test_the_rules_by_path():
         "msdlab/course/release_rules.py",
         "assignments/task3.py",
         "notebooks/task1.ipynb",
-        "notebooks/src/task1.py",
         "tests/tasks/test_task2.py",
         "tests/tasks/conftest.py",
     ):
@@ -67,6 +66,9 @@ def test_the_rules_by_path():
         "tests/conftest.py",
         "msdlab/__pycache__/body.cpython-312.pyc",
         "notebooks/.ipynb_checkpoints/task1-checkpoint.ipynb",
+        "notebooks/src/task1.py",
+        "notebooks/build.py",
+        "notebooks/conftest.py",
         "assignments/notes/task1.py",
         "README.md",
         "msdlab",
