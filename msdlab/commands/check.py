@@ -9,17 +9,17 @@ the exit status is 0 only if every check passed.
 from __future__ import annotations
 
 import argparse
-import os
 import shutil
-import subprocess
-import sys
-import tempfile
 from pathlib import Path
 
-from ..course import PROJECT_ROOT, TASKS, loader
-from ..course.report import CheckReport
-
-CHECKS = Path("tests") / "tasks"
+from ..course import TASKS
+from ..course.runner import (
+    CHECKS,
+    ChecksDidNotRun,
+    checks_folder,
+    implementation_folder,
+    run_checks,
+)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -61,29 +61,22 @@ def run(args: argparse.Namespace) -> int:
     folder = implementation_folder(args.impl, Path.cwd())
     scope = f"task {task}" if task else "all tasks"
     print(f"msdlab check: {scope} on {folder}")
-    with tempfile.TemporaryDirectory(prefix="msdlab-check-") as scratch:
-        report_path = Path(scratch) / "report.json"
-        command = pytest_command(checks, folder, task, args.hidden, report_path, args.verbose)
-        try:
-            process = subprocess.run(
-                command,
-                cwd=checks,
-                env={**os.environ, "PYTHONDONTWRITEBYTECODE": "1"},
-                capture_output=True,
-                text=True,
-                timeout=args.timeout,
-            )
-        except subprocess.TimeoutExpired:
-            print(f"the checks did not finish within {args.timeout:g} s: is there an endless loop?")
-            return 2
-        if args.verbose or process.returncode not in (0, 1) or not report_path.exists():
-            print(process.stdout + process.stderr)
-        if not report_path.exists() or process.returncode not in (0, 1):
-            print(f"the checks could not run (pytest exit status {process.returncode})")
-            return 2
-        report = CheckReport.read(report_path)
-        if args.report:
-            shutil.copyfile(report_path, args.report)
+    try:
+        report, output = run_checks(
+            checks,
+            folder,
+            task,
+            hidden=args.hidden,
+            verbose=args.verbose,
+            timeout=args.timeout,
+            save=args.report,
+        )
+    except ChecksDidNotRun as error:
+        print(error.output)
+        print(error)
+        return 2
+    if args.verbose:
+        print(output)
     width = shutil.get_terminal_size((100, 24)).columns
     print()
     print(report.table(width))
@@ -102,54 +95,3 @@ def parse_task(text: str | None) -> int | None:
     if not digits.isdigit() or int(digits) not in TASKS:
         raise ValueError(f"TASK must be one of {', '.join(map(str, TASKS))}, got {text!r}")
     return int(digits)
-
-
-def checks_folder(given: Path | None, cwd: Path) -> Path:
-    """The folder of the checks: given, else the course's tests/tasks (yours first)."""
-    if given is None:
-        local = loader.course_root(cwd) / CHECKS
-        given = local if local.is_dir() else PROJECT_ROOT / CHECKS
-    folder = Path(given).expanduser().resolve()
-    if not folder.is_dir():
-        raise FileNotFoundError(f"no checks folder at {folder}")
-    return folder
-
-
-def implementation_folder(spec: str | None, cwd: Path) -> Path:
-    """The folder of task files to check; a student's ./assignments comes first."""
-    if spec is None:
-        local = loader.course_root(cwd) / "assignments"
-        folder = local if local.is_dir() else PROJECT_ROOT / "assignments"
-    elif spec in loader.NAMED:
-        local = loader.course_root(cwd) / spec
-        folder = local if local.is_dir() else PROJECT_ROOT / spec
-    else:
-        folder = Path(spec).expanduser()
-    folder = folder.resolve()
-    if not folder.is_dir():
-        raise FileNotFoundError(f"no folder of task files at {folder}")
-    return folder
-
-
-def pytest_command(
-    checks: Path, folder: Path, task: int | None, hidden: bool, report: Path, verbose: bool
-) -> list[str]:
-    """The pytest command line that runs the chosen checks on ``folder``."""
-    selected = f"task{task}" if task else " or ".join(f"task{n}" for n in TASKS)
-    marker = selected if hidden else f"({selected}) and not hidden"
-    return [
-        sys.executable,
-        "-m",
-        "pytest",
-        str(checks),
-        f"--impl={folder}",
-        f"--msdlab-report={report}",
-        "-m",
-        marker,
-        "-p",
-        "no:cacheprovider",
-        "-p",
-        "no:nbval",  # not needed by the checks; loading it takes most of a second
-        "--tb=short" if verbose else "--tb=no",
-        "-q",
-    ]

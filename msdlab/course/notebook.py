@@ -19,9 +19,7 @@ from __future__ import annotations
 
 import os
 import re
-import subprocess
 import sys
-import tempfile
 import textwrap
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -29,10 +27,10 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
-from ..commands.check import checks_folder, pytest_command
 from . import loader
 from .pytest_plugin import ENV_IMPL
 from .report import CheckReport
+from .runner import ChecksDidNotRun, checks_folder, run_checks
 
 TODO = re.compile(r"Task (\d+): (.*)", re.DOTALL)
 """The message of a template's ``raise NotImplementedError("Task N: what to do")``."""
@@ -135,24 +133,15 @@ class Course:
         """Run the checks of task ``number`` on these task files (as ``msdlab check``) and print
         the table, with what the failing checks saw; return the report (None if they could
         not run)."""
-        checks = checks_folder(None, self.root)
         print(f"checks of task {number} on {self.label}:\n")
-        with tempfile.TemporaryDirectory(prefix="msdlab-check-") as scratch:
-            path = Path(scratch) / "report.json"
-            command = pytest_command(checks, self.folder, number, False, path, False)
-            process = subprocess.run(
-                command,
-                cwd=checks,
-                env={**os.environ, "PYTHONDONTWRITEBYTECODE": "1"},
-                capture_output=True,
-                text=True,
-                timeout=timeout,
+        try:
+            report, _ = run_checks(
+                checks_folder(None, self.root), self.folder, number, timeout=timeout
             )
-            if not path.exists():
-                print(process.stdout[-3000:] + process.stderr[-3000:])
-                print(f"the checks could not run (pytest exit status {process.returncode})")
-                return None
-            report = CheckReport.read(path)
+        except ChecksDidNotRun as error:
+            print(error.output[-6000:])
+            print(error)
+            return None
         print(report.table(width=100))
         seen = [c for c in report.checks if not c.passed and c.exception != "NotImplementedError"]
         if seen:

@@ -1,0 +1,119 @@
+"""Running the checks in a fresh pytest process and reading back their report.
+
+Used by ``msdlab check`` and by the notebooks' `Course.check`: the checks of one
+task (or all) in a checks folder, on a folder of task files.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+from . import PROJECT_ROOT, TASKS, loader
+from .report import CheckReport
+
+CHECKS = Path("tests") / "tasks"
+
+
+class ChecksDidNotRun(RuntimeError):
+    """pytest ended without a report (a broken checks folder, a crash, a timeout)."""
+
+    def __init__(self, message: str, output: str = "") -> None:
+        super().__init__(message)
+        self.output = output
+
+
+def run_checks(
+    checks: Path,
+    folder: Path,
+    task: int | None = None,
+    *,
+    hidden: bool = False,
+    verbose: bool = False,
+    timeout: float = 900.0,
+    save: Path | None = None,
+) -> tuple[CheckReport, str]:
+    """Run the checks of ``task`` (None: all tasks) on the task files in ``folder``.
+
+    Returns the report and pytest's output; ``save`` keeps a copy of the JSON
+    report. Hidden checks run only with ``hidden``.
+    """
+    with tempfile.TemporaryDirectory(prefix="msdlab-check-") as scratch:
+        report_path = Path(scratch) / "report.json"
+        command = pytest_command(checks, folder, task, hidden, report_path, verbose)
+        try:
+            process = subprocess.run(
+                command,
+                cwd=checks,
+                env={**os.environ, "PYTHONDONTWRITEBYTECODE": "1"},
+                capture_output=True,
+                text=True,
+                timeout=timeout,
+            )
+        except subprocess.TimeoutExpired:
+            raise ChecksDidNotRun(
+                f"the checks did not finish within {timeout:g} s: is there an endless loop?"
+            ) from None
+        output = process.stdout + process.stderr
+        if not report_path.exists() or process.returncode not in (0, 1):
+            raise ChecksDidNotRun(
+                f"the checks could not run (pytest exit status {process.returncode})", output
+            )
+        if save is not None:
+            shutil.copyfile(report_path, save)
+        return CheckReport.read(report_path), output
+
+
+def checks_folder(given: Path | None, cwd: Path) -> Path:
+    """The folder of the checks: given, else the course's tests/tasks (yours first)."""
+    if given is None:
+        local = loader.course_root(cwd) / CHECKS
+        given = local if local.is_dir() else PROJECT_ROOT / CHECKS
+    folder = Path(given).expanduser().resolve()
+    if not folder.is_dir():
+        raise FileNotFoundError(f"no checks folder at {folder}")
+    return folder
+
+
+def implementation_folder(spec: str | None, cwd: Path) -> Path:
+    """The folder of task files to check; a student's ./assignments comes first."""
+    if spec is None:
+        local = loader.course_root(cwd) / "assignments"
+        folder = local if local.is_dir() else PROJECT_ROOT / "assignments"
+    elif spec in loader.NAMED:
+        local = loader.course_root(cwd) / spec
+        folder = local if local.is_dir() else PROJECT_ROOT / spec
+    else:
+        folder = Path(spec).expanduser()
+    folder = folder.resolve()
+    if not folder.is_dir():
+        raise FileNotFoundError(f"no folder of task files at {folder}")
+    return folder
+
+
+def pytest_command(
+    checks: Path, folder: Path, task: int | None, hidden: bool, report: Path, verbose: bool
+) -> list[str]:
+    """The pytest command line that runs the chosen checks on ``folder``."""
+    selected = f"task{task}" if task else " or ".join(f"task{n}" for n in TASKS)
+    marker = selected if hidden else f"({selected}) and not hidden"
+    return [
+        sys.executable,
+        "-m",
+        "pytest",
+        str(checks),
+        f"--impl={folder}",
+        f"--msdlab-report={report}",
+        "-m",
+        marker,
+        "-p",
+        "no:cacheprovider",
+        "-p",
+        "no:nbval",  # not needed by the checks; loading it takes most of a second
+        "--tb=short" if verbose else "--tb=no",
+        "-q",
+    ]
