@@ -42,7 +42,12 @@ def simulation(
     dt: float = 1.0,
     extra: Sequence[Force | Constraint] = (),
 ) -> Simulation:
-    """A gallery body on the page's canvas: gravity (px/frame²), damping per frame, walls."""
+    """A gallery body on the page's canvas: gravity (px/frame²), damping per frame, walls.
+
+    The page's per-frame model (``model="frame"``) is not a physical one, so its
+    runs skip the energy ledger's per-mechanism bookkeeping (``ledger=False``:
+    the frames still record the energies) and stay fast enough to drag live.
+    """
     if model not in MODELS:
         raise ValueError(f"unknown model {model!r}; choose one of {', '.join(MODELS)}")
     if walls not in WALLS:
@@ -59,7 +64,7 @@ def simulation(
     if walls != "none":
         mode = "reflect" if walls == "hard" else "periodic"
         forces.append(Walls((0.0, 0.0), (WIDTH, HEIGHT), mode))
-    return Simulation(body, integrator, dt, [*forces, *extra])
+    return Simulation(body, integrator, dt, [*forces, *extra], ledger=model != "frame")
 
 
 def two_particles(

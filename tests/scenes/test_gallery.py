@@ -205,3 +205,10 @@ def test_periodic_walls_wrap_a_loose_particle():
     sim = gallery.simulation(body, walls="periodic", damping=1.0)
     sim.step()
     assert sim.body.positions[0, 0] == pytest.approx(5.0)
+
+
+def test_the_page_model_skips_the_ledger_bookkeeping_and_the_physical_model_keeps_it():
+    frame, physical = gallery.mesh(model="frame"), gallery.mesh(model="physical")
+    assert not frame.ledger and physical.ledger
+    assert frame.run(steps=20).energies.dissipated == {}
+    assert "drag" in physical.run(steps=20).energies.dissipated
