@@ -1,12 +1,14 @@
-"""The course around the engine: staged tasks, their templates, and the checks that grade them.
+"""What students use of the course: loading their task files, running the checks, feedback.
 
-- `templates`: make the student templates (``assignments/``) from the reference
-  solutions (``solutions/``) by replacing each marked solution block.
+(What only instructors use, grading, the sandbox, the release and the templates' maker,
+is `msdlab.instructor`, which the student bundle does not contain.)
+
 - `loader`: load the task modules of a submission (a folder laid out like ``assignments/``).
 - `feedback`: the physics messages of failing checks.
 - `oracles`: what the public checks compare with besides the engine (the template's loop,
   energies, engine-made variants of typical mistakes); no answers.
-- `release_rules`: which files ship to students, and the solution lines none may contain.
+- `runner`: run the checks in a fresh pytest process (``msdlab check``, the notebooks).
+- `notebook`: the notebooks' helper for trying and checking a task.
 - `report`: the machine-readable result of a check run, and its text table.
 - `pytest_plugin`: ``--impl``, the task fixtures, markers, points and the JSON report.
 """

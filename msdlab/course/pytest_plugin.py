@@ -23,23 +23,31 @@ import os
 import time
 from collections.abc import Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import Any
 
 import pytest
 
 from . import TASKS, loader
 from .report import CheckReport, CheckResult
 
-if TYPE_CHECKING:
-    from .sandbox import RemoteImplementation
-else:  # the sandbox is imported only when --sandbox is given
-    RemoteImplementation = object
-
 ENV_IMPL = "MSDLAB_IMPL"
 _REPORT = pytest.StashKey[CheckReport]()
 _STARTED = pytest.StashKey[float]()
 _GRADED = pytest.StashKey[tuple[int, int, bool]]()
-_REMOTE = pytest.StashKey[RemoteImplementation]()
+
+
+class Hooks:
+    """Hooks other plugins may implement (the instructor's sandbox plugin does)."""
+
+    @pytest.hookspec(firstresult=True)
+    def pytest_msdlab_implementation(self, config: pytest.Config, spec: str, root: Path) -> Any:
+        """Provide the implementation under test for ``spec`` in place of loading it here
+        (it needs ``label`` and ``task(n)`` like `loader.Implementation`, and may have
+        ``close()``); return None to let the course load it in this process."""
+
+
+def pytest_addhooks(pluginmanager: pytest.PytestPluginManager) -> None:
+    pluginmanager.add_hookspecs(Hooks)
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -50,26 +58,6 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         metavar="IMPL",
         help="implementation under test: 'solutions', 'assignments' or a folder laid out "
         f"like assignments/ (default: ${ENV_IMPL}, else solutions where they exist)",
-    )
-    group.addoption(
-        "--sandbox",
-        action="store_true",
-        help="run the implementation in a restricted child process and judge only the data it "
-        "returns (what `msdlab grade` does)",
-    )
-    group.addoption(
-        "--sandbox-timeout",
-        type=float,
-        default=60.0,
-        metavar="S",
-        help="with --sandbox: seconds one call into the implementation may take (default 60)",
-    )
-    group.addoption(
-        "--sandbox-memory",
-        type=int,
-        default=2048,
-        metavar="MB",
-        help="with --sandbox: memory limit of the implementation's process (default 2048 MB)",
     )
     group.addoption(
         "--msdlab-report",
@@ -96,35 +84,22 @@ def implementation_spec(config: pytest.Config) -> str:
 
 @pytest.fixture(scope="session")
 def implementation(pytestconfig: pytest.Config) -> Iterator[loader.Implementation]:
-    """The implementation under test (see ``--impl`` and ``--sandbox``)."""
+    """The implementation under test (see ``--impl``; a plugin implementing
+    `Hooks.pytest_msdlab_implementation` may provide it instead)."""
     spec = implementation_spec(pytestconfig)
     root = loader.course_root(pytestconfig.rootpath)
-    if not pytestconfig.getoption("sandbox"):
+    provided = pytestconfig.hook.pytest_msdlab_implementation(
+        config=pytestconfig, spec=spec, root=root
+    )
+    if provided is None:
         yield loader.load(spec, root)
         return
-    from .sandbox import RemoteImplementation, course_secrets
-
-    uid = os.environ.get("MSDLAB_SANDBOX_UID")
-    remote = RemoteImplementation(
-        loader.resolve(spec, root),
-        label=str(spec),
-        timeout=pytestconfig.getoption("sandbox_timeout"),
-        memory_bytes=pytestconfig.getoption("sandbox_memory") * 2**20,
-        hide=course_secrets(root),
-        uid=None if uid is None else int(uid),
-    )
-    pytestconfig.stash[_REMOTE] = remote
     try:
-        yield remote
+        yield provided
     finally:
-        remote.close()
-
-
-def pytest_runtest_setup(item: pytest.Item) -> None:
-    """Each check starts afresh: a function that timed out in an earlier check runs again."""
-    remote = item.config.stash.get(_REMOTE, None)
-    if remote is not None:
-        remote.forgive()
+        close = getattr(provided, "close", None)
+        if close is not None:
+            close()
 
 
 def _task_fixture(number: int):

@@ -12,7 +12,8 @@ from pathlib import Path
 import pytest
 
 from msdlab.cli import main
-from msdlab.course import PROJECT_ROOT, grading
+from msdlab.course import PROJECT_ROOT
+from msdlab.instructor import grading
 
 SOLUTIONS = PROJECT_ROOT / "solutions"
 CHECKS = PROJECT_ROOT / "tests" / "tasks"

@@ -13,8 +13,9 @@ from pathlib import Path
 import pytest
 
 from msdlab.cli import main
-from msdlab.course import PROJECT_ROOT, release
-from msdlab.course.release_rules import solution_leaks, solution_lines
+from msdlab.course import PROJECT_ROOT
+from msdlab.instructor import release
+from msdlab.instructor.release_rules import solution_leaks, solution_lines
 
 
 @pytest.fixture(scope="module")

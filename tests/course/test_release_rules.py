@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 
 from msdlab.course import PROJECT_ROOT, TASKS
-from msdlab.course.release_rules import (
+from msdlab.instructor.release_rules import (
     MIN_LINE_LENGTH,
     is_shipped,
     readable_lines,

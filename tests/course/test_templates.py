@@ -8,7 +8,7 @@ import pytest
 
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
-from msdlab.course.templates import TemplateError, differences, generate, make_template
+from msdlab.instructor.templates import TemplateError, differences, generate, make_template
 
 SOLUTIONS = PROJECT_ROOT / "solutions"
 ASSIGNMENTS = PROJECT_ROOT / "assignments"

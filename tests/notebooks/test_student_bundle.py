@@ -13,9 +13,9 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from msdlab.course import release
 from msdlab.course.loader import SubmissionError
 from msdlab.course.notebook import Course
+from msdlab.instructor import release
 
 ROOT = Path(__file__).resolve().parents[2]
 TASKS = range(1, 6)

@@ -9,8 +9,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..course import PROJECT_ROOT
-from ..course.templates import differences, generate
+from ...course import PROJECT_ROOT
+from ..templates import differences, generate
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

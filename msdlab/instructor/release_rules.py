@@ -29,6 +29,9 @@ SHIPPED = ("msdlab", "assignments", "notebooks", "tests/tasks")
 INSTRUCTOR_ONLY = "*_hidden.py"
 """Files of ``tests/tasks`` that stay with the instructor: hidden checks and their references."""
 
+INSTRUCTOR_PACKAGE = "instructor"
+"""The part of ``msdlab/`` that stays with the instructor: grading, sandbox, release, templates."""
+
 NOT_SHIPPED_PARTS = ("__pycache__", ".ipynb_checkpoints", ".pytest_cache")
 """Folders that are build or editor by-products, never shipped."""
 
@@ -59,7 +62,7 @@ def is_shipped(relative: PurePosixPath | str) -> bool:
         return False
     top = path.parts[0] if path.parts else ""
     if top == "msdlab":
-        return len(path.parts) > 1
+        return len(path.parts) > 1 and path.parts[1] != INSTRUCTOR_PACKAGE
     if (
         top == "notebooks"
     ):  # the notebooks themselves; their sources and build script need solutions/

@@ -11,7 +11,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..course import PROJECT_ROOT, release
+from ...course import PROJECT_ROOT
+from .. import release
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

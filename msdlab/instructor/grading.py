@@ -28,8 +28,8 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from . import TASKS
-from .report import CheckReport
+from ..course import TASKS
+from ..course.report import CheckReport
 
 MAX_FILE_BYTES = 1_000_000
 FIRST_UID = 61000  # as root, sandboxes run as reserved user ids from here on
@@ -116,7 +116,8 @@ def grade(
         report_path = workspace / "report.json"
         command = [
             sys.executable, "-m", "pytest", str(workspace / "checks"), "-q", "--no-header",
-            "-p", "no:cacheprovider", "-p", "no:nbval", "--confcutdir", str(workspace / "checks"),
+            "-p", "no:cacheprovider", "-p", "no:nbval", "-p", "msdlab.instructor.pytest_sandbox",
+            "--confcutdir", str(workspace / "checks"),
             "--rootdir", str(workspace), "-o", "addopts=", "--impl", str(workspace / "submission"),
             "--sandbox", "--sandbox-timeout", str(call_timeout), "--sandbox-memory", str(memory_mb),
             "--msdlab-report", str(report_path),

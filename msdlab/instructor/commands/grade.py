@@ -16,7 +16,8 @@ import sys
 import time
 from pathlib import Path
 
-from ..course import PROJECT_ROOT, grading
+from ...course import PROJECT_ROOT
+from .. import grading
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

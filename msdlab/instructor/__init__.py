@@ -1,0 +1,12 @@
+"""What only instructors use: grading, the sandbox, the student release and the templates.
+
+Not shipped to students (see `release_rules`):
+
+- `templates`: make the student templates (``assignments/``) from the reference
+  solutions (``solutions/``) by replacing each marked solution block.
+- `grading`: grade folders of submissions, each in its own workspace with a judge
+  process and a `sandbox` for the submission's code (`wire` is their data format;
+  `pytest_sandbox` the judge's pytest plugin).
+- `release_rules` and `release`: which files ship to students, and the bundle.
+- `commands`: the ``msdlab templates``, ``grade`` and ``release`` sub-commands.
+"""

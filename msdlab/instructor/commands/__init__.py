@@ -1,0 +1,5 @@
+"""The instructor's sub-commands of the ``msdlab`` command line."""
+
+from . import grade, release, templates
+
+COMMANDS = [templates, grade, release]

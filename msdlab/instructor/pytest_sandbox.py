@@ -1,0 +1,70 @@
+"""pytest plugin that runs the implementation under test in the grading sandbox.
+
+Loaded by `msdlab.instructor.grading` with ``-p msdlab.instructor.pytest_sandbox``
+(the student bundle has no such plugin). ``--sandbox`` makes the course plugin's
+``implementation`` fixture a `RemoteImplementation`: the checks see only the data the
+sandboxed submission returns.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from ..course import loader
+from .sandbox import RemoteImplementation, course_secrets
+
+_REMOTE = pytest.StashKey[RemoteImplementation]()
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    group = parser.getgroup("msdlab", "msdlab course checks")
+    group.addoption(
+        "--sandbox",
+        action="store_true",
+        help="run the implementation in a restricted child process and judge only the data it "
+        "returns (what `msdlab grade` does)",
+    )
+    group.addoption(
+        "--sandbox-timeout",
+        type=float,
+        default=60.0,
+        metavar="S",
+        help="with --sandbox: seconds one call into the implementation may take (default 60)",
+    )
+    group.addoption(
+        "--sandbox-memory",
+        type=int,
+        default=2048,
+        metavar="MB",
+        help="with --sandbox: memory limit of the implementation's process (default 2048 MB)",
+    )
+
+
+@pytest.hookimpl
+def pytest_msdlab_implementation(
+    config: pytest.Config, spec: str, root: Path
+) -> RemoteImplementation | None:
+    """With ``--sandbox``, the submission at ``spec`` in a sandbox process."""
+    if not config.getoption("sandbox"):
+        return None
+    uid = os.environ.get("MSDLAB_SANDBOX_UID")
+    remote = RemoteImplementation(
+        loader.resolve(spec, root),
+        label=str(spec),
+        timeout=config.getoption("sandbox_timeout"),
+        memory_bytes=config.getoption("sandbox_memory") * 2**20,
+        hide=course_secrets(root),
+        uid=None if uid is None else int(uid),
+    )
+    config.stash[_REMOTE] = remote
+    return remote
+
+
+def pytest_runtest_setup(item: pytest.Item) -> None:
+    """Each check starts afresh: a function that timed out in an earlier check runs again."""
+    remote = item.config.stash.get(_REMOTE, None)
+    if remote is not None:
+        remote.forgive()
