@@ -1,47 +1,44 @@
-"""Compiled (numba) kernels: the physics of `kernels.spring_forces` in one pass, and more.
+"""The numba spring kernel: the same `msdlab.equations`, compiled into loops over the springs.
 
-`kernels.spring_forces` is the readable numpy version: it builds (E, d) arrays
-of spring vectors and forces, then sums them per particle. The loop here takes
-the springs one by one and computes the same formula (eq. 1.2 plus the dashpot)
+`kernels.NumpyKernel` applies the equations to (E, d) arrays of all springs,
+then sums them per particle. `NumbaKernel` compiles the same functions of
+`msdlab.equations` and applies them to the springs one by one: for each it
+computes the length, the force along it (eq. 1.2 plus the dashpot), adds it to
+particle a and its opposite to particle b (eq. 1.1), and keeps the largest
+stretch |d|/l and the dashpot power on the way, with no temporary arrays.
+Large bodies split the springs between the threads, each summing into its own
+force buffer (no two threads write the same memory; the first one writes the
+result), and the buffers are then added per particle.
 
-    f = [k (l - |d|) - c (v_a - v_b)·d/|d|] d/|d|,   d = x_a - x_b,
+`NumbaKernel.advance` compiles an integrator's update function (for example
+`integrators.verlet_update`) into one loop over the particles that computes
+a = F/m and the update together; it is compiled once per process and update.
 
-adds f to particle a and -f to particle b (eq. 1.1), and keeps the largest
-stretch |d|/l on the way, with no temporary arrays. Large bodies split the
-springs between the threads, each summing into its own force buffer (no two
-threads write the same memory; the first one writes the result), and the
-buffers are then added per particle. Dashpot power and elastic energy are
-compiled the same way, and so are the updates of `Verlet`, `SymplecticEuler`
-and `ExplicitEuler` after the forces, each one loop over the particles with the
-operations of the class's `step` in the same order.
-
-The functions are compiled on first use and cached on disk (``cache=True``), so
-compiling is paid once per machine and numba version. Set the number of
+The spring loops are compiled on first use and cached on disk (``cache=True``),
+so compiling is paid once per machine and numba version. Set the number of
 threads with ``NUMBA_NUM_THREADS`` or `numba.set_num_threads`.
 """
 
 from __future__ import annotations
 
 import math
-import os
-from typing import TYPE_CHECKING
-
-# Threads that wait for work sleep instead of spinning. Spinning costs little on
-# an idle machine, but when another program holds a core the spinning thread
-# keeps the waiting work off the CPU: a 0.5 ms step took 30 ms. Set the
-# variable before importing msdlab to choose otherwise.
-os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+import warnings
+from collections.abc import Callable
 
 import numba
 import numpy as np
 
-from .integrators import ExplicitEuler, SymplecticEuler, Verlet
-
-if TYPE_CHECKING:
-    from .body import Body
+from . import equations
+from .body import Body
 
 # Below this many springs one thread is faster than waking the others.
 PARALLEL_MIN_SPRINGS = 50_000
+
+_spring_force = numba.njit(cache=True, inline="always")(equations.spring_force)
+_spring_energy = numba.njit(cache=True, inline="always")(equations.spring_energy)
+_dashpot_power_of = numba.njit(cache=True, inline="always")(equations.dashpot_power)
+_inverse_mass = numba.njit(cache=True, inline="always")(equations.inverse_mass)
+_acceleration = numba.njit(cache=True, inline="always")(equations.acceleration)
 
 
 @numba.njit(cache=True, inline="always")
@@ -63,15 +60,13 @@ def _add_spring_forces(x, v, a, b, k, rest, c, first, stop, out):
             stretch = length / rest[s]
         if length == 0.0:  # coincident ends: no direction, no force
             continue
-        magnitude = k[s] * (rest[s] - length)
+        closing = 0.0
         if c[s] != 0.0:
             closing = (v[i, 0] - v[j, 0]) * d0 + (v[i, 1] - v[j, 1]) * d1
             if three:
                 closing += (v[i, 2] - v[j, 2]) * d2
-            magnitude -= c[s] * closing / length
-            rate = closing / length
-            power += c[s] * rate * rate
-        scale = magnitude / length
+            power += _dashpot_power_of(c[s], closing / length)
+        scale = _spring_force(k[s], rest[s], length, c[s], closing) / length
         out[i, 0] += scale * d0
         out[j, 0] -= scale * d0
         out[i, 1] += scale * d1
@@ -130,8 +125,7 @@ def _dashpot_power(x, v, a, b, c, first, stop):
                 squared += d * d
                 closing += (v[i, q] - v[j, q]) * d
             if squared > 0.0:
-                rate = closing / math.sqrt(squared)
-                power += c[s] * rate * rate
+                power += _dashpot_power_of(c[s], closing / math.sqrt(squared))
     return power
 
 
@@ -161,7 +155,7 @@ def _elastic_energy(x, a, b, k, rest, first, stop):
         for q in range(x.shape[1]):
             d = x[i, q] - x[j, q]
             squared += d * d
-        energy += 0.5 * k[s] * (math.sqrt(squared) - rest[s]) ** 2
+        energy += _spring_energy(k[s], rest[s], math.sqrt(squared))
     return energy
 
 
@@ -184,48 +178,37 @@ def _elastic_energy_parallel(x, a, b, k, rest, blocks):
 
 @numba.njit(cache=True)
 def _divide_by_masses(forces, masses, fixed):
-    """Turn forces (N, d) into accelerations in place: F/m, and 0·F for fixed particles."""
+    """Turn forces (N, d) into accelerations in place: a = F/m, and 0 for fixed particles."""
     for i in range(len(masses)):
-        inverse = 0.0 if fixed[i] else 1.0 / masses[i]
+        inverse = _inverse_mass(masses[i], not fixed[i])
         for q in range(forces.shape[1]):
-            forces[i, q] *= inverse
+            forces[i, q] = _acceleration(forces[i, q], inverse)
 
 
-@numba.njit(cache=True)
-def _verlet_update(x, v, forces, masses, fixed, dt, dt2, lam, x_new, v_new):
-    """`Verlet.step` after the forces: a = F/m (0 if fixed), x_old = x - v dt,
-    x_new = (2 - λ) x - (1 - λ) x_old + a dt², v_new = (x_new - x)/dt; ``dt2`` is dt**2."""
-    for i in range(len(masses)):
-        inverse = 0.0 if fixed[i] else 1.0 / masses[i]
-        for q in range(x.shape[1]):
-            a = forces[i, q] * inverse
-            x_old = x[i, q] - v[i, q] * dt
-            x_new[i, q] = (2.0 - lam) * x[i, q] - (1.0 - lam) * x_old + a * dt2
-            v_new[i, q] = (x_new[i, q] - x[i, q]) / dt
+def _compile_advance(update: Callable) -> Callable | None:
+    """A compiled loop over the particles doing a = F/m then ``update`` per coordinate.
+
+    None if numba cannot compile ``update`` (it then runs on whole arrays).
+    """
+    scalar = numba.njit(update)
+
+    @numba.njit
+    def advance(x, v, forces, masses, fixed, dt, coefficients, x_new, v_new):
+        for i in range(len(masses)):
+            inverse = _inverse_mass(masses[i], not fixed[i])
+            for q in range(x.shape[1]):
+                a = _acceleration(forces[i, q], inverse)
+                x_new[i, q], v_new[i, q] = scalar(x[i, q], v[i, q], a, dt, *coefficients)
+
+    return advance
 
 
-@numba.njit(cache=True)
-def _symplectic_euler_update(x, v, forces, masses, fixed, dt, x_new, v_new):
-    """`SymplecticEuler.step` after the forces: v_new = v + dt a, x_new = x + dt v_new."""
-    for i in range(len(masses)):
-        inverse = 0.0 if fixed[i] else 1.0 / masses[i]
-        for q in range(x.shape[1]):
-            v_new[i, q] = v[i, q] + dt * (forces[i, q] * inverse)
-            x_new[i, q] = x[i, q] + dt * v_new[i, q]
+# One compiled loop per update function, for the whole process.
+_ADVANCES: dict[Callable, Callable | None] = {}
 
 
-@numba.njit(cache=True)
-def _explicit_euler_update(x, v, forces, masses, fixed, dt, x_new, v_new):
-    """`ExplicitEuler.step` after the forces: x_new = x + dt v, v_new = v + dt a."""
-    for i in range(len(masses)):
-        inverse = 0.0 if fixed[i] else 1.0 / masses[i]
-        for q in range(x.shape[1]):
-            x_new[i, q] = x[i, q] + dt * v[i, q]
-            v_new[i, q] = v[i, q] + dt * (forces[i, q] * inverse)
-
-
-class CompiledKernels:
-    """The compiled kernels for one body, with what they need kept between calls.
+class NumbaKernel:
+    """The compiled spring kernel for one body, with what they need kept between calls.
 
     Keeps int32 copies of the spring ends (half the memory traffic of int64)
     and one force buffer per extra thread, rebuilt when the springs change
@@ -238,7 +221,8 @@ class CompiledKernels:
         self._version = -1
         self._a = self._b = np.zeros(0, dtype=np.int32)
         self._partial: np.ndarray | None = None
-        self._new: tuple[np.ndarray, np.ndarray] | None = None
+
+    name = "numba"
 
     def add_spring_forces(
         self,
@@ -278,41 +262,43 @@ class CompiledKernels:
         return _elastic_energy_parallel(x, *arrays, len(self._partial) + 1)
 
     @staticmethod
-    def has_update(integrator: object) -> bool:
-        """True for exactly `Verlet`, `SymplecticEuler`, `ExplicitEuler` (a subclass may
-        change `step`)."""
-        return type(integrator) in (Verlet, SymplecticEuler, ExplicitEuler)
+    def to_acceleration(body: Body, forces: np.ndarray) -> np.ndarray:
+        """Turn forces (N, d) into accelerations a = F/m in place (0 for fixed); return them."""
+        _divide_by_masses(forces, body.masses, body.fixed)
+        return forces
 
-    def update(
+    def advance(
         self,
+        update: Callable,
         body: Body,
-        integrator: Verlet | SymplecticEuler | ExplicitEuler,
         x: np.ndarray,
         v: np.ndarray,
         forces: np.ndarray,
         dt: float,
+        coefficients: tuple[float, ...],
     ) -> tuple[np.ndarray, np.ndarray]:
-        """The new (x, v) of ``integrator.step`` given the forces at (x, v).
+        """``update(x, v, a, dt, *coefficients)`` with a = F/m (0 if fixed), in one loop.
 
-        The arrays returned are buffers reused by the next call.
+        An update numba cannot compile warns once and runs on whole arrays.
         """
-        kind = type(integrator)
-        if self._new is None or self._new[0].shape != x.shape:
-            self._new = (np.empty_like(x), np.empty_like(x))
-        x_new, v_new = self._new
-        args = (x, v, forces, body.masses, body.fixed, dt)
-        if kind is Verlet:
-            _verlet_update(*args, dt**2, integrator.damping, x_new, v_new)
-        elif kind is SymplecticEuler:
-            _symplectic_euler_update(*args, x_new, v_new)
-        else:
-            _explicit_euler_update(*args, x_new, v_new)
-        return x_new, v_new
-
-    @staticmethod
-    def divide_by_masses(body: Body, forces: np.ndarray) -> None:
-        """Turn forces (N, d) into accelerations in place: F/m, and 0·F for fixed particles."""
-        _divide_by_masses(forces, body.masses, body.fixed)
+        if update not in _ADVANCES:
+            _ADVANCES[update] = _compile_advance(update)
+        compiled = _ADVANCES[update]
+        if compiled is not None:
+            x_new, v_new = np.empty_like(x), np.empty_like(v)
+            try:
+                compiled(x, v, forces, body.masses, body.fixed, dt, coefficients, x_new, v_new)
+                return x_new, v_new
+            except numba.core.errors.NumbaError as error:
+                _ADVANCES[update] = None
+                warnings.warn(
+                    f"numba cannot compile {update.__qualname__} ({type(error).__name__}); "
+                    "it runs on whole numpy arrays instead, with the same result, more slowly",
+                    RuntimeWarning,
+                    stacklevel=4,
+                )
+        inverse = equations.inverse_mass(body.masses, ~body.fixed)
+        return update(x, v, equations.acceleration(forces, inverse[:, None]), dt, *coefficients)
 
     def _ends(self, body: Body) -> tuple[np.ndarray, np.ndarray]:
         """The spring ends as compact integers, and the thread buffers, for this topology."""

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import equations
 from .body import Body
 from .errors import check_non_negative
 
@@ -122,7 +123,7 @@ class Drag(Constraint):
 
     def apply(self, state: StepState) -> float:
         factor = math.exp(-self.rate * state.dt)
-        kinetic = 0.5 * np.sum(state.body.masses * np.einsum("ij,ij->i", state.v, state.v))
+        kinetic = equations.kinetic_energy(state.body.masses, state.v)
         state.v *= factor
         return float(kinetic * (1.0 - factor * factor))
 

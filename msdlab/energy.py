@@ -7,14 +7,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import kernels
+from . import equations, kernels
 from .body import Body
 
 
 def kinetic_energy(body: Body, v: np.ndarray | None = None) -> float:
     """½ Σ m |v|² (J); ``v`` defaults to the body's velocities."""
-    v = body.velocities if v is None else v
-    return float(0.5 * np.sum(body.masses * np.einsum("ij,ij->i", v, v)))
+    return equations.kinetic_energy(body.masses, body.velocities if v is None else v)
 
 
 def elastic_energy(body: Body, x: np.ndarray | None = None) -> float:

@@ -2,13 +2,16 @@
 
 An integrator only needs ``dynamics.acceleration(x, v)`` (see `Dynamics`); it
 returns the new (x, v) and does not touch the body, so every scheme here is a
-few lines that read like its formula. The `Simulation` pins fixed particles
-and applies the constraints (ground, drag, ...) after each step.
+few lines that read like its formula. The `Simulation` calls the integrator's
+`step` every step, then pins fixed particles and applies the constraints
+(ground, drag, ...).
 
-With the compiled kernel, `Simulation` runs exactly `Verlet`, `SymplecticEuler`
-and `ExplicitEuler` (not subclasses) as one compiled loop over the particles
-that computes what their `step` computes, in the same order (`msdlab.compiled`;
-the tests compare the two).
+A scheme that needs a(x, v) once, at the current state, can write its update as
+a plain function of numbers ``update(x, v, a, dt, *coefficients) -> (x_new, v_new)``
+(like `verlet_update`) and step with ``dynamics.advance(update, x, v, dt, *coefficients)``.
+On whole arrays that is ``update(x, v, dynamics.acceleration(x, v), dt, ...)``;
+the numba kernel compiles the same function into one loop with a = F/m, for
+any integrator, the engine's or a user's.
 """
 
 from __future__ import annotations
@@ -20,8 +23,31 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .dynamics import Dynamics
+from .equations import kinetic_energy
 
 State = tuple[np.ndarray, np.ndarray]
+
+
+def explicit_euler_update(x: float, v: float, a: float, dt: float) -> tuple[float, float]:
+    """Forward Euler: x + dt·v and v + dt·a, both from the old state (numbers or arrays)."""
+    return x + dt * v, v + dt * a
+
+
+def symplectic_euler_update(x: float, v: float, a: float, dt: float) -> tuple[float, float]:
+    """Semi-implicit Euler: v_new = v + dt·a, then x + dt·v_new (numbers or arrays)."""
+    v_new = v + dt * a
+    return x + dt * v_new, v_new
+
+
+def verlet_update(x: float, v: float, a: float, dt: float, damping: float) -> tuple[float, float]:
+    """Position Verlet with damping λ, eq. (1.4), from x(t), the stored v and a(t)::
+
+    x(t - dt) = x - v dt,   x(t + dt) = (2 - λ) x - (1 - λ) x(t - dt) + a dt²,
+    v_new = (x(t + dt) - x) / dt        (numbers or arrays)
+    """
+    x_old = x - v * dt  # the template's `old` buffer
+    x_new = (2.0 - damping) * x - (1.0 - damping) * x_old + a * dt**2  # eq. (1.4)
+    return x_new, (x_new - x) / dt
 
 
 class Integrator(ABC):
@@ -56,8 +82,7 @@ class ExplicitEuler(Integrator):
     """
 
     def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: Dynamics) -> State:
-        a = dynamics.acceleration(x, v)
-        return x + dt * v, v + dt * a
+        return dynamics.advance(explicit_euler_update, x, v, dt)
 
 
 class SymplecticEuler(Integrator):
@@ -67,8 +92,7 @@ class SymplecticEuler(Integrator):
     """
 
     def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: Dynamics) -> State:
-        v_new = v + dt * dynamics.acceleration(x, v)
-        return x + dt * v_new, v_new
+        return dynamics.advance(symplectic_euler_update, x, v, dt)
 
 
 class Verlet(Integrator):
@@ -100,11 +124,7 @@ class Verlet(Integrator):
         self.damping = damping
 
     def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: Dynamics) -> State:
-        lam = self.damping
-        x_old = x - v * dt  # the template's `old` buffer
-        a = dynamics.acceleration(x, v)
-        x_new = (2.0 - lam) * x - (1.0 - lam) * x_old + a * dt**2  # eq. (1.4)
-        return x_new, (x_new - x) / dt
+        return dynamics.advance(verlet_update, x, v, dt, self.damping)
 
     def velocity_at_positions(self, v: np.ndarray, a: np.ndarray, dt: float) -> np.ndarray:
         """v(t) ≈ v(t - dt/2) + ½ a(t) dt: the stored velocity is half a step behind x."""
@@ -114,8 +134,7 @@ class Verlet(Integrator):
         """Kinetic energy λ removes per step: (1 - (1 - λ)²)·½ Σ m v²."""
         if self.damping == 0.0:
             return 0.0
-        kinetic = 0.5 * np.sum(masses * np.einsum("ij,ij->i", v, v))
-        return float((1.0 - (1.0 - self.damping) ** 2) * kinetic)
+        return float((1.0 - (1.0 - self.damping) ** 2) * kinetic_energy(masses, v))
 
     def __repr__(self) -> str:
         return f"Verlet(damping={self.damping:g})"

@@ -1,16 +1,30 @@
-"""Spring physics over whole arrays: forces (eq. 1.1-1.2), energy, power and Jacobians.
+"""The spring kernel: forces (eq. 1.1-1.2), energy, dashpot power and Jacobians of all springs.
+
+`SpringKernel` is the interface `Dynamics` uses; `NumpyKernel` is its readable
+reference, the functions of this module applied to whole arrays. The numba
+kernel (`msdlab.compiled.NumbaKernel`, the default) applies the same
+`msdlab.equations` one spring at a time in compiled loops. `make_kernel` picks one.
 
 Every function takes the spring arrays of a `Body` (``a``, ``b`` particle indices,
 ``k`` stiffness, ``rest`` rest lengths, ``c`` dashpot coefficients) and computes,
-for all springs at once, exactly what `Spring.force` computes for one.
+for all springs at once, what `Spring.force` computes for one.
 """
 
 from __future__ import annotations
 
+import os
+import warnings
+from collections.abc import Callable
+from typing import Protocol
+
 import numpy as np
 import scipy.sparse as sp
 
+from . import equations
 from .body import Body
+
+KERNELS = ("numba", "numpy")
+Update = Callable[..., tuple[np.ndarray, np.ndarray]]
 
 
 def spring_vectors(body: Body, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -34,23 +48,39 @@ def spring_forces(
     (used to detect blow-ups); zero-length springs exert no force. ``springs``
     restricts the sum to some springs (indices).
     """
+    out, stretch, _ = _spring_forces_and_power(body, x, v, out, springs)
+    return out, stretch
+
+
+def _spring_forces_and_power(
+    body: Body,
+    x: np.ndarray,
+    v: np.ndarray,
+    out: np.ndarray | None = None,
+    springs: np.ndarray | None = None,
+) -> tuple[np.ndarray, float, float]:
+    """`spring_forces`, and the power (W) the dashpots take at (x, v)."""
     pick = slice(None) if springs is None else springs
     a, b = body.spring_a[pick], body.spring_b[pick]
     rest, damping = body.rest_lengths[pick], body.spring_damping[pick]
     d = x[a] - x[b]
     length = np.sqrt(np.einsum("ij,ij->i", d, d))
     safe = np.where(length > 0, length, np.inf)  # coincident ends: no direction, no force
-    magnitude = body.stiffness[pick] * (rest - length)
+    power = 0.0
+    closing = 0.0
     if np.any(damping):
-        magnitude -= damping * np.einsum("ij,ij->i", v[a] - v[b], d) / safe
-    f = (magnitude / safe)[:, None] * d
+        closing = np.einsum("ij,ij->i", v[a] - v[b], d)
+        power = float(np.sum(equations.dashpot_power(damping, closing / safe)))
+    with np.errstate(divide="ignore", invalid="ignore"):  # coincident ends, masked below
+        magnitude = equations.spring_force(body.stiffness[pick], rest, length, damping, closing)
+    f = np.where(length > 0, magnitude / safe, 0.0)[:, None] * d
     if out is None:
         out = np.zeros_like(x)
     n = len(x)
     for axis in range(x.shape[1]):
         out[:, axis] += np.bincount(a, f[:, axis], n) - np.bincount(b, f[:, axis], n)
     stretch = float(np.max(length / rest)) if len(length) else 0.0
-    return out, stretch
+    return out, stretch, power
 
 
 def elastic_energy(body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
@@ -58,18 +88,16 @@ def elastic_energy(body: Body, x: np.ndarray, springs: np.ndarray | None = None)
     pick = slice(None) if springs is None else springs
     d = x[body.spring_a[pick]] - x[body.spring_b[pick]]
     length = np.sqrt(np.einsum("ij,ij->i", d, d))
-    return float(0.5 * np.sum(body.stiffness[pick] * (length - body.rest_lengths[pick]) ** 2))
+    return float(
+        np.sum(equations.spring_energy(body.stiffness[pick], body.rest_lengths[pick], length))
+    )
 
 
 def dashpot_power(body: Body, x: np.ndarray, v: np.ndarray) -> float:
     """Power the dashpots take out of the body, Σ c ((v_a - v_b)·n)² (W), always >= 0."""
     if not np.any(body.spring_damping):
         return 0.0
-    d, length = spring_vectors(body, x)
-    rate = np.einsum("ij,ij->i", v[body.spring_a] - v[body.spring_b], d) / np.where(
-        length > 0, length, np.inf
-    )
-    return float(np.sum(body.spring_damping * rate**2))
+    return _spring_forces_and_power(body, x, v)[2]
 
 
 class JacobianPattern:
@@ -145,3 +173,118 @@ def _block_indices(a: np.ndarray, b: np.ndarray, dim: int) -> tuple[np.ndarray, 
     rows = np.broadcast_to(firsts, (4, len(a), dim, dim)).ravel()
     cols = np.broadcast_to(seconds, (4, len(a), dim, dim)).ravel()
     return rows, cols
+
+
+class SpringKernel(Protocol):
+    """What `Dynamics` needs from a spring kernel; `NumpyKernel` and `NumbaKernel` have it."""
+
+    name: str
+
+    def add_spring_forces(
+        self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray, springs: np.ndarray | None
+    ) -> tuple[float, float]:
+        """Add the spring and dashpot forces (N) to ``out``; return (largest stretch, power W)."""
+
+    def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None) -> float:
+        """Energy (J) stored in the springs (or in the given ones)."""
+
+    def dashpot_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
+        """Power (W) the dashpots take out at (x, v)."""
+
+    def to_acceleration(self, body: Body, forces: np.ndarray) -> np.ndarray:
+        """Accelerations a = F/m (N, d) from forces (N, d), 0 for fixed (may reuse ``forces``)."""
+
+    def advance(
+        self,
+        update: Update,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        forces: np.ndarray,
+        dt: float,
+        coefficients: tuple[float, ...],
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """``update(x, v, a, dt, *coefficients)`` with a = F/m (0 for fixed particles)."""
+
+
+class NumpyKernel:
+    """The readable kernel: the functions above on whole arrays."""
+
+    name = "numpy"
+
+    def add_spring_forces(
+        self,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        out: np.ndarray,
+        springs: np.ndarray | None = None,
+    ) -> tuple[float, float]:
+        """Add the spring and dashpot forces (N) to ``out``; return (largest stretch, power W)."""
+        _, stretch, power = _spring_forces_and_power(body, x, v, out, springs)
+        return stretch, power
+
+    def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
+        """Energy (J) stored in the springs (or in the given ones)."""
+        return elastic_energy(body, x, springs)
+
+    def dashpot_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
+        """Power (W) the dashpots take out at (x, v)."""
+        return dashpot_power(body, x, v)
+
+    def to_acceleration(self, body: Body, forces: np.ndarray) -> np.ndarray:
+        """Accelerations a = F/m (N, d) in m/s² from forces (N, d); 0 for fixed particles."""
+        inverse = equations.inverse_mass(body.masses, ~body.fixed)
+        return equations.acceleration(forces, inverse[:, None])
+
+    def advance(
+        self,
+        update: Update,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        forces: np.ndarray,
+        dt: float,
+        coefficients: tuple[float, ...],
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """``update(x, v, a, dt, *coefficients)`` on whole arrays, a = F/m (0 if fixed)."""
+        return update(x, v, self.to_acceleration(body, forces), dt, *coefficients)
+
+
+def default_kernel() -> str:
+    """The spring kernel to use: ``MSDLAB_KERNEL`` if set, else "numba".
+
+    "numba" is the compiled loop of `msdlab.compiled`; "numpy" is the readable
+    array version of this module. Both apply the same `msdlab.equations`.
+    """
+    name = os.environ.get("MSDLAB_KERNEL", "").strip().lower()
+    return checked_kernel_name(name, "MSDLAB_KERNEL") if name else "numba"
+
+
+def checked_kernel_name(name: str, what: str) -> str:
+    """``name`` if it is a kernel's name, else a ValueError naming ``what`` and the choices."""
+    if name not in KERNELS:
+        raise ValueError(f"{what} must be one of {', '.join(KERNELS)}, got {name!r}")
+    return name
+
+
+def make_kernel(name: str | None = None) -> SpringKernel:
+    """The kernel called ``name`` ("numba" or "numpy"; default `default_kernel()`).
+
+    numba is a dependency of msdlab; if it cannot be imported (a broken
+    install), this warns and returns the numpy kernel, which computes the same.
+    """
+    name = default_kernel() if name is None else checked_kernel_name(name, "kernel")
+    if name == "numpy":
+        return NumpyKernel()
+    try:
+        from .compiled import NumbaKernel  # the one optional, compiled backend
+    except ImportError as error:
+        warnings.warn(
+            f"the numba kernel is unavailable ({error}); using the numpy kernel, which "
+            'computes the same more slowly. Reinstall with pip install -e ".[test]" to fix it.',
+            RuntimeWarning,
+            stacklevel=3,
+        )
+        return NumpyKernel()
+    return NumbaKernel()

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import equations
 from .body import Body
 from .constraints import Constraint, StepState
 from .dynamics import Dynamics
@@ -125,12 +126,9 @@ class Simulation:
         """Advance the body by one step of ``dt``."""
         body, dt = self.body, self.dt
         x, v = body.positions, body.velocities
-        integrated = self.dynamics.compiled_step(self.integrator, x, v, dt)
-        if integrated is None:
-            power = self.dynamics.dashpot_power(x, v) if self.ledger else 0.0
-            x_new, v_new = self._checked(self.integrator.step(x, v, dt, self.dynamics), x)
-        else:
-            x_new, v_new, power = integrated
+        self.dynamics.forget_last_state()
+        x_new, v_new = self._checked(self.integrator.step(x, v, dt, self.dynamics), x)
+        power = self.dynamics.dashpot_power(x, v) if self.ledger else 0.0
         booked = self._dissipation(x, v, power) if self.ledger else {}
         fixed = body.fixed
         if fixed.any():
@@ -266,7 +264,7 @@ class Simulation:
             if synchronising:
                 a = dynamics.acceleration_of(particles, x, v, touching)
                 u = integrator.velocity_at_positions(u, a, self.dt)
-            kinetic = 0.5 * np.sum(body.masses[particles] * np.einsum("ij,ij->i", u, u))
+            kinetic = equations.kinetic_energy(body.masses[particles], u)
             potential = sum(f.potential_energy(body, x, particles) for f in self.forces)
             return float(kinetic + potential + dynamics.elastic_energy(x, touching))
 
