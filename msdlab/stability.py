@@ -11,7 +11,7 @@ eigenvalue ω² of M⁻¹K (K = -∂F/∂x of the springs).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -82,6 +82,11 @@ class _OneMode:
         return -(self.mode.omega**2) * x - self.mode.gamma * v
 
     acceleration = force  # unit mass
+
+    def advance(
+        self, update: Callable, x: np.ndarray, v: np.ndarray, dt: float, *coefficients: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        return update(x, v, self.acceleration(x, v), dt, *coefficients)
 
     def jacobians(self, x: np.ndarray, v: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         return sp.csr_matrix([[-(self.mode.omega**2)]]), sp.csr_matrix([[-self.mode.gamma]])
