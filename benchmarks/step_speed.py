@@ -47,6 +47,9 @@ import tracemalloc
 import numpy as np
 
 import msdlab as msd
+from msdlab.cli import configure_process
+
+configure_process()  # the thread wait policy the command line uses
 
 IMPLEMENTATIONS = {
     "engine-verlet": "engine, numba, Verlet",

@@ -7,8 +7,9 @@ sim = msd.Simulation(body, msd.Verlet(damping=0.01), dt=1e-3,
 trajectory = sim.run(duration=1.0, record_every=10)
 """
 
+from .analysis import Convergence, bisect_blowup, convergence_order, measure_blowup_dt
 from .body import Body, rotation_matrix
-from .constraints import Constraint, Drag, Grab, Ground, Prescribed, StepState, Walls
+from .constraint import Constraint, StepState
 from .dynamics import Dynamics
 from .energy import (
     EnergyLedger,
@@ -19,7 +20,7 @@ from .energy import (
     momentum,
 )
 from .errors import SimulationDiverged
-from .forces import Force, Gravity, SphereContact, ViscousDamping
+from .forces import Force, Gravity, ViscousDamping
 from .integrators import (
     RK4,
     ExplicitEuler,
@@ -29,7 +30,7 @@ from .integrators import (
     VelocityVerlet,
     Verlet,
 )
-from .measure import Convergence, bisect_blowup, convergence_order, measure_blowup_dt
+from .interaction import Drag, Grab, Ground, Prescribed, SphereContact, Walls
 from .particle import Particle
 from .simulation import Simulation, Trajectory
 from .spring import Spring

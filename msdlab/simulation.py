@@ -11,7 +11,7 @@ import numpy as np
 
 from . import equations
 from .body import Body
-from .constraints import Constraint, StepState
+from .constraint import Constraint, StepState
 from .dynamics import Dynamics
 from .energy import EnergyLedger, kinetic_energy
 from .errors import SimulationDiverged, check_finite_array, check_positive

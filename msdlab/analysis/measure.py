@@ -8,14 +8,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import kernels
-from .body import Body
-from .constraints import Constraint
-from .errors import SimulationDiverged
-from .forces import Force
-from .integrators import Integrator
-from .simulation import Simulation
-from .stability import max_stable_dt
+from .. import kernels
+from ..body import Body
+from ..constraint import Constraint
+from ..errors import SimulationDiverged
+from ..forces import Force
+from ..integrators import Integrator
+from ..simulation import Simulation
+from ..stability import max_stable_dt
 
 
 def bisect_blowup(

@@ -7,41 +7,14 @@ energy it removed (J; negative when it put energy in) for the energy ledger.
 from __future__ import annotations
 
 import math
-from abc import ABC, abstractmethod
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
-from . import equations
-from .body import Body
-from .errors import check_non_negative
-
-
-@dataclass
-class StepState:
-    """The end of a step, as constraints see it (edit ``x`` and ``v`` in place)."""
-
-    body: Body
-    x_old: np.ndarray  # positions at the start of the step (m)
-    x: np.ndarray  # new positions (m)
-    v: np.ndarray  # new velocities (m/s)
-    time: float  # time at the end of the step (s)
-    dt: float  # step (s)
-    energy_of: Callable[[np.ndarray], float]  # energy (J) involving these particles now
-
-
-class Constraint(ABC):
-    """A rule applied after each integrator step; see the module docstring."""
-
-    ledger_name = "other"
-
-    def check(self, body: Body) -> None:
-        """Raise ValueError if this constraint cannot act on ``body``."""
-
-    @abstractmethod
-    def apply(self, state: StepState) -> float:
-        """Edit ``state.x``/``state.v``; return the energy removed (J)."""
+from .. import equations
+from ..body import Body
+from ..constraint import Constraint, StepState
+from ..errors import check_non_negative
 
 
 class Ground(Constraint):

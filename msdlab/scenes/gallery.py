@@ -20,9 +20,10 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from ..body import Body, rotation_matrix
-from ..constraints import Constraint, Drag, Prescribed, Walls
+from ..constraint import Constraint
 from ..forces import Force, Gravity
 from ..integrators import VelocityVerlet
+from ..interaction import Drag, Prescribed, Walls
 from ..simulation import Simulation
 from .frame_model import FrameEuler
 

@@ -15,9 +15,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from ..body import Body, rotation_matrix
-from ..constraints import Ground
 from ..forces import Gravity
 from ..integrators import Integrator, Verlet
+from ..interaction import Ground
 from ..simulation import Simulation
 
 

@@ -34,9 +34,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..body import Body
-from ..constraints import Drag
-from ..forces import Gravity, SphereContact
+from ..forces import Gravity
 from ..integrators import Integrator, VelocityVerlet
+from ..interaction import Drag, SphereContact
 from ..lattice import grid_pairs, neighbour_offsets
 from ..simulation import Simulation
 

@@ -16,8 +16,8 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.backend_bases import MouseEvent
 
-from ..constraints import Grab
 from ..errors import SimulationDiverged
+from ..interaction import Grab
 from ..simulation import Simulation
 from .view import BodyView, new_axes, spheres_of
 

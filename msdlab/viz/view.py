@@ -21,7 +21,7 @@ from matplotlib.patches import Circle
 from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
 from ..body import Body
-from ..forces import SphereContact
+from ..interaction import SphereContact
 from ..simulation import Simulation
 
 UPS = ("x", "y", "z")
