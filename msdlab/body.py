@@ -133,15 +133,15 @@ class Body:
         """Add ``particle`` and return its index; the object then reads/writes this body."""
         if not isinstance(particle, Particle):
             raise TypeError(f"add_particle takes a msdlab.Particle, got {type(particle).__name__}")
-        if particle._body is not None:
+        if particle.is_bound:
             raise ValueError(
                 "this particle already belongs to a body; make a new Particle for each body"
             )
-        own = particle._own
+        own = particle.own_values
         (index,) = self.add_particles(
             own["position"][None], own["velocity"][None], own["mass"], own["fixed"]
         )
-        particle._body, particle._index, particle._own = self, int(index), {}
+        particle.bind(self, int(index))
         return int(index)
 
     def add_particles(
@@ -189,16 +189,16 @@ class Body:
         """Add ``spring`` and return its index; the object then reads/writes this body."""
         if not isinstance(spring, Spring):
             raise TypeError(f"add_spring takes a msdlab.Spring, got {type(spring).__name__}")
-        if spring._body is not None:
+        if spring.is_bound:
             raise ValueError("this spring already belongs to a body; make a new Spring")
-        own = spring._own
+        own = spring.own_values
         (index,) = self.add_springs(
             [[own["a"], own["b"]]],
             own["stiffness"],
             None if own["rest_length"] is None else [own["rest_length"]],
             own["damping"],
         )
-        spring._body, spring._index, spring._own = self, int(index), {}
+        spring.bind(self, int(index))
         return int(index)
 
     def add_springs(
@@ -444,7 +444,7 @@ class _Items(Sequence, Generic[Item]):
                 f"{self._kind.__name__.lower()} {index} does not exist: the body has "
                 f"{self._count} (indices 0 to {self._count - 1})"
             )
-        return self._kind._bound(self._body, position % self._count)
+        return self._kind.row(self._body, position % self._count)
 
     def __iter__(self) -> Iterator[Item]:
         return (self[i] for i in range(self._count))

@@ -2,19 +2,15 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
+from .bound import Bound
 from .errors import check_finite_array, check_positive
-
-if TYPE_CHECKING:
-    from .body import Body
 
 MASS_HINT = "Give every particle a mass > 0 (kg); to pin a particle use fixed=True."
 
 
-class Particle:
+class Particle(Bound):
     """A point mass: position (m), velocity (m/s), mass (kg), and whether it is fixed.
 
     Made on its own it holds its values; once added to a `Body` (or read back as
@@ -44,21 +40,7 @@ class Particle:
             )
         check_finite_array("particle velocity", velocity[None])
         mass = check_positive("mass", mass, MASS_HINT)
-        self._body: Body | None = None
-        self._index = -1
-        self._own = {"position": position, "velocity": velocity, "mass": mass, "fixed": fixed}
-
-    @classmethod
-    def _bound(cls, body: Body, index: int) -> Particle:
-        """A particle object that reads and writes row ``index`` of ``body``."""
-        particle = cls.__new__(cls)
-        particle._body, particle._index, particle._own = body, index, {}
-        return particle
-
-    @property
-    def index(self) -> int:
-        """Index in its body (-1 while not in a body)."""
-        return self._index
+        super().__init__(position=position, velocity=velocity, mass=mass, fixed=fixed)
 
     @property
     def dim(self) -> int:

@@ -274,9 +274,17 @@ class Simulation:
         finite = math.isfinite(float(np.sum(x_new)) + float(np.sum(v_new)))
         stretched = self.max_stretch is not None and self.dynamics.max_stretch > self.max_stretch
         if not finite or stretched:
-            raise SimulationDiverged(
-                self.step_count, self.time, diagnose_divergence(self, x, x_new, v_new)
+            diagnosis = diagnose_divergence(
+                self.body,
+                self.integrator,
+                self.dt,
+                self.forces,
+                self.initial_positions,
+                x,
+                x_new,
+                v_new,
             )
+            raise SimulationDiverged(self.step_count, self.time, diagnosis)
 
     def _trajectory(self, frames: list, ledger: EnergyLedger) -> Trajectory:
         velocities = (

@@ -4,17 +4,15 @@ from __future__ import annotations
 
 import math
 import operator
-from typing import TYPE_CHECKING
 
 import numpy as np
 
+from . import equations
+from .bound import Bound
 from .errors import check_non_negative, check_positive
 
-if TYPE_CHECKING:
-    from .body import Body
 
-
-class Spring:
+class Spring(Bound):
     """A spring of stiffness k (N/m) and rest length l (m) joining particles ``a`` and ``b``.
 
     The force on ``a`` is eq. (1.2) of the brief plus a dashpot of coefficient c
@@ -24,9 +22,8 @@ class Spring:
         f_a = k (l - |x_a - x_b|) n  -  c ((v_a - v_b) · n) n,     f_b = -f_a
 
     ``rest_length=None`` takes the distance between the particles when the spring
-    is added to a body. `kernels.spring_forces` (numpy) and `compiled` (numba)
-    compute exactly this for all springs at once; this class is the readable
-    one-spring version.
+    is added to a body. This class is the readable one-spring version; it and the
+    spring kernels (`msdlab.kernels`) all apply `equations.spring_force`.
     """
 
     def __init__(
@@ -52,30 +49,12 @@ class Spring:
             rest_length = check_positive(
                 "rest_length", rest_length, "A spring needs a rest length > 0 (m)."
             )
-        self._body: Body | None = None
-        self._index = -1
-        self._own = {
-            "a": a,
-            "b": b,
-            "stiffness": float(stiffness),
-            "rest_length": rest_length,
-            "damping": float(damping),
-        }
-
-    @classmethod
-    def _bound(cls, body: Body, index: int) -> Spring:
-        """A spring object that reads and writes spring ``index`` of ``body``."""
-        spring = cls.__new__(cls)
-        spring._body, spring._index, spring._own = body, index, {}
-        return spring
+        super().__init__(
+            a=a, b=b, stiffness=float(stiffness), rest_length=rest_length, damping=float(damping)
+        )
 
     def _get(self, name: str, array: str) -> float:
         return self._own[name] if self._body is None else getattr(self._body, array)[self._index]
-
-    @property
-    def index(self) -> int:
-        """Index in its body (-1 while not in a body)."""
-        return self._index
 
     @property
     def a(self) -> int:
@@ -140,14 +119,15 @@ class Spring:
         length = math.dist(x_a, x_b)
         if length == 0.0:  # coincident ends: no direction, no force
             return np.zeros_like(x_a)
-        n = (x_a - x_b) / length
-        elastic = self.stiffness * (self.rest_length - length) * n
-        dashpot = -self.damping * np.dot(v_a - v_b, n) * n
-        return elastic + dashpot
+        closing = float(np.dot(v_a - v_b, x_a - x_b))
+        along = equations.spring_force(
+            self.stiffness, self.rest_length, length, self.damping, closing
+        )
+        return along * (x_a - x_b) / length
 
     def energy(self) -> float:
         """Elastic energy ½ k (|x_a - x_b| - l)² (J)."""
-        return 0.5 * self.stiffness * (self.length() - self.rest_length) ** 2
+        return equations.spring_energy(self.stiffness, self.rest_length, self.length())
 
     def __repr__(self) -> str:
         where = f"index={self._index}, " if self._body is not None else ""

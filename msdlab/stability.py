@@ -13,7 +13,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.linalg
@@ -24,9 +23,6 @@ from . import kernels
 from .body import Body
 from .forces import Force
 from .integrators import Integrator
-
-if TYPE_CHECKING:
-    from .simulation import Simulation
 
 
 @dataclass(frozen=True)
@@ -142,10 +138,17 @@ def max_stable_dt(
 
 
 def diagnose_divergence(
-    sim: Simulation, x: np.ndarray, x_new: np.ndarray, v_new: np.ndarray
+    body: Body,
+    integrator: Integrator,
+    dt: float,
+    forces: Sequence[Force],
+    reference: np.ndarray,
+    x: np.ndarray,
+    x_new: np.ndarray,
+    v_new: np.ndarray,
 ) -> str:
-    """Explain a blow-up: which particle and spring, and dt against the predicted limit."""
-    body = sim.body
+    """Explain a blow-up from x to (x_new, v_new) in a step of ``dt`` (s): which particle
+    and spring, and dt against the limit predicted at the ``reference`` positions."""
     lines = []
     bad = ~(np.all(np.isfinite(x_new), axis=1) & np.all(np.isfinite(v_new), axis=1))
     if bad.any():
@@ -164,10 +167,10 @@ def diagnose_divergence(
             f"spring {worst} (particles {body.spring_a[worst]}-{body.spring_b[worst]}) is at "
             f"{stretch[worst]:.3g}× its rest length"
         )
-    mode = stiffest_mode(body, sim.forces, sim.initial_positions)
-    name, dt = type(sim.integrator).__name__, sim.dt
+    mode = stiffest_mode(body, forces, reference)
+    name = type(integrator).__name__
     try:
-        limit = stability_limit(sim.integrator, mode)
+        limit = stability_limit(integrator, mode)
     except Exception as error:  # a user's integrator that cannot step a one-mode system
         lines.append(f"(no stability prediction: {name}.step failed on a test mode: {error!r})")
         return "; ".join(lines)
