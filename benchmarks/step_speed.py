@@ -55,6 +55,8 @@ IMPLEMENTATIONS = {
     "engine-verlet": "engine, numba, Verlet",
     "engine-symplectic": "engine, numba, SymplecticEuler",
     "engine-numpy": "engine, numpy kernel, Verlet",
+    "user-arrays": "engine, numba, a user's Verlet on arrays",
+    "user-advance": "engine, numba, a user's Verlet via advance",
     "numpy-edge-list": "numpy edge list, Verlet",
     "spring-loop": "Spring.force loop, Verlet",
 }
@@ -72,8 +74,38 @@ def make_grid(n: int) -> tuple[msd.Body, float]:
     return body, time.perf_counter() - start
 
 
+def damped_verlet_update(
+    x: np.ndarray, v: np.ndarray, a: np.ndarray, dt: float, lam: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Eq. (1.4) as a user writes it (like task 5), for numbers or arrays."""
+    old = x - v * dt
+    new = (2.0 - lam) * x - (1.0 - lam) * old + a * dt**2
+    return new, (new - x) / dt
+
+
+class UserArrayVerlet(msd.Integrator):
+    """A user's damped Verlet written like task 5: ``dynamics.acceleration`` and arrays."""
+
+    def __init__(self, damping: float) -> None:
+        self.damping = damping
+
+    def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: msd.Dynamics) -> tuple:
+        return damped_verlet_update(x, v, dynamics.acceleration(x, v), dt, self.damping)
+
+
+class UserAdvanceVerlet(UserArrayVerlet):
+    """The same update handed to ``dynamics.advance``, which the numba kernel compiles."""
+
+    def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: msd.Dynamics) -> tuple:
+        return dynamics.advance(damped_verlet_update, x, v, dt, self.damping)
+
+
 def engine_stepper(body: msd.Body, implementation: str) -> tuple:
-    integrator = msd.SymplecticEuler() if "symplectic" in implementation else msd.Verlet(0.01)
+    integrator = {
+        "engine-symplectic": msd.SymplecticEuler(),
+        "user-arrays": UserArrayVerlet(0.01),
+        "user-advance": UserAdvanceVerlet(0.01),
+    }.get(implementation, msd.Verlet(0.01))
     kernel = "numpy" if implementation == "engine-numpy" else "numba"
     forces = [msd.Gravity(GRAVITY), msd.Ground(height=0.0)]
     sim = msd.Simulation(body, integrator, dt=DT, forces=forces, kernel=kernel)
@@ -125,7 +157,7 @@ def spring_loop_stepper(body: msd.Body) -> tuple:
 def measure(implementation: str, n: int, repeats: int, warmup: int) -> dict:
     """Run one implementation on one grid (in this process) and return its row."""
     body, build = make_grid(n)
-    if implementation.startswith("engine"):
+    if implementation.startswith(("engine", "user")):
         step, timed_springs = engine_stepper(body, implementation)
     elif implementation == "numpy-edge-list":
         step, timed_springs = numpy_edge_list_stepper(body)

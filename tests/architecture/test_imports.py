@@ -66,7 +66,7 @@ def resolve(module: str, node: ast.ImportFrom | ast.Import) -> list[str]:
         return [alias.name for alias in node.names if alias.name.split(".")[0] == "msdlab"]
     if node.level:
         package = module.split(".")
-        if not MODULES[module].name == "__init__.py":
+        if MODULES[module].name != "__init__.py":
             package = package[:-1]
         base = package[: len(package) - node.level + 1]
         target = ".".join(base + ([node.module] if node.module else []))
