@@ -33,6 +33,7 @@ class Dynamics:
         self.max_stretch = 0.0  # largest |d|/l seen in the last force evaluation
         self._pattern: kernels.JacobianPattern | None = None
         self._last_power: tuple[np.ndarray, np.ndarray, float] | None = None
+        self._buffer: np.ndarray | None = None
 
     @property
     def kernel(self) -> str:
@@ -51,7 +52,10 @@ class Dynamics:
 
     def force(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Total force on each particle (N, d) in N."""
-        total = np.zeros_like(x)
+        return self._add_forces(x, v, np.zeros_like(x))
+
+    def _add_forces(self, x: np.ndarray, v: np.ndarray, total: np.ndarray) -> np.ndarray:
+        """Add the spring, dashpot and external forces at (x, v) to ``total``; return it."""
         self.max_stretch, power = self.springs.add_spring_forces(self.body, x, v, total, None)
         self._last_power = (x, v, power)
         for force in self.forces:
@@ -70,7 +74,11 @@ class Dynamics:
         ``update`` is a function of arrays or numbers (like `integrators.verlet_update`)
         returning the new (x, v); the numba kernel compiles it into one loop with a = F/m.
         """
-        return self.springs.advance(update, self.body, x, v, self.force(x, v), dt, coefficients)
+        if self._buffer is None or self._buffer.shape != x.shape:
+            self._buffer = np.empty_like(x)  # the forces, used up within this call
+        self._buffer.fill(0.0)
+        forces = self._add_forces(x, v, self._buffer)
+        return self.springs.advance(update, self.body, x, v, forces, dt, coefficients)
 
     def forget_last_state(self) -> None:
         """Drop the dashpot power kept from the last force evaluation (the state changed)."""
