@@ -185,10 +185,10 @@ def _divide_by_masses(forces, masses, fixed):
             forces[i, q] = _acceleration(forces[i, q], inverse)
 
 
-def _compile_advance(update: Callable) -> Callable | None:
-    """A compiled loop over the particles doing a = F/m then ``update`` per coordinate.
+def _compile_advance(update: Callable) -> Callable:
+    """A loop over the particles doing a = F/m then ``update`` per coordinate.
 
-    None if numba cannot compile ``update`` (it then runs on whole arrays).
+    numba compiles it at its first call, which raises a numba error if it cannot.
     """
     scalar = numba.njit(update)
 
@@ -208,7 +208,7 @@ _ADVANCES: dict[Callable, Callable | None] = {}
 
 
 class NumbaKernel:
-    """The compiled spring kernel for one body, with what they need kept between calls.
+    """The compiled spring kernel for one body, with what it needs kept between calls.
 
     Keeps int32 copies of the spring ends (half the memory traffic of int64)
     and one force buffer per extra thread, rebuilt when the springs change
