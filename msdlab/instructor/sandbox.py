@@ -119,12 +119,20 @@ def isolation_problem(level: str = "namespace") -> str | None:
     if level == "process":
         return None
     if shutil.which("bwrap") is None:
-        return f"the grading sandbox needs bubblewrap (bwrap), which is not installed: {ENABLE_HINT}"
+        return (
+            f"the grading sandbox needs bubblewrap (bwrap), which is not installed: {ENABLE_HINT}"
+        )
     if os.geteuid() == 0 and not Path("/usr/bin/setpriv").is_file():
         return "the grading sandbox needs /usr/bin/setpriv (util-linux) when run as root"
     with tempfile.TemporaryDirectory(prefix="msdlab-probe-") as folder:
         path = [INSIDE_LIBRARY, *_sites()]
-        command = [sys.executable, "-I", "-S", "-c", f"import sys; sys.path[:0] = {path!r}; import msdlab"]
+        command = [
+            sys.executable,
+            "-I",
+            "-S",
+            "-c",
+            f"import sys; sys.path[:0] = {path!r}; import msdlab",
+        ]
         try:
             result = subprocess.run(
                 bubblewrap_command(Path(folder), command, None),
@@ -204,7 +212,8 @@ class SandboxProcess:
         try:
             self.request({"op": "ping"}, timeout=STARTUP_SECONDS)
         except SandboxError as error:
-            raise SandboxError(f"cannot start the grading sandbox ({error}): {self.log_tail()}")
+            reason = f"cannot start the grading sandbox ({error}): {self.log_tail()}"
+            raise SandboxError(reason) from None
 
     def log_tail(self, limit: int = 2000) -> str:
         """The end of what the submission printed (its stdout and stderr)."""
@@ -223,7 +232,11 @@ class SandboxProcess:
         else:  # a fresh scratch each start: nothing planted there runs on the next one
             shutil.rmtree(self.scratch / "scratch", ignore_errors=True)
             (self.scratch / "scratch").mkdir()
-            folder, scratch, library = str(self.folder), str(self.scratch / "scratch"), str(self.scratch / "lib")
+            folder, scratch, library = (
+                str(self.folder),
+                str(self.scratch / "scratch"),
+                str(self.scratch / "lib"),
+            )
         child = f"{library}/msdlab/instructor/{CHILD.name}"
         config = {
             "folder": folder,
