@@ -63,7 +63,7 @@ def python_environment() -> list[Path]:
     """The folders the sandboxed interpreter needs, read-only: the interpreter's
     prefixes, the real interpreter and the installed libraries (never the course)."""
     paths = {"/usr", sys.prefix, sys.base_prefix, sys.exec_prefix}
-    paths |= {sysconfig.get_paths()[key] for key in ("stdlib", "platstdlib", "purelib", "platlib")}
+    paths |= {sysconfig.get_paths()[key] for key in ("stdlib", "platstdlib")} | set(_sites())
     paths.add(os.path.dirname(os.path.realpath(sys.executable)))
     folders = sorted({Path(os.path.realpath(p)) for p in paths} | {Path(p) for p in paths})
     chosen: list[Path] = []
@@ -150,8 +150,13 @@ def isolation_problem(level: str = "namespace") -> str | None:
 
 
 def _sites() -> list[str]:
-    """The folders of the installed libraries (numpy, scipy)."""
-    return sorted({sysconfig.get_paths()["purelib"], sysconfig.get_paths()["platlib"]})
+    """The folders of the installed libraries: this environment's and those numpy and
+    scipy were imported from."""
+    import scipy
+
+    folders = {sysconfig.get_paths()["purelib"], sysconfig.get_paths()["platlib"]}
+    folders |= {str(Path(module.__file__).parents[1]) for module in (np, scipy)}
+    return sorted(folders)
 
 
 class SandboxError(Exception):
