@@ -249,7 +249,7 @@ class SandboxProcess:
             "sys_path": [library, *sites],
             "read_roots": [folder, library, sys.prefix, sys.base_prefix, *sites],
             "memory_bytes": self.memory_bytes,
-            "cpu_seconds": int(max(60.0, 20 * self.timeout)),
+            "cpu_seconds": int(max(600.0, 100 * self.timeout)),  # a whole set of checks
             "in_fd": to_child,
             "out_fd": from_child,
         }
