@@ -127,6 +127,8 @@ def grade(
         # the checks' bodies are small: the numpy kernel spares each judge the JIT start-up
         environment = dict(os.environ, PYTHONDONTWRITEBYTECODE="1", MSDLAB_KERNEL="numpy")
         environment["MSDLAB_SANDBOX_ISOLATION"] = isolation
+        (workspace / "tmp").mkdir()  # the sandboxes' logs, removed with the workspace
+        environment["TMPDIR"] = str(workspace / "tmp")
         if isolation != "namespace":
             notes.append(f"graded with the weaker isolation '{isolation}'")
         if uid is not None:
