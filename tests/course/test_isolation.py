@@ -18,6 +18,7 @@ from pathlib import Path
 
 import pytest
 
+from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
 from msdlab.instructor import sandbox
 
@@ -179,3 +180,28 @@ def test_an_unknown_isolation_level_is_refused():
     assert "unknown isolation" in sandbox.isolation_problem("none")
     with pytest.raises(ValueError, match="isolation must be one of"):
         sandbox.SandboxProcess(PROJECT_ROOT / "solutions", isolation="none")
+
+
+@needs_bubblewrap
+def test_a_sandbox_that_dies_before_its_first_answer_is_an_error_not_a_fallback():
+    starved = sandbox.SandboxProcess(PROJECT_ROOT / "assignments", memory_bytes=2**20)
+    try:
+        with pytest.raises(sandbox.SandboxError, match="cannot start the grading sandbox"):
+            starved.start()
+        assert starved.strong and "namespaces" in starved.isolation
+    finally:
+        starved.cleanup()
+
+
+def test_the_weaker_isolation_is_named_in_every_row_and_the_summary(tmp_path, capsys):
+    nobody = tmp_path / "nobody"
+    nobody.mkdir()
+    checks = tmp_path / "checks"
+    checks.mkdir()
+    (checks / "test_nothing.py").write_text("def test_nothing():\n    pass\n")
+    out = tmp_path / "grades.csv"
+    arguments = ["grade", str(nobody), "--out", str(out), "--checks", str(checks)]
+    assert main([*arguments, "--isolation", "process"]) == 0
+    (row,) = csv.DictReader(out.open())
+    assert "weaker isolation 'process'" in row["notes"]
+    assert "isolation: process" in capsys.readouterr().out
