@@ -97,22 +97,24 @@ def grade(
     call_timeout: float = 60.0,
     memory_mb: int = 2048,
     uid: int | None = None,
+    isolation: str = "namespace",
 ) -> Grade:
     """Grade one submission with the checks in ``checks`` (see the module docstring).
 
     As root the sandbox runs as user ``uid`` (default: one reserved for this call).
+    ``isolation`` is the sandbox's level (`sandbox.ISOLATION_LEVELS`); a weaker one
+    than ``namespace`` is named in the row's notes.
     """
     if uid is None and os.geteuid() == 0:
         with reserved_uids(1) as (reserved,):
             return grade(submission, checks, timeout=timeout, call_timeout=call_timeout,
-                         memory_mb=memory_mb, uid=reserved)  # fmt: skip
+                         memory_mb=memory_mb, uid=reserved, isolation=isolation)  # fmt: skip
     started = time.monotonic()
     workspace = Path(tempfile.mkdtemp(prefix="msdlab-grade-"))
     try:
         notes = _copy_submission(submission.folder, workspace / "submission")
         shutil.copytree(checks, workspace / "checks", ignore=shutil.ignore_patterns("__pycache__"))
-        os.chmod(workspace, 0o711)  # the sandbox may reach its submission, not list or write here
-        os.chmod(workspace / "checks", 0o700)
+        os.chmod(workspace, 0o700)  # the sandbox sees only its bind-mounted copy of the tasks
         report_path = workspace / "report.json"
         command = [
             sys.executable, "-m", "pytest", str(workspace / "checks"), "-q", "--no-header",
@@ -124,6 +126,11 @@ def grade(
         ]  # fmt: skip
         # the checks' bodies are small: the numpy kernel spares each judge the JIT start-up
         environment = dict(os.environ, PYTHONDONTWRITEBYTECODE="1", MSDLAB_KERNEL="numpy")
+        environment["MSDLAB_SANDBOX_ISOLATION"] = isolation
+        (workspace / "tmp").mkdir()  # the sandboxes' logs, removed with the workspace
+        environment["TMPDIR"] = str(workspace / "tmp")
+        if isolation != "namespace":
+            notes.append(f"graded with the weaker isolation '{isolation}'")
         if uid is not None:
             environment["MSDLAB_SANDBOX_UID"] = str(uid)
         failure = _run_judge(command, workspace, environment, timeout)
@@ -147,6 +154,7 @@ def grade_all(
     *,
     jobs: int = 2,
     progress: Callable[[Grade, int, int], None] | None = None,
+    isolation: str = "namespace",
     **limits: float,
 ) -> list[Grade]:
     """Grade ``submissions``, ``jobs`` at a time; ``progress(grade, done, count)`` as each ends."""
@@ -158,7 +166,7 @@ def grade_all(
     def one(submission: Submission) -> Grade:
         uid = slots.get()
         try:
-            result = grade(submission, checks, uid=uid, **limits)
+            result = grade(submission, checks, uid=uid, isolation=isolation, **limits)
         finally:
             slots.put(uid)
         with lock:

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from ..course import loader
-from .sandbox import RemoteImplementation, course_secrets
+from .sandbox import RemoteImplementation
 
 _REMOTE = pytest.StashKey[RemoteImplementation]()
 
@@ -56,8 +56,8 @@ def pytest_msdlab_implementation(
         label=str(spec),
         timeout=config.getoption("sandbox_timeout"),
         memory_bytes=config.getoption("sandbox_memory") * 2**20,
-        hide=course_secrets(root),
         uid=None if uid is None else int(uid),
+        isolation=os.environ.get("MSDLAB_SANDBOX_ISOLATION", "namespace"),
     )
     config.stash[_REMOTE] = remote
     return remote

@@ -7,12 +7,16 @@ only in a child process (`sandbox_child`). Calls cross a pipe as plain data
 numpy or pytest, printing fake results, exiting, looping, eating memory) cannot
 decide a check: the verdict is computed here, from the numbers it sent back.
 
-Isolation, strongest available first: as root with ``unshare`` and ``setpriv``,
-the child gets its own mount namespace where the course's ``solutions/`` and
-``tests/`` are hidden, and runs under its own user id; always: a fresh scratch
-folder, an audit hook limiting files, processes and sockets, memory and file
-size limits, and a per-call time limit after which the process is killed and
-restarted for the next call.
+Isolation is by the operating system (``namespace``, the default): the child
+runs under Debian's ``bubblewrap`` in its own user (without root), PID, mount,
+IPC, UTS and network namespaces, seeing only a read-only copy of the
+submission's task files, the Python environment read-only, its own ``/proc``
+and a private, size-limited ``/tmp``; as root it runs as a reserved user id
+without capabilities. Everything it starts dies with it. ``process`` is the
+weaker level an instructor must ask for: a plain child process as the
+grader's user. Both add resource limits (CPU time, memory, processes, file
+size), a per-call time limit after which the process is killed and restarted,
+and an audit hook whose only job is friendly messages, not the boundary.
 """
 
 from __future__ import annotations
@@ -22,7 +26,6 @@ import contextlib
 import json
 import os
 import select
-import shlex
 import shutil
 import signal
 import subprocess
@@ -43,14 +46,117 @@ CHILD = Path(__file__).with_name("sandbox_child.py")
 PACKAGE = Path(__file__).resolve().parents[1]
 CALLBACK_NAMES = frozenset({"acceleration", "force", "masses", "free"})
 STARTUP_SECONDS = 60.0  # the interpreter and numpy/scipy must load, even on a busy machine
+ISOLATION_LEVELS = ("namespace", "process")
+SCRATCH_BYTES = 64 * 2**20  # the private /tmp of one sandbox
+INSIDE_LIBRARY = "/sandbox/lib"  # where the msdlab package is seen inside the sandbox
+INSIDE_FOLDER = "/submission"  # where the submission's task files are seen
+INSIDE_SCRATCH = "/tmp"
+ENABLE_HINT = (
+    "install bubblewrap (Debian/Ubuntu: apt-get install bubblewrap) and, when not root, "
+    "allow unprivileged user namespaces (sysctl kernel.unprivileged_userns_clone=1 and "
+    "kernel.apparmor_restrict_unprivileged_userns=0 where they exist); or grade with the "
+    "weaker --isolation process"
+)
 
 
-def course_secrets(*roots: Path) -> list[Path]:
-    """The folders a submission must not see: ``solutions/`` and ``tests/`` of the course
-    roots and of the project this package belongs to."""
-    names = ("solutions", "tests")
-    folders = {Path(root).resolve() / name for root in (*roots, PACKAGE.parent) for name in names}
-    return sorted(folder for folder in folders if folder.is_dir())
+def python_environment() -> list[Path]:
+    """The folders the sandboxed interpreter needs, read-only: the interpreter's
+    prefixes, the real interpreter and the installed libraries (never the course)."""
+    paths = {"/usr", sys.prefix, sys.base_prefix, sys.exec_prefix}
+    paths |= {sysconfig.get_paths()[key] for key in ("stdlib", "platstdlib")} | set(_sites())
+    paths.add(os.path.dirname(os.path.realpath(sys.executable)))
+    folders = sorted({Path(os.path.realpath(p)) for p in paths} | {Path(p) for p in paths})
+    chosen: list[Path] = []
+    for folder in folders:  # parents first; a folder inside a chosen one is already there
+        if folder.is_dir() and not any(folder.is_relative_to(c) for c in chosen):
+            chosen.append(folder)
+    return chosen
+
+
+def bubblewrap_command(
+    folder: Path, command: Sequence[str], uid: int | None, scratch_bytes: int = SCRATCH_BYTES
+) -> list[str]:
+    """``command`` wrapped in bubblewrap: own namespaces, a private ``/tmp`` of
+    ``scratch_bytes`` bytes, then the Python environment and msdlab read-only
+    (mounted after ``/tmp``, so an environment living under ``/tmp`` stays
+    visible), the submission ``folder`` read-only at ``INSIDE_FOLDER``. As root,
+    ``uid`` is the user it runs as, with no capabilities."""
+    wrap = ["bwrap", "--die-with-parent", "--new-session", "--unshare-ipc", "--unshare-pid"]
+    wrap += ["--unshare-net", "--unshare-uts", "--unshare-cgroup-try"]
+    if os.geteuid() != 0:  # as root the user namespace would map only root: setpriv drops it
+        wrap.append("--unshare-user")
+    wrap += ["--proc", "/proc", "--dev", "/dev"]
+    wrap += ["--size", str(scratch_bytes), "--perms", "1777", "--tmpfs", INSIDE_SCRATCH]
+    for link in ("bin", "lib", "lib64", "sbin"):
+        target = Path("/") / link
+        if target.is_symlink():
+            wrap += ["--symlink", os.readlink(target), str(target)]
+        elif target.is_dir():
+            wrap += ["--ro-bind", str(target), str(target)]
+    binds = [(path, path) for path in python_environment()]
+    if Path("/etc/ld.so.cache").is_file():
+        binds.append((Path("/etc/ld.so.cache"), Path("/etc/ld.so.cache")))
+    binds += [(PACKAGE, Path(INSIDE_LIBRARY, "msdlab")), (Path(folder), Path(INSIDE_FOLDER))]
+    parents = {parent for _, inside in binds for parent in inside.parents}
+    for parent in sorted(parents - {Path("/"), Path(INSIDE_SCRATCH)}):  # bwrap's own are 0700
+        wrap += ["--perms", "0755", "--dir", str(parent)]
+    for source, inside in binds:
+        wrap += ["--ro-bind", str(source), str(inside)]
+    wrap += ["--chdir", INSIDE_SCRATCH]
+    if os.geteuid() == 0:
+        user = 65534 if uid is None else uid
+        drop = [f"--reuid={user}", f"--regid={user}", "--clear-groups", "--no-new-privs"]
+        drop += ["--inh-caps=-all", "--bounding-set=-all"]
+        return [*wrap, "--", "/usr/bin/setpriv", *drop, "--", *command]
+    return [*wrap, "--disable-userns", "--", *command]
+
+
+def isolation_problem(level: str = "namespace") -> str | None:
+    """Why sandboxes of isolation ``level`` cannot start here (None if they can),
+    with how to enable them; tried once with a tiny sandbox."""
+    if level not in ISOLATION_LEVELS:
+        return f"unknown isolation {level!r}; choose one of {', '.join(ISOLATION_LEVELS)}"
+    if level == "process":
+        return None
+    if shutil.which("bwrap") is None:
+        return (
+            f"the grading sandbox needs bubblewrap (bwrap), which is not installed: {ENABLE_HINT}"
+        )
+    if os.geteuid() == 0 and not Path("/usr/bin/setpriv").is_file():
+        return "the grading sandbox needs /usr/bin/setpriv (util-linux) when run as root"
+    with tempfile.TemporaryDirectory(prefix="msdlab-probe-") as folder:
+        path = [INSIDE_LIBRARY, *_sites()]
+        command = [
+            sys.executable,
+            "-I",
+            "-S",
+            "-c",
+            f"import sys; sys.path[:0] = {path!r}; import msdlab",
+        ]
+        try:
+            result = subprocess.run(
+                bubblewrap_command(Path(folder), command, None),
+                capture_output=True,
+                timeout=STARTUP_SECONDS,
+                env={"PATH": "/usr/bin:/bin"},
+                check=False,
+            )
+        except (OSError, subprocess.TimeoutExpired) as error:
+            return f"the grading sandbox could not start ({error}): {ENABLE_HINT}"
+    if result.returncode != 0:
+        reason = result.stderr.decode(errors="replace").strip().splitlines()[-1:] or ["?"]
+        return f"the grading sandbox could not start ({reason[0]}): {ENABLE_HINT}"
+    return None
+
+
+def _sites() -> list[str]:
+    """The folders of the installed libraries: this environment's and those numpy and
+    scipy were imported from."""
+    import scipy
+
+    folders = {sysconfig.get_paths()["purelib"], sysconfig.get_paths()["platlib"]}
+    folders |= {str(Path(module.__file__).parents[1]) for module in (np, scipy)}
+    return sorted(folders)
 
 
 class SandboxError(Exception):
@@ -78,24 +184,21 @@ class SandboxProcess:
         *,
         timeout: float = 60.0,
         memory_bytes: int = 2 * 2**30,
-        hide: Sequence[Path] = (),
         uid: int | None = None,
+        isolation: str = "namespace",
     ) -> None:
+        if isolation not in ISOLATION_LEVELS:
+            raise ValueError(f"isolation must be one of {ISOLATION_LEVELS}, not {isolation!r}")
         self.folder = Path(folder).resolve()
         self.timeout = timeout
         self.memory_bytes = memory_bytes
-        hidden = [Path(p).resolve() for p in hide if Path(p).exists()]
-        self.hide = [
-            p for p in hidden if not self.folder.is_relative_to(p)
-        ]  # never the folder graded
         self.uid = uid if uid is not None else 65534
-        self.strong = os.geteuid() == 0 and bool(
-            shutil.which("unshare") and shutil.which("setpriv")
-        )
+        self.strong = isolation == "namespace"
         self.generation = 0
         self.process: subprocess.Popen | None = None
-        self.scratch = Path(tempfile.mkdtemp(prefix="msdlab-sandbox-"))
-        self.scratch.chmod(0o755)
+        self.scratch = Path(tempfile.mkdtemp(prefix="msdlab-sandbox-"))  # the grader's files
+        (self.scratch / "lib").mkdir()
+        (self.scratch / "lib" / "msdlab").symlink_to(PACKAGE, target_is_directory=True)
         self.exports: dict[int, Any] = {}
         self.members: dict[tuple[int, str], wire.Ref] = {}
         self.broken: dict[str, SandboxError] = {}  # name -> its failure, until `forgive`
@@ -104,22 +207,18 @@ class SandboxProcess:
     def isolation(self) -> str:
         """A short description of the isolation in force."""
         if self.strong:
-            return "own user and mount namespace, audit hook, resource limits"
-        return "separate process, audit hook, resource limits"
+            return "own namespaces (bubblewrap), resource limits, audit hook"
+        return "separate process as the grader's user, resource limits, audit hook"
 
     # ------------------------------------------------------------ lifecycle
     def start(self) -> None:
-        """Start the child and wait until it answers; fall back to the weaker isolation if
-        the strong one cannot start (e.g. the interpreter is not readable by the sandbox user)."""
+        """Start the child and wait until it answers (never falling back to weaker isolation)."""
         self._launch()
         try:
             self.request({"op": "ping"}, timeout=STARTUP_SECONDS)
-        except SandboxError:
-            if not self.strong:
-                raise SandboxError(f"cannot start the grading sandbox: {self.log_tail()}") from None
-            self.strong = False
-            self._launch()
-            self.request({"op": "ping"}, timeout=STARTUP_SECONDS)
+        except SandboxError as error:
+            reason = f"cannot start the grading sandbox ({error}): {self.log_tail()}"
+            raise SandboxError(reason) from None
 
     def log_tail(self, limit: int = 2000) -> str:
         """The end of what the submission printed (its stdout and stderr)."""
@@ -130,30 +229,33 @@ class SandboxProcess:
 
     def _launch(self) -> None:
         self.close()
-        lib = self.scratch / "lib"
-        lib.mkdir(parents=True, exist_ok=True)
-        link = lib / "msdlab"
-        if not link.exists():
-            link.symlink_to(PACKAGE, target_is_directory=True)
         to_child, self._send_fd = os.pipe()
         self._recv_fd, from_child = os.pipe()
-        sites = sorted({sysconfig.get_paths()["purelib"], sysconfig.get_paths()["platlib"]})
+        sites = _sites()
+        if self.strong:
+            folder, scratch, library = INSIDE_FOLDER, INSIDE_SCRATCH, INSIDE_LIBRARY
+        else:  # a fresh scratch each start: nothing planted there runs on the next one
+            shutil.rmtree(self.scratch / "scratch", ignore_errors=True)
+            (self.scratch / "scratch").mkdir()
+            folder, scratch, library = (
+                str(self.folder),
+                str(self.scratch / "scratch"),
+                str(self.scratch / "lib"),
+            )
+        child = f"{library}/msdlab/instructor/{CHILD.name}"
         config = {
-            "folder": str(self.folder),
-            "scratch": str(self.scratch),
-            "log": str(self.scratch / "output.log"),
-            "sys_path": [str(lib), *sites],
-            "read_roots": [str(self.folder), str(PACKAGE), sys.prefix, sys.base_prefix, *sites],
+            "folder": folder,
+            "scratch": scratch,
+            "sys_path": [library, *sites],
+            "read_roots": [folder, library, sys.prefix, sys.base_prefix, *sites],
             "memory_bytes": self.memory_bytes,
+            "cpu_seconds": int(max(600.0, 100 * self.timeout)),  # a whole set of checks
             "in_fd": to_child,
             "out_fd": from_child,
         }
-        command = [sys.executable, "-I", "-S", "-B", str(CHILD), json.dumps(config)]
+        command = [sys.executable, "-I", "-S", "-B", child, json.dumps(config)]
         if self.strong:
-            os.chown(self.scratch, self.uid, self.uid)
-            for path in self.scratch.rglob("*"):
-                os.lchown(path, self.uid, self.uid)
-            command = self._isolated(command)
+            command = bubblewrap_command(self.folder, command, self.uid)
         environment = {
             "PATH": "/usr/bin:/bin",
             "MSDLAB_KERNEL": "numpy",
@@ -161,39 +263,20 @@ class SandboxProcess:
             "OMP_NUM_THREADS": "1",
             "MKL_NUM_THREADS": "1",
         }
-        self.process = subprocess.Popen(
-            command,
-            pass_fds=(to_child, from_child),
-            stdin=subprocess.DEVNULL,
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
-            env=environment,
-            start_new_session=True,
-        )
+        with (self.scratch / "output.log").open("ab") as log:  # the grader's side only
+            self.process = subprocess.Popen(
+                command,
+                pass_fds=(to_child, from_child),
+                stdin=subprocess.DEVNULL,
+                stdout=log,
+                stderr=log,
+                env=environment,
+                start_new_session=True,
+            )
         os.close(to_child)
         os.close(from_child)
         self.exports.clear()
         self.members.clear()
-
-    def _isolated(self, command: list[str]) -> list[str]:
-        """``command`` wrapped to run in a private mount namespace under ``self.uid``."""
-        mounts = [
-            f"mount -t tmpfs -o size=4k,mode=0555 none {shlex.quote(str(p))}" for p in self.hide
-        ]
-        drop = f'exec setpriv --reuid={self.uid} --regid={self.uid} --clear-groups -- "$@"'
-        script = " && ".join([*mounts, drop])
-        return [
-            "unshare",
-            "--mount",
-            "--propagation",
-            "private",
-            "--",
-            "sh",
-            "-c",
-            script,
-            "sh",
-            *command,
-        ]
 
     def close(self) -> None:
         """Kill the child (and anything it started) and close the pipes; its objects are gone."""

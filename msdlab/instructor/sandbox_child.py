@@ -21,12 +21,10 @@ from typing import Any
 def main(config: dict[str, Any]) -> None:
     _die_with_parent()
     sys.path[:0] = config["sys_path"]
-    log = os.open(config["log"], os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o600)
-    os.dup2(log, 1)  # what the submission prints goes to its log, never to the grader
-    os.dup2(log, 2)
+    # stdout and stderr are the grader's log of what the submission printed
     sys.stdout = os.fdopen(1, "w", buffering=1)
     sys.stderr = os.fdopen(2, "w", buffering=1)
-    _limit_resources(config["memory_bytes"])
+    _limit_resources(config["memory_bytes"], config["cpu_seconds"])
     import importlib.util
 
     import numpy  # noqa: F401  trusted libraries load before the guard
@@ -47,18 +45,25 @@ def _die_with_parent() -> None:
     import ctypes
     import signal
 
+    parent = os.getppid()  # in a PID namespace the parent may be 1 (bubblewrap's init)
     with contextlib.suppress(OSError, AttributeError):  # not Linux: time limits still apply
         ctypes.CDLL(None).prctl(1, int(signal.SIGKILL))  # PR_SET_PDEATHSIG
-    if os.getppid() == 1:  # the grader died before we asked
+    if os.getppid() != parent:  # the grader died before we asked
         os._exit(1)
 
 
-def _limit_resources(memory_bytes: int) -> None:
+MAX_PROCESSES = 32  # of the sandbox's user: threads and helpers, not a fork bomb
+
+
+def _limit_resources(memory_bytes: int, cpu_seconds: int) -> None:
+    """Memory (bytes), CPU time (s), file size, processes of this user, no core dumps."""
     import resource
 
     for limit, value in (
         (resource.RLIMIT_AS, memory_bytes),
+        (resource.RLIMIT_CPU, cpu_seconds),
         (resource.RLIMIT_FSIZE, 64 * 2**20),
+        (resource.RLIMIT_NPROC, MAX_PROCESSES),
         (resource.RLIMIT_CORE, 0),
     ):
         resource.setrlimit(limit, (value, value))

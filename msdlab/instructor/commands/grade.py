@@ -17,7 +17,7 @@ import time
 from pathlib import Path
 
 from ...course import PROJECT_ROOT
-from .. import grading
+from .. import grading, sandbox
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -48,6 +48,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default=PROJECT_ROOT / "tests" / "tasks",
         help="folder of the checks, hidden ones included (default: the course's tests/tasks)",
     )
+    parser.add_argument(
+        "--isolation",
+        choices=sandbox.ISOLATION_LEVELS,
+        default="namespace",
+        help="namespace (default): each submission in its own namespaces (bubblewrap), "
+        "seeing only its task files; process: a plain child process, weaker, named in "
+        "every row's notes",
+    )
     parser.set_defaults(run=run)
 
 
@@ -56,6 +64,10 @@ def run(args: argparse.Namespace) -> int:
         raise FileNotFoundError(f"no checks in {args.checks}; give --checks DIR")
     if args.jobs < 1 or args.timeout <= 0 or args.call_timeout <= 0 or args.memory < 256:
         raise ValueError("--jobs >= 1, --timeout and --call-timeout > 0 and --memory >= 256 MB")
+    problem = sandbox.isolation_problem(args.isolation)
+    if problem is not None:
+        print(f"msdlab grade: {problem}", file=sys.stderr)
+        return 2
     submissions = grading.find_submissions(args.submissions)
     width = max(len(s.name) for s in submissions)
     print(f"grading {len(submissions)} submissions, {args.jobs} at a time", file=sys.stderr)
@@ -77,6 +89,7 @@ def run(args: argparse.Namespace) -> int:
         timeout=args.timeout,
         call_timeout=args.call_timeout,
         memory_mb=args.memory,
+        isolation=args.isolation,
     )
     grading.write_csv(grades, args.out)
     if args.feedback is not None:
@@ -84,5 +97,8 @@ def run(args: argparse.Namespace) -> int:
         for grade in grades:
             (args.feedback / f"{grade.submission}.md").write_text(grading.feedback(grade))
     print(grading.summary(grades, time.monotonic() - started))
+    if args.isolation != "namespace":
+        print(f"isolation: {args.isolation} (weaker than namespace; submissions were not "
+              "isolated by the operating system)")  # fmt: skip
     print(f"grades written to {args.out}")
     return 0 if all(grade.graded for grade in grades) else 1
