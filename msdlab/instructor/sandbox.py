@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from ..course.delegation import DelegationRefused
 from ..integrators import Integrator
 from . import wire
 
@@ -99,6 +100,7 @@ class SandboxProcess:
         self.exports: dict[int, Any] = {}
         self.members: dict[tuple[int, str], wire.Ref] = {}
         self.broken: dict[str, SandboxError] = {}  # name -> its failure, until `forgive`
+        self.refused_task: int | None = None  # whose engine answers the submission may not use
 
     @property
     def isolation(self) -> str:
@@ -387,6 +389,8 @@ def _raise(error: dict) -> None:
     name, message = str(error.get("type")), str(error.get("message"))
     where = str(error.get("traceback") or "")
     text = message + (f"\n(in the submission)\n{where.rstrip()}" if where else "")
+    if name == "DelegationRefused":  # the same failure as in one process
+        raise DelegationRefused(message)
     kind = getattr(builtins, name, None)
     if (
         isinstance(kind, type)
@@ -416,6 +420,7 @@ class RemoteObject:
 
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
         message = {"op": "call", "ref": self._ref, "args": args, "kwargs": kwargs}
+        message["refuse"] = self._sandbox.refused_task  # see msdlab.course.delegation
         arguments = {**{str(i): a for i, a in enumerate(args)}, **kwargs}
         arrays = {k: a for k, a in arguments.items() if isinstance(a, np.ndarray)}
         return self._request(message, f"{self._name}()", arrays)
@@ -496,6 +501,11 @@ class RemoteImplementation:
     def forgive(self) -> None:
         """A new check starts: functions that timed out may run again."""
         self.sandbox.forgive()
+
+    def refuse_delegation(self, task: int | None) -> None:
+        """From now on the engine's answer to ``task`` refuses the submission's calls (None:
+        nothing is refused); see `msdlab.course.delegation`."""
+        self.sandbox.refused_task = task
 
     def close(self) -> None:
         self.sandbox.cleanup()

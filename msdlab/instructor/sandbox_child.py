@@ -34,7 +34,10 @@ def main(config: dict[str, Any]) -> None:
     import scipy.sparse  # noqa: F401
 
     import msdlab  # noqa: F401
+    from msdlab.course import delegation
     from msdlab.instructor import wire
+
+    delegation.install()  # before the submission is imported: see msdlab.course.delegation
 
     _install_guard(config["read_roots"], config["scratch"])
     os.chdir(config["scratch"])
@@ -145,6 +148,7 @@ class Server:
             elif op == "call":
                 target = self.objects[request["ref"].id]
                 args, kwargs = self.local(request["args"]), self.local(request["kwargs"])
+                _refuse_delegation(request.get("refuse"), self.folder)
                 before = _array_arguments(args, kwargs)
                 value = target(*args, **kwargs)
                 changed = _changed_arguments(before, args, kwargs)
@@ -237,6 +241,13 @@ class GraderObject:
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
         message = {"op": "call", "ref": self._ref, "args": args, "kwargs": kwargs}
         return self._server.callback(message)
+
+
+def _refuse_delegation(task: Any, folder: str) -> None:
+    """The task being checked: the engine's answer to it refuses the submission's calls."""
+    from msdlab.course import delegation
+
+    delegation.set_refused(task if isinstance(task, int) else None, folder)
 
 
 def _array_arguments(args: tuple, kwargs: dict) -> dict[str, Any]:
