@@ -199,8 +199,11 @@ def _hypothesis_profile() -> None:
     settings.load_profile("ci")
 
 
-class CheckTimeout(Exception):
-    """A check ran longer than its time limit (an endless loop in the code under test?)."""
+class CheckTimeout(BaseException):
+    """A check ran longer than its time limit (an endless loop in the code under test?).
+
+    Not an `Exception`, so that hypothesis does not catch it and shrink an endless example.
+    """
 
 
 @contextlib.contextmanager

@@ -89,3 +89,20 @@ def test_verlet_step_leaves_its_inputs_alone(task1):
         "x(t) and x(t - dt) (the template rotates its three buffers)",
     )
     expect(got.shape == current.shape, saw=f"verlet_step returned shape {got.shape}")
+
+
+@pytest.mark.points(1)
+def test_steps_to_floor_refuses_a_start_on_or_below_the_floor(task1):
+    """steps_to_floor needs y0 > 0: a start on or below the floor is refused with ValueError."""
+    for y0 in (0.0, -0.5):
+        try:
+            got = task1.steps_to_floor(y0, 0.1, -0.001)
+        except ValueError:
+            continue
+        expect(
+            False,
+            saw=f"steps_to_floor({y0}, 0.1, -0.001) returned {got!r} for a particle that starts "
+            "on or below the floor",
+            cause="no check of the inputs: raise ValueError unless y0 > 0 and g < 0, as the "
+            "docstring asks (a negative height has no first floor contact)",
+        )

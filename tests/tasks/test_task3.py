@@ -32,6 +32,23 @@ def springs_of(body):
     return np.stack([body.spring_a, body.spring_b], axis=1), body.rest_lengths.copy()
 
 
+def rotation_at_fault(task3):
+    """Why drop_rotated_cube may be wrong because of another function of the task, or None."""
+    grid = oracles.template_positions((2, 3, 2), 0.5, (0.0, 1.0, 0.0))
+    try:
+        got = np.asarray(task3.rotate_layout(grid.copy(), (0.0, 0.0, 1.0), 45.0), dtype=float)
+    except Exception as error:
+        return f"your rotate_layout fails ({type(error).__name__}), and the cube is turned by it"
+    centroid = grid.reshape(-1, 3).mean(axis=0)
+    turned = (grid - centroid) @ msd.rotation_matrix(45.0, (0.0, 0.0, 1.0)).T + centroid
+    if got.shape != grid.shape or not np.allclose(got, turned, atol=1e-9):
+        return (
+            "your rotate_layout does not turn the layout right (see its check), and the "
+            "cube is turned by it"
+        )
+    return None
+
+
 def student_acceleration(task3, positions, springs, rest, stiffness):
     got = task3.spring_acceleration(positions.copy(), springs.copy(), rest.copy(), stiffness)
     return as_array(got, "spring_acceleration", positions.shape)
@@ -210,12 +227,13 @@ def test_tilted_cube_collapses_upright_one_stands(task3):
                 got < 0.3,
                 saw=f"a cube with axis springs only, tilted {angle}° about {axis}, kept "
                 f"{percent(got)} of its thickness",
-                cause="springs beyond the 6 axis neighbours, or the cube was not rotated",
+                cause=rotation_at_fault(task3)
+                or "springs beyond the 6 axis neighbours, or the cube was not rotated",
             )
         else:
             expect(
                 got > 0.9,
                 saw=f"a cube turned {angle}° about the vertical axis {axis} kept only "
                 f"{percent(got)} of its thickness; its springs still carry gravity vertically",
-                cause="rotating about the wrong axis",
+                cause=rotation_at_fault(task3) or "rotating about the wrong axis",
             )

@@ -108,3 +108,23 @@ def test_cube_tilted_about_x_collapses(task3):
             cause="a different experiment: check the rotation, the lift to y = LIFT, the "
             "number of steps, dt, gravity and the floor",
         )
+
+
+@pytest.mark.points(1)
+def test_drop_rotated_cube_uses_steps_and_neighbours(task3):
+    """One step leaves the cube as it was; with 1, √2, √3 springs the tilted cube stands."""
+    still = float(task3.drop_rotated_cube((0.0, 0.0, 1.0), 45.0, (1,), steps=1))
+    expect(
+        abs(still - 1.0) < 0.01,
+        saw=f"drop_rotated_cube(..., steps=1) = {num(still)}: in a single step the cube "
+        "cannot change its shape that much",
+        cause="the number of steps is ignored (run `steps` steps, not a fixed number)",
+    )
+    held = float(task3.drop_rotated_cube((0.0, 0.0, 1.0), 45.0, (1, 2, 3)))
+    expected = reference.drop_rotated_cube((0.0, 0.0, 1.0), 45.0, (1, 2, 3))
+    expect(
+        abs(held - expected) < 0.1,
+        saw=f"with springs to neighbours (1, 2, 3) the tilted cube's flatness ratio is "
+        f"{num(held)}, the experiment gives {num(expected)} (it stands)",
+        cause="the neighbours argument is ignored: pass it to msd.Body.grid",
+    )

@@ -38,6 +38,23 @@ def student_springs(task4, shape, spacing, neighbours):
     return springs.astype(np.int64), rest
 
 
+def springs_at_fault(task4):
+    """Why drop_rotated_cube may be wrong because of grid_springs, or None."""
+    expected, body = engine_pairs((2, 2, 3), (1, 2, 3))
+    try:
+        springs, rest = student_springs(task4, (2, 2, 3), 1.0, (1, 2, 3))
+    except Exception as error:
+        return f"your grid_springs fails ({type(error).__name__}), and the cube is built with it"
+    lengths = {frozenset(p): r for p, r in zip(springs.tolist(), rest.tolist())}
+    wrong_rest = any(
+        not np.isclose(lengths.get(frozenset(p), -1.0), r)
+        for p, r in zip(zip(body.spring_a.tolist(), body.spring_b.tolist()), body.rest_lengths)
+    )
+    if len(springs) != len(expected) or set(lengths) != expected or wrong_rest:
+        return "your grid_springs is wrong (see its checks), and the cube is built with it"
+    return None
+
+
 def missing_and_extra(springs, expected):
     found = [frozenset(p) for p in springs.tolist()]
     return expected - set(found), set(found) - expected, len(found) - len(set(found))
@@ -123,14 +140,15 @@ def test_rotated_cube_holds_its_shape(task4):
         held > 0.9,
         saw=f"with 26 neighbours, tilted {angle}° about z, the cube kept {percent(held)} of its "
         "thickness; the diagonal springs give it the shear stiffness to stand",
-        cause="missing diagonal springs or wrong rest lengths, or a different experiment",
+        cause=springs_at_fault(task4)
+        or "missing diagonal springs or wrong rest lengths, or a different experiment",
     )
     folded = float(task4.drop_rotated_cube(axis, angle, (1,)))
     expect(
         folded < 0.3,
         saw=f"with axis springs only the tilted cube kept {percent(folded)} of its thickness; "
         "it has no shear stiffness and should fold flat",
-        cause="drop_rotated_cube ignores squared_distances",
+        cause=springs_at_fault(task4) or "drop_rotated_cube ignores squared_distances",
     )
 
 
@@ -150,3 +168,17 @@ def test_step_cost_reports_springs_and_time(task4):
             saw=f"step_cost(6, {neighbours}) reports {num(seconds)} s per step",
             cause="the total time not divided by the number of steps, or a wrong clock",
         )
+    springs, _ = task4.step_cost(3, (1,), 1)
+    expect(
+        springs == 54,
+        saw=f"step_cost(3, (1,)) counts {springs} springs, a 3³ grid has 54 axis springs",
+        cause="the size n is ignored: build the n³ grid",
+    )
+    few = float(task4.step_cost(6, (1, 2, 3), 2)[1])
+    many = float(task4.step_cost(6, (1, 2, 3), 40)[1])
+    expect(
+        many < 6 * few,
+        saw=f"step_cost reports {num(few)} s per step for 2 steps but {num(many)} s per step "
+        "for 40 steps of the same grid: the time grows with the number of steps",
+        cause="the total time of all steps reported instead of the time per step (divide by steps)",
+    )

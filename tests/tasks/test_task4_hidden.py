@@ -69,3 +69,15 @@ def test_cube_tilted_about_x_holds(task4):
         cause="a different experiment: check the rotation, the lift to y = LIFT, the number "
         "of steps, dt, gravity and the floor",
     )
+
+
+@pytest.mark.points(1)
+def test_drop_rotated_cube_runs_the_steps_asked_for(task4):
+    """drop_rotated_cube(..., steps=1) leaves the cube as it was: ratio 1."""
+    still = float(task4.drop_rotated_cube((0.0, 0.0, 1.0), 45.0, (1,), steps=1))
+    expect(
+        abs(still - 1.0) < 0.01,
+        saw=f"drop_rotated_cube(..., steps=1) = {num(still)}: in a single step the cube "
+        "cannot change its shape that much",
+        cause="the number of steps is ignored (run `steps` steps, not a fixed number)",
+    )
