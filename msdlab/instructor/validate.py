@@ -11,6 +11,7 @@ and a time limit. `validate` runs them on
   (operators, operands, constants, comparisons, dropped terms, signs). A mutant is *killed*
   when a check fails on it; the report names the checks that kill each mutant and lists the
   survivors, which are either equivalent to the solution or a mistake no check catches.
+  A mutant runs only the checks that reach the function it changes (`reached`).
 
 Mutation tools such as mutmut mutate a whole package and report per test-suite run; a
 per-check kill matrix of a single file's solution blocks, judged by checks that take the
@@ -155,15 +156,81 @@ def run_source(
     source: str, task: int, checks: Sequence[Check], **options: Any
 ) -> dict[str, Outcome]:
     """`run_checks` on a task file given as text (written to a fresh folder and imported)."""
+    with _task_file(source, task) as (module, folder, failure):
+        if failure is not None:  # a version that does not even import fails every check
+            return {check.name: failure for check in checks}
+        return run_checks(checks, module, folder, **options)
+
+
+def reached(source: str, task: int, checks: Sequence[Check], **options: Any) -> dict[str, set]:
+    """Per check, the top-level functions and classes of the task file it can reach.
+
+    The checks are run on ``source`` (the solution) with a module that records which of
+    its names each check uses; the file's own calls between its functions are added, so
+    a change inside a function matters only to the checks listed with it.
+    """
+    calls = _calls_between_definitions(source)
+    used: dict[str, set] = {}
+    with _task_file(source, task) as (module, folder, failure):
+        if failure is not None:
+            raise ValueError(f"task{task}.py does not import: {failure.message}")
+        for check in checks:
+            recorder = _Recorder(module)
+            run_checks([check], recorder, folder, **options)
+            found, todo = set(), list(recorder.names)
+            while todo:
+                name = todo.pop()
+                if name not in found:
+                    found.add(name)
+                    todo += calls.get(name, ())
+            used[check.name] = found
+    return used
+
+
+def definition_at(source: str, line: int) -> str | None:
+    """The name of the top-level function or class whose code holds ``line``."""
+    for node in ast.parse(source).body:
+        inside = node.lineno <= line <= (getattr(node, "end_lineno", None) or node.lineno)
+        if isinstance(node, (ast.FunctionDef, ast.ClassDef)) and inside:
+            return node.name
+    return None
+
+
+class _Recorder:
+    """A task module that notes the names the checks take from it."""
+
+    def __init__(self, module: Any) -> None:
+        self._module, self.names = module, set()
+
+    def __getattr__(self, name: str) -> Any:
+        self.names.add(name)
+        return getattr(self._module, name)
+
+
+def _calls_between_definitions(source: str) -> dict[str, set[str]]:
+    """For each top-level function or class: the file's other top-level names it uses."""
+    tree = ast.parse(source)
+    defined = {n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
+    return {
+        node.name: {n.id for n in ast.walk(node) if isinstance(n, ast.Name) and n.id in defined}
+        - {node.name}
+        for node in tree.body
+        if isinstance(node, (ast.FunctionDef, ast.ClassDef))
+    }
+
+
+@contextlib.contextmanager
+def _task_file(source: str, task: int) -> Iterator[tuple[Any, Path, Outcome | None]]:
+    """The task module made from ``source`` in a fresh folder (or why it does not import)."""
     folder = Path(tempfile.mkdtemp(prefix="msdlab-validate-"))
     try:
         (folder / f"task{task}.py").write_text(source)
         try:
             module = FolderImplementation(folder).task(task)
-        except Exception as error:  # a version that does not even import fails every check
-            failed = Outcome(False, type(error).__name__, _message(error))
-            return {check.name: failed for check in checks}
-        return run_checks(checks, module, folder, **options)
+        except Exception as error:
+            yield None, folder, Outcome(False, type(error).__name__, _message(error))
+        else:
+            yield module, folder, None
     finally:
         shutil.rmtree(folder, ignore_errors=True)
 
@@ -344,8 +411,11 @@ def validate(
         if sample is not None and sample < len(chosen):
             chosen = sorted(random.Random(seed).sample(chosen, sample), key=lambda m: m.line)
         report.mutants = len(chosen)
+        uses = reached(source, task, checks, seconds=seconds)
         for number, mutant in enumerate(chosen, start=1):
-            outcomes = run_source(mutant.source, task, checks, seconds=seconds)
+            changed = definition_at(source, mutant.line)
+            concerned = [c for c in checks if changed is None or changed in uses[c.name]]
+            outcomes = run_source(mutant.source, task, concerned, seconds=seconds)
             report.kills[mutant.label] = [n for n, o in outcomes.items() if not o.passed]
             if progress is not None:
                 progress(f"task {task}: mutant {number}/{len(chosen)} {mutant.label}")
