@@ -32,6 +32,17 @@ def springs_of(body):
     return np.stack([body.spring_a, body.spring_b], axis=1), body.rest_lengths.copy()
 
 
+def matrix_at_fault(task3, axis, angle):
+    """Why rotate_layout may be wrong because rotation_matrix is, or None."""
+    try:
+        got = np.asarray(task3.rotation_matrix(axis, angle), dtype=float)
+    except Exception as error:
+        return f"your rotation_matrix fails ({type(error).__name__}), and rotate_layout uses it"
+    if got.shape != (3, 3) or not np.allclose(got, msd.rotation_matrix(angle, axis), atol=1e-9):
+        return "your rotation_matrix is wrong (see its check), and rotate_layout uses it"
+    return None
+
+
 def rotation_at_fault(task3):
     """Why drop_rotated_cube may be wrong because of another function of the task, or None."""
     grid = oracles.template_positions((2, 3, 2), 0.5, (0.0, 1.0, 0.0))
@@ -111,6 +122,9 @@ def test_rotate_layout_turns_about_centroid(task3):
                 "x @ R rotates by -angle; row vectors need x @ R.T": (
                     (grid - centroid) @ msd.rotation_matrix(angle, axis) + centroid
                 ),
+                "the angle argument is ignored (always 45°)": (
+                    (grid - centroid) @ msd.rotation_matrix(45.0, axis).T + centroid
+                ),
             },
         )
         moved = got.reshape(-1, 3).mean(axis=0) - centroid
@@ -119,7 +133,9 @@ def test_rotate_layout_turns_about_centroid(task3):
             saw=f"rotate_layout(grid, {axis}, {angle}) moved the centroid by {vec(moved)} and "
             f"puts particles up to {num(np.max(np.abs(got - expected)))} away from the rotated "
             "grid",
-            cause=mistake or "rotate every position p to R (p - c) + c, c the centroid",
+            cause=mistake
+            or matrix_at_fault(task3, axis, angle)
+            or "rotate every position p to R (p - c) + c, c the centroid",
         )
 
 
@@ -144,6 +160,7 @@ def compare_with_engine(got, body, x, what):
             "-f_ij is never added to particle j": oracles.one_sided_acceleration(
                 x, springs, rest, stiffness
             ),
+            **oracles.spring_list_mistakes(x, springs, rest, stiffness),
         },
     )
     expect(

@@ -68,16 +68,28 @@ def test_neighbour_offsets_26(task4):
         expect(
             offsets.ndim == 2 and offsets.shape[1:] == (3,),
             saw=f"neighbour_offsets({wanted}) has shape {offsets.shape}, expected (M, 3)",
+            cause="no offsets at all: none of squared length "
+            f"{' or '.join(map(str, wanted))} was kept (e.g. a test that leaves out the body "
+            "diagonals)"
+            if offsets.size == 0
+            else "",
         )
         unique = {tuple(o) for o in offsets.astype(int).tolist()}
         lengths = sorted({int(np.sum(np.square(o))) for o in unique})
+        if 0 in lengths:
+            cause = "the zero offset (the particle itself) is included"
+        elif lengths != sorted(wanted):
+            cause = f"offsets of squared lengths {lengths}, not the {sorted(wanted)} asked for"
+        elif len(unique) * 2 == count:
+            cause = "only one of o and -o (both directions are neighbours)"
+        else:
+            cause = "offsets listed twice, or some of them missing"
         expect(
             len(offsets) == len(unique) == count and lengths == sorted(wanted),
             saw=f"neighbour_offsets({wanted}) gives {len(offsets)} offsets ({len(unique)} "
             f"different) of squared lengths {lengths}; an interior particle has {count} such "
             "neighbours",
-            cause="only one of o and -o (both directions are neighbours), the zero offset "
-            "included, or offsets of other squared lengths",
+            cause=cause,
         )
         expect(
             all(tuple(-np.array(o)) in unique for o in unique),
@@ -100,10 +112,22 @@ def test_grid_springs_each_pair_once(task4):
             saw=f"for {kinds} springs of a {SHAPE} grid you give {len(springs)} springs, "
             f"{len(expected)} expected: {len(missing)} missing, {len(extra)} that are not "
             f"neighbour pairs, {repeated} listed twice (e.g. particles {example})",
-            cause="both i→j and j→i listed (a spring counted twice doubles its force), "
-            "neighbours across the border wrapped around, or C order mixed up "
-            "(index = (i·ny + j)·nz + k)",
+            cause=pairs_cause(missing, extra, repeated, len(springs), len(expected)),
         )
+
+
+def pairs_cause(missing, extra, repeated, given, expected):
+    """The usual cause of a wrong list of grid springs."""
+    if repeated or (given == 2 * expected and not missing):
+        return "both i→j and j→i listed (a spring counted twice doubles its force)"
+    if missing and not extra:
+        return (
+            "springs missing at the border: each offset joins every particle whose "
+            "neighbour (i, j, k) + offset is inside the grid, up to the last one"
+        )
+    if missing and extra and given == expected:
+        return "C order mixed up: particle (i, j, k) is row (i·ny + j)·nz + k"
+    return "neighbours across the border wrapped around, or offsets of the wrong kind"
 
 
 @pytest.mark.points(2)
@@ -161,7 +185,9 @@ def test_step_cost_reports_springs_and_time(task4):
         expect(
             springs == expected,
             saw=f"step_cost(6, {neighbours}) counts {springs} springs, a 6³ grid has {expected}",
-            cause="springs counted twice or the wrong neighbours",
+            cause="springs counted twice"
+            if springs == 2 * expected
+            else "the wrong neighbours, or a grid other than n³ (is n ignored?)",
         )
         expect(
             math.isfinite(seconds) and 0 < seconds < 1.0,

@@ -30,20 +30,42 @@ def test_any_grid_shape_and_neighbours(task4, shape, neighbours, spacing):
     body = oracles.grid_body(shape, spacing, 1.0, neighbours)
     expected = {frozenset(p) for p in zip(body.spring_a.tolist(), body.spring_b.tolist())}
     found = [frozenset(p) for p in springs.tolist()]
+    positions = body.positions
+
+    def kinds(pairs):
+        """The squared lengths (in grid units) of index pairs of the grid at rest."""
+        return sorted(
+            {
+                round(float(np.sum(np.square(positions[a] - positions[b]))) / spacing**2)
+                for a, b in map(tuple, pairs)
+                if a != b
+            }
+        )
+
+    missing, wrong = expected - set(found), set(found) - expected
+    if missing and not wrong and kinds(missing) != kinds(expected):
+        cause = f"all springs of squared length {kinds(missing)} are missing"
+    elif wrong and not missing and set(kinds(wrong)) - set(neighbours):
+        cause = (
+            f"springs of squared length {kinds(wrong)} given, {sorted(neighbours)} were asked for"
+        )
+    else:
+        cause = "a loop bound or border test that only works for some grid sizes"
     expect(
         len(found) == len(expected) and set(found) == expected,
         saw=f"for a {shape} grid with neighbours {neighbours}: {len(found)} springs given, "
-        f"{len(expected)} expected ({len(expected - set(found))} missing, "
-        f"{len(set(found) - expected)} wrong)",
-        cause="a loop bound or border test that only works for some grid sizes",
+        f"{len(expected)} expected ({len(missing)} missing, {len(wrong)} wrong)",
+        cause=cause,
     )
-    positions = body.positions
     distance = np.linalg.norm(positions[springs[:, 0]] - positions[springs[:, 1]], axis=1)
     expect(
         np.allclose(rest, distance, rtol=1e-9),
         saw=f"rest lengths differ from the distances at rest by up to "
         f"{num(np.max(np.abs(rest - distance), initial=0.0))}",
-        cause="rest lengths not scaled by the spacing",
+        cause="rest lengths not scaled by the spacing"
+        if np.allclose(rest, distance / spacing, rtol=1e-9)
+        else "rest lengths that are not spacing·√(squared length) of each spring (the "
+        "distance at rest)",
     )
 
 

@@ -283,8 +283,8 @@ def test_measured_stable_dt_as_predicted(task5):
             saw=f"with λ = {lam} you measured a largest stable dt of {num(measured[lam])}, the "
             f"predicted limit √(4 - 2λ)/ω is {num(predicted)}",
             cause=step_at_fault(task5)
-            or "a different body than jelly(n), or a measurement that does not use your "
-            "DampedVerlet",
+            or "a different body than jelly(n), a measurement that does not use your "
+            "DampedVerlet, or the damping λ is not passed on",
         )
     expect(
         measured[0.5] < measured[0.0],
