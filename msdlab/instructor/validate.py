@@ -162,12 +162,19 @@ def run_source(
         return run_checks(checks, module, folder, **options)
 
 
-def reached(source: str, task: int, checks: Sequence[Check], **options: Any) -> dict[str, set]:
+def reached(
+    source: str,
+    task: int,
+    checks: Sequence[Check],
+    outcomes: dict[str, Outcome] | None = None,
+    **options: Any,
+) -> dict[str, set]:
     """Per check, the top-level functions and classes of the task file it can reach.
 
     The checks are run on ``source`` (the solution) with a module that records which of
     its names each check uses; the file's own calls between its functions are added, so
-    a change inside a function matters only to the checks listed with it.
+    a change inside a function matters only to the checks listed with it. The checks'
+    outcomes on ``source`` go to ``outcomes`` if given.
     """
     calls = _calls_between_definitions(source)
     used: dict[str, set] = {}
@@ -176,7 +183,9 @@ def reached(source: str, task: int, checks: Sequence[Check], **options: Any) -> 
             raise ValueError(f"task{task}.py does not import: {failure.message}")
         for check in checks:
             recorder = _Recorder(module)
-            run_checks([check], recorder, folder, **options)
+            (outcomes if outcomes is not None else {}).update(
+                run_checks([check], recorder, folder, **options)
+            )
             found, todo = set(), list(recorder.names)
             while todo:
                 name = todo.pop()
@@ -401,7 +410,8 @@ def validate(
         checks = collect_checks(course / "tests" / "tasks", task)
         source = (course / "solutions" / f"task{task}.py").read_text()
         report = TaskReport(task, [c.name for c in checks])
-        solved = run_source(source, task, checks, seconds=seconds)
+        solved: dict[str, Outcome] = {}
+        uses = reached(source, task, checks, solved, seconds=seconds)
         report.solution_failures = {n: o for n, o in solved.items() if not o.passed}
         template = course / "assignments" / f"task{task}.py"
         if template.is_file():
@@ -411,7 +421,6 @@ def validate(
         if sample is not None and sample < len(chosen):
             chosen = sorted(random.Random(seed).sample(chosen, sample), key=lambda m: m.line)
         report.mutants = len(chosen)
-        uses = reached(source, task, checks, seconds=seconds)
         for number, mutant in enumerate(chosen, start=1):
             changed = definition_at(source, mutant.line)
             concerned = [c for c in checks if changed is None or changed in uses[c.name]]

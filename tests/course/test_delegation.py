@@ -3,14 +3,18 @@ submission's calls, and only the submission's."""
 
 from __future__ import annotations
 
+import shutil
+import subprocess
+import sys
 import textwrap
 
 import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab.course import delegation
+from msdlab.course import PROJECT_ROOT, delegation
 from msdlab.course.loader import FolderImplementation
+from msdlab.course.report import CheckReport
 
 SUBMISSION = """
 import numpy as np
@@ -73,3 +77,26 @@ def test_other_tasks_own_code_and_the_judge_are_not_refused(student):
     with delegation.refusing(5, folder):
         msd.Verlet(0.1).step(x, v, 0.1, dynamics)  # the checks' own oracles keep working
     module.Subclassed(0.1)  # outside a check nothing is refused
+
+
+def test_an_instructor_can_allow_delegation_per_task(tmp_path):
+    folder = tmp_path / "delegating"
+    shutil.copytree(PROJECT_ROOT / "solutions", folder)
+    task3 = folder / "task3.py"
+    solution = "rotation = rotation_matrix(axis, angle_degrees)"
+    task3.write_text(
+        task3.read_text().replace(solution, "rotation = msd.rotation_matrix(angle_degrees, axis)")
+    )
+
+    def lost(*options: str) -> list[str]:
+        report = tmp_path / "report.json"
+        command = [
+            sys.executable, "-m", "pytest", str(PROJECT_ROOT / "tests" / "tasks"), "-q",
+            "-m", "task3 and not hidden", "-k", "rotate_layout", f"--impl={folder}",
+            f"--msdlab-report={report}", "-p", "no:cacheprovider", *options,
+        ]  # fmt: skip
+        subprocess.run(command, cwd=PROJECT_ROOT, capture_output=True, check=False, timeout=300)
+        return [c.exception for c in CheckReport.read(report).checks if not c.passed]
+
+    assert lost() == ["DelegationRefused"]
+    assert lost("--allow-delegation=3") == []
