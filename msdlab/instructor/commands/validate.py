@@ -51,14 +51,19 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"no task {wrong[0]}: the tasks are {', '.join(map(str, TASKS))}")
     if args.sample is not None and args.sample < 0:
         raise ValueError(f"--sample must be >= 0, got {args.sample}")
-    reports = validate(
-        args.course,
-        args.tasks or TASKS,
-        sample=args.sample,
-        seed=args.seed,
-        seconds=args.seconds,
-        progress=lambda line: print(line, file=sys.stderr),
-    )
-    print(format_report(reports, verbose=args.verbose))
+    reports = []
+    for task in args.tasks or TASKS:  # each task's report as soon as it is done
+        (report,) = validate(
+            args.course,
+            [task],
+            sample=args.sample,
+            seed=args.seed,
+            seconds=args.seconds,
+            progress=lambda line: print(line, file=sys.stderr),
+        )
+        reports.append(report)
+        print(format_report([report], verbose=args.verbose), flush=True)
+    if len(reports) > 1:
+        print(format_report(reports).splitlines()[-1])  # all tasks together
     broken = any(r.solution_failures or r.template_passes for r in reports)
     return 1 if broken else 0
