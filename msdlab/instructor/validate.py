@@ -269,10 +269,17 @@ def _message(error: BaseException) -> str:
 
 
 def _hypothesis_profile() -> None:
-    from hypothesis import settings
+    """The checks' reproducible profile, without hypothesis's own failure printouts."""
+    from hypothesis import Verbosity, settings
 
-    settings.register_profile("ci", deadline=None, derandomize=True, database=None)
-    settings.load_profile("ci")
+    settings.register_profile(
+        "msdlab-validate",
+        deadline=None,
+        derandomize=True,
+        database=None,
+        verbosity=Verbosity.quiet,
+    )
+    settings.load_profile("msdlab-validate")
 
 
 class CheckTimeout(BaseException):
