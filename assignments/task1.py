@@ -147,7 +147,9 @@ def steps_to_floor(y0: float = ORIGIN[1], dt: float = DT, g: float = GRAVITY[1])
 
     That is the first step n whose new height (before the clamp) is <= 0: the
     step in which the floor clamp first acts on it. For the bottom layer of the
-    template (y0 = 1.5) this is close to 547. Needs y0 > 0 and g < 0.
+    template (y0 = 1.5) this is close to 547. Needs y0 > 0, g < 0 and dt > 0:
+    raise ValueError otherwise (a particle that starts on or below the floor, or
+    does not fall, has no first contact to count).
     """
     raise NotImplementedError(
         "Task 1: return the first step after which the particle is at or below the floor y = 0."

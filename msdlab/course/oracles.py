@@ -165,6 +165,48 @@ def wrapped_border_pairs(shape: Sequence[int]) -> np.ndarray:
     return np.concatenate(pairs) if pairs else np.zeros((0, 2), dtype=np.int64)
 
 
+TEMPLATE_STIFFNESS = 0.5  # k of the tasks' templates
+TEMPLATE_SPACING = 0.1  # 2/N of the template, N = 20
+
+
+def spring_list_mistakes(
+    positions: np.ndarray, springs: np.ndarray, rest_lengths: np.ndarray | float, stiffness: float
+) -> dict[str, np.ndarray]:
+    """Accelerations (N, 3) that typical mistakes in a sum of spring forces give, by cause."""
+    positions = np.asarray(positions, dtype=float)
+    springs = np.asarray(springs, dtype=np.int64).reshape(-1, 2)
+    rest = np.broadcast_to(np.asarray(rest_lengths, dtype=float), (len(springs),))
+    right = spring_acceleration(spring_body(positions, springs, rest, stiffness), positions)
+    one_sided = one_sided_acceleration(positions, springs, rest, stiffness)
+    length = np.linalg.norm(positions[springs[:, 0]] - positions[springs[:, 1]], axis=1)
+    unnormalised = spring_body(positions, springs, rest, 1.0)
+    unnormalised.stiffness[:] = stiffness * np.maximum(length, 1e-300)  # k|d| (l - |d|) d̂
+    count = np.bincount(springs.ravel(), minlength=len(positions)).astype(float)
+    mistakes = {}
+    if not np.isclose(stiffness, TEMPLATE_STIFFNESS):
+        mistakes[
+            f"the stiffness argument is ignored (k = {TEMPLATE_STIFFNESS} used instead of "
+            f"k = {stiffness:g})"
+        ] = right * TEMPLATE_STIFFNESS / stiffness
+    mistakes |= {
+        "-f_ij is never added to particle j: each spring acts on both of its ends": one_sided,
+        "the force is not divided by the spring length: f_ij = k (l - |x_i - x_j|) times the "
+        "UNIT vector (x_i - x_j)/|x_i - x_j|": spring_acceleration(unnormalised, positions),
+        "the reaction on j has the same sign as the force on i: j gets -f_ij": (
+            2 * one_sided - right
+        ),
+        "half of each spring force given to each end: particle i gets all of f_ij, j all "
+        "of -f_ij": right / 2,
+        "eq. (1.1) is the sum over the neighbours, not their average": right
+        / np.maximum(count, 1)[:, None],
+    }
+    if len(rest) and not np.allclose(rest, rest[0]):
+        mistakes["one rest length for every spring: each spring has its own l_ij"] = (
+            spring_acceleration(spring_body(positions, springs, rest.mean(), stiffness), positions)
+        )
+    return mistakes
+
+
 def axis_spring_mistakes(x: np.ndarray, spacing: float, stiffness: float) -> dict[str, np.ndarray]:
     """Accelerations (nx, ny, nz, 3) that typical mistakes in task 2 give, by cause."""
     shape = x.shape[:3]
@@ -175,6 +217,7 @@ def axis_spring_mistakes(x: np.ndarray, spacing: float, stiffness: float) -> dic
     wrapped = spring_body(flat, wrapped_border_pairs(shape), spacing, stiffness)
     border = np.ones(shape, dtype=bool)
     border[tuple(slice(1, -1) if n > 2 else slice(0, 0) for n in shape)] = False
+    along_z = springs[:, 1] - springs[:, 0] == 1  # C order: the last index is the fastest
     mistakes = {
         "the sign: eq. (1.2) is k (l - |x_i - x_j|) times the unit vector from x_j to x_i; "
         "with either factor reversed a stretched spring pushes its ends apart": -right,
@@ -195,4 +238,17 @@ def axis_spring_mistakes(x: np.ndarray, spacing: float, stiffness: float) -> dic
             "rest length 1 in world units: 'rest length 1' means one grid spacing, "
             f"l = spacing = {spacing:g}"
         ] = spring_acceleration(spring_body(flat, springs, 1.0, stiffness), flat).reshape(x.shape)
+    if not np.isclose(spacing, TEMPLATE_SPACING):
+        mistakes[
+            f"the spacing argument is ignored (rest length {TEMPLATE_SPACING} used instead of "
+            f"the spacing {spacing:g})"
+        ] = spring_acceleration(
+            spring_body(flat, springs, TEMPLATE_SPACING, stiffness), flat
+        ).reshape(x.shape)
+    if along_z.any() and not along_z.all():
+        mistakes["only two of the three axes have springs: loop over all three"] = (
+            spring_acceleration(spring_body(flat, springs[~along_z], spacing, stiffness), flat)
+        ).reshape(x.shape)
+    for cause, values in spring_list_mistakes(flat, springs, spacing, stiffness).items():
+        mistakes.setdefault(cause, values.reshape(x.shape))
     return mistakes

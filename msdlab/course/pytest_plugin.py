@@ -27,7 +27,7 @@ from typing import Any
 
 import pytest
 
-from . import TASKS, loader
+from . import TASKS, delegation, loader
 from .report import CheckReport, CheckResult
 
 ENV_IMPL = "MSDLAB_IMPL"
@@ -58,6 +58,13 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         metavar="IMPL",
         help="implementation under test: 'solutions', 'assignments' or a folder laid out "
         f"like assignments/ (default: ${ENV_IMPL}, else solutions where they exist)",
+    )
+    group.addoption(
+        "--allow-delegation",
+        default="",
+        metavar="TASKS",
+        help="comma-separated tasks whose checks let the implementation call the engine's "
+        "answer to them (by default it is refused, see msdlab.course.delegation)",
     )
     group.addoption(
         "--msdlab-report",
@@ -139,6 +146,39 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         item.stash[_GRADED] = (tasks[0], value, item.get_closest_marker("hidden") is not None)
     if problems:
         raise pytest.UsageError("graded checks are badly marked:\n  " + "\n  ".join(problems))
+    if any(_GRADED in item.stash for item in items):
+        delegation.install()  # before the implementation is imported
+
+
+def allowed_delegation(config: pytest.Config) -> set[int]:
+    """The tasks named by ``--allow-delegation`` (e.g. "2,5")."""
+    text = config.getoption("allow_delegation") or ""
+    tasks = {part.strip().removeprefix("task") for part in text.split(",") if part.strip()}
+    wrong = sorted(t for t in tasks if not t.isdigit() or int(t) not in TASKS)
+    if wrong:
+        raise pytest.UsageError(f"--allow-delegation takes task numbers {TASKS}, got {wrong}")
+    return {int(t) for t in tasks}
+
+
+@pytest.fixture(autouse=True)
+def _own_implementation_only(request: pytest.FixtureRequest) -> Iterator[None]:
+    """While a graded check runs, the engine's answer to its task refuses the
+    implementation's calls (unless ``--allow-delegation`` names the task)."""
+    graded = request.node.stash.get(_GRADED, None)
+    if graded is None or graded[0] in allowed_delegation(request.config):
+        yield
+        return
+    implementation = request.getfixturevalue("implementation")
+    remote = getattr(implementation, "refuse_delegation", None)
+    if remote is not None:  # the implementation runs in another process: it refuses there
+        remote(graded[0])
+        try:
+            yield
+        finally:
+            remote(None)
+        return
+    with delegation.refusing(graded[0], getattr(implementation, "folder", None)):
+        yield
 
 
 @pytest.hookimpl(hookwrapper=True)

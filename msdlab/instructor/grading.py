@@ -98,6 +98,7 @@ def grade(
     memory_mb: int = 2048,
     uid: int | None = None,
     isolation: str = "namespace",
+    allow_delegation: Sequence[int] = (),
 ) -> Grade:
     """Grade one submission with the checks in ``checks`` (see the module docstring).
 
@@ -108,7 +109,8 @@ def grade(
     if uid is None and os.geteuid() == 0:
         with reserved_uids(1) as (reserved,):
             return grade(submission, checks, timeout=timeout, call_timeout=call_timeout,
-                         memory_mb=memory_mb, uid=reserved, isolation=isolation)  # fmt: skip
+                         memory_mb=memory_mb, uid=reserved, isolation=isolation,
+                         allow_delegation=allow_delegation)  # fmt: skip
     started = time.monotonic()
     workspace = Path(tempfile.mkdtemp(prefix="msdlab-grade-"))
     try:
@@ -123,6 +125,7 @@ def grade(
             "--rootdir", str(workspace), "-o", "addopts=", "--impl", str(workspace / "submission"),
             "--sandbox", "--sandbox-timeout", str(call_timeout), "--sandbox-memory", str(memory_mb),
             "--msdlab-report", str(report_path),
+            "--allow-delegation", ",".join(str(task) for task in allow_delegation),
         ]  # fmt: skip
         # the checks' bodies are small: the numpy kernel spares each judge the JIT start-up
         environment = dict(os.environ, PYTHONDONTWRITEBYTECODE="1", MSDLAB_KERNEL="numpy")
@@ -155,6 +158,7 @@ def grade_all(
     jobs: int = 2,
     progress: Callable[[Grade, int, int], None] | None = None,
     isolation: str = "namespace",
+    allow_delegation: Sequence[int] = (),
     **limits: float,
 ) -> list[Grade]:
     """Grade ``submissions``, ``jobs`` at a time; ``progress(grade, done, count)`` as each ends."""
@@ -166,7 +170,14 @@ def grade_all(
     def one(submission: Submission) -> Grade:
         uid = slots.get()
         try:
-            result = grade(submission, checks, uid=uid, isolation=isolation, **limits)
+            result = grade(
+                submission,
+                checks,
+                uid=uid,
+                isolation=isolation,
+                allow_delegation=allow_delegation,
+                **limits,
+            )
         finally:
             slots.put(uid)
         with lock:
@@ -343,6 +354,9 @@ def _problems(report: CheckReport) -> list[str]:
                 kinds.append(_KNOWN[check.exception])
             elif check.exception == "SubmissionRaised" and "sys.exit" in text:
                 kinds.append("called sys.exit")
+            elif check.exception == "DelegationRefused":
+                used = text.split("your code used ", 1)[-1].split(",", 1)[0]
+                kinds.append(f"delegation refused: called the engine's answer {used}")
             elif check.exception in ("SubmissionError", "FileNotFoundError"):
                 kinds.append(text or "task file could not be loaded")
         notes += [f"task{task}: {kind}" for kind in dict.fromkeys(kinds)]

@@ -39,6 +39,7 @@ from typing import Any
 
 import numpy as np
 
+from ..course.delegation import DelegationRefused
 from ..integrators import Integrator
 from . import wire
 
@@ -202,6 +203,7 @@ class SandboxProcess:
         self.exports: dict[int, Any] = {}
         self.members: dict[tuple[int, str], wire.Ref] = {}
         self.broken: dict[str, SandboxError] = {}  # name -> its failure, until `forgive`
+        self.refused_task: int | None = None  # whose engine answers the submission may not use
 
     @property
     def isolation(self) -> str:
@@ -306,8 +308,12 @@ class SandboxProcess:
         generation: int | None = None,
         name: str = "",
         timeout: float | None = None,
+        arguments: dict[str, Any] | None = None,
     ) -> Any:
         """Send ``message`` and return the child's answer, serving its callbacks meanwhile.
+
+        ``arguments`` (a call's array arguments by position or name) receive the
+        changes the call made to its copies of them (see `write_back`).
 
         The answer must come within ``timeout`` (default: the call time limit). A
         call of ``name`` that timed out or killed the process is not run again until
@@ -348,6 +354,8 @@ class SandboxProcess:
             raise SubmissionCrashed("the submission's process sent a malformed answer")
         if "error" in reply:
             _raise(reply["error"])
+        if arguments is not None and "args" in reply:
+            write_back(arguments, reply["args"], name)
         return reply["ok"]
 
     def _remember(self, name: str, error: SandboxError) -> None:
@@ -417,6 +425,43 @@ class SandboxProcess:
             return {"error": f"{type(error).__name__}: {error}"}
 
 
+def write_back(arguments: dict[str, np.ndarray], changed: Any, name: str) -> None:
+    """Apply to the caller's arrays what the submission's call did to its copies of them.
+
+    In one process the checks see a function change its arguments in place; through
+    the sandbox they see it the same way. Only changes of values are applied (NaN and
+    inf included, as in one process); a call that changed an argument's shape or
+    dtype fails the check with `ArgumentChanged` instead of reaching the judge.
+    """
+    if not isinstance(changed, dict):
+        raise SubmissionCrashed("the submission's process sent a malformed answer")
+    for key, new in changed.items():
+        target = arguments.get(key)
+        if target is None:
+            continue
+        where = f"argument {int(key) + 1}" if key.isdigit() else f"argument '{key}'"
+        if not isinstance(new, np.ndarray):
+            shape = new.get("shape") if isinstance(new, dict) else "?"
+            dtype = new.get("dtype") if isinstance(new, dict) else "?"
+            raise ArgumentChanged(
+                f"{name} changed its {where} in place from an array of shape "
+                f"{target.shape} ({target.dtype}) to shape {tuple(shape)} ({dtype}): "
+                "functions must not resize or retype the arrays they are given"
+            )
+        if new.shape != target.shape or new.dtype != target.dtype:
+            raise ArgumentChanged(
+                f"{name} changed its {where} in place to shape {new.shape} ({new.dtype}), "
+                f"given {target.shape} ({target.dtype})"
+            )
+        if not target.flags.writeable:
+            raise ValueError(f"{name}: assignment destination is read-only ({where})")
+        np.copyto(target, new)
+
+
+class ArgumentChanged(AssertionError):
+    """A submission's function changed the shape or dtype of an array it was given."""
+
+
 def _plain(value: Any) -> Any:
     wire.encode(value)  # raises WireError if it is not plain data
     return value
@@ -427,6 +472,8 @@ def _raise(error: dict) -> None:
     name, message = str(error.get("type")), str(error.get("message"))
     where = str(error.get("traceback") or "")
     text = message + (f"\n(in the submission)\n{where.rstrip()}" if where else "")
+    if name == "DelegationRefused":  # the same failure as in one process
+        raise DelegationRefused(message)
     kind = getattr(builtins, name, None)
     if (
         isinstance(kind, type)
@@ -444,8 +491,8 @@ class RemoteObject:
         self._sandbox, self._ref, self._name = sandbox, ref, name
         self._generation = sandbox.generation
 
-    def _request(self, message: dict, name: str) -> Any:
-        value = self._sandbox.request(message, self._generation, self._name)
+    def _request(self, message: dict, name: str, arguments: dict | None = None) -> Any:
+        value = self._sandbox.request(message, self._generation, self._name, arguments=arguments)
         return _wrap(self._sandbox, value, name)
 
     def __getattr__(self, name: str) -> Any:
@@ -456,7 +503,10 @@ class RemoteObject:
 
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
         message = {"op": "call", "ref": self._ref, "args": args, "kwargs": kwargs}
-        return self._request(message, f"{self._name}()")
+        message["refuse"] = self._sandbox.refused_task  # see msdlab.course.delegation
+        arguments = {**{str(i): a for i, a in enumerate(args)}, **kwargs}
+        arrays = {k: a for k, a in arguments.items() if isinstance(a, np.ndarray)}
+        return self._request(message, f"{self._name}()", arrays)
 
     def __repr__(self) -> str:
         return f"<submission {self._ref.kind}>"
@@ -534,6 +584,11 @@ class RemoteImplementation:
     def forgive(self) -> None:
         """A new check starts: functions that timed out may run again."""
         self.sandbox.forgive()
+
+    def refuse_delegation(self, task: int | None) -> None:
+        """From now on the engine's answer to ``task`` refuses the submission's calls (None:
+        nothing is refused); see `msdlab.course.delegation`."""
+        self.sandbox.refused_task = task
 
     def close(self) -> None:
         self.sandbox.cleanup()

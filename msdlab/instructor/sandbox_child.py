@@ -32,7 +32,10 @@ def main(config: dict[str, Any]) -> None:
     import scipy.sparse  # noqa: F401
 
     import msdlab  # noqa: F401
+    from msdlab.course import delegation
     from msdlab.instructor import wire
+
+    delegation.install()  # before the submission is imported: see msdlab.course.delegation
 
     _install_guard(config["read_roots"], config["scratch"])
     os.chdir(config["scratch"])
@@ -149,7 +152,13 @@ class Server:
                 value = getattr(self.objects[request["ref"].id], request["name"])
             elif op == "call":
                 target = self.objects[request["ref"].id]
-                value = target(*self.local(request["args"]), **self.local(request["kwargs"]))
+                args, kwargs = self.local(request["args"]), self.local(request["kwargs"])
+                _refuse_delegation(request.get("refuse"), self.folder)
+                before = _array_arguments(args, kwargs)
+                value = target(*args, **kwargs)
+                changed = _changed_arguments(before, args, kwargs)
+                if changed:
+                    return {"ok": value, "args": changed}
             elif op == "release":
                 for ref in request["refs"]:
                     self.objects.pop(ref.id, None)
@@ -237,6 +246,38 @@ class GraderObject:
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
         message = {"op": "call", "ref": self._ref, "args": args, "kwargs": kwargs}
         return self._server.callback(message)
+
+
+def _refuse_delegation(task: Any, folder: str) -> None:
+    """The task being checked: the engine's answer to it refuses the submission's calls."""
+    from msdlab.course import delegation
+
+    delegation.set_refused(task if isinstance(task, int) else None, folder)
+
+
+def _array_arguments(args: tuple, kwargs: dict) -> dict[str, Any]:
+    """Copies of the call's array arguments, keyed by position ("0", "1", ...) or name."""
+    import numpy
+
+    named = {**{str(i): a for i, a in enumerate(args)}, **kwargs}
+    return {k: a.copy() for k, a in named.items() if isinstance(a, numpy.ndarray)}
+
+
+def _changed_arguments(before: dict[str, Any], args: tuple, kwargs: dict) -> dict[str, Any]:
+    """The array arguments the call changed in place: their new values, so that the grader's
+    arrays change as they would in one process; for a changed shape or dtype only a
+    description (the grader refuses to apply it)."""
+    import numpy
+
+    named = {**{str(i): a for i, a in enumerate(args)}, **kwargs}
+    changed: dict[str, Any] = {}
+    for key, old in before.items():
+        new = named[key]
+        if new.shape != old.shape or new.dtype != old.dtype:
+            changed[key] = {"shape": list(new.shape), "dtype": new.dtype.str}
+        elif not numpy.array_equal(new, old, equal_nan=new.dtype.kind in "fc"):
+            changed[key] = new
+    return changed
 
 
 def _describe(error: BaseException, folder: str) -> dict:

@@ -40,7 +40,7 @@ def test_default_is_the_students_assignments_folder(capsys, tmp_path, monkeypatc
     assert main(["check", "1", "--hidden"]) == 0
     out = capsys.readouterr().out
     assert str(tmp_path / "assignments") in out
-    assert "(hidden)" in out and "total: 14/14 points" in out
+    assert "(hidden)" in out and "total: 15/15 points" in out
 
 
 @pytest.mark.parametrize(

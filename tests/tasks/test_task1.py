@@ -75,26 +75,29 @@ def test_verlet_step_is_the_kernel(task1):
     """verlet_step (eq. 1.3) gives the same new positions as the template's kernel."""
     rng = np.random.default_rng(1)
     a = np.array([0.01, -0.001, 0.002])
-    for shape in ((4, 3, 5, 3), (7, 3)):
+    for shape, dt in (((4, 3, 5, 3), DT), ((7, 3), 0.37)):  # the step is an argument too
         current = rng.uniform(-1.0, 1.0, shape) + np.array([0.0, 5.0, 0.0])
         old = current - 0.05 * rng.standard_normal(shape)
-        expected = template_kernel(old, current, DT, a)
-        got = as_array(task1.verlet_step(old.copy(), current.copy(), DT, tuple(a)), "verlet_step")
+        expected = template_kernel(old, current, dt, a)
+        got = as_array(task1.verlet_step(old.copy(), current.copy(), dt, tuple(a)), "verlet_step")
         mistake = matching_variant(
             got,
             {
                 "the acceleration is missing (a·dt² was left out)": 2 * current - old,
-                "a·dt instead of a·dt²": 2 * current - old + a * DT,
+                "a·dt instead of a·dt²": 2 * current - old + a * dt,
                 "½·a·dt², the exact free fall of one step, instead of the kernel's a·dt²": (
-                    2 * current - old + 0.5 * a * DT**2
+                    2 * current - old + 0.5 * a * dt**2
                 ),
-                "x(t - dt) added instead of subtracted": 2 * current + old + a * DT**2,
+                "x(t - dt) added instead of subtracted": 2 * current + old + a * dt**2,
+                f"the template's dt = {DT} instead of the dt argument": (
+                    2 * current - old + a * DT**2
+                ),
             },
         )
         expect(
             got.shape == expected.shape and relative_error(got, expected) < 1e-12,
-            saw=f"for positions of shape {shape} verlet_step differs from the kernel's new "
-            f"positions by up to {num(np.max(np.abs(got - expected)))} (positions ~1)",
+            saw=f"for positions of shape {shape} and dt = {dt} verlet_step differs from the "
+            f"kernel's new positions by up to {num(np.max(np.abs(got - expected)))} (positions ~1)",
             cause=mistake
             or "eq. (1.3) is x(t+dt) = 2 x(t) - x(t-dt) + a dt², with current = "
             "x(t) and old = x(t-dt)",

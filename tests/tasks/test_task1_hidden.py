@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+import contextlib
+import signal
+import threading
+from collections.abc import Iterator
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from msdlab.course.feedback import as_array, expect, num
+from msdlab.course.feedback import CheckFailed, as_array, expect, num
 
 import reference_hidden as reference
 
@@ -34,12 +39,19 @@ def test_steps_to_floor_for_any_start(task1, y0, dt, g):
     got = task1.steps_to_floor(y0, dt, g)
     first = reference.first_floor_contact(y0, dt, g)
     at_boundary = abs(template_height(y0, dt, g, min(int(got), first))) < 1e-9 * y0
+    if got in (first - 1, first + 1):
+        cause = f"one step {'early' if got < first else 'late'}: the answer is the first n whose "
+        cause += "height y0 + g dt² n(n+1)/2 is <= 0"
+    else:
+        cause = (
+            "a formula that only works for the default numbers, or rounding: check the "
+            "smallest n with y0 + g dt² n(n+1)/2 <= 0 directly"
+        )
     expect(
         got == first or at_boundary,
         saw=f"steps_to_floor({num(y0)}, {num(dt)}, {num(g)}) = {got!r}, but the running "
         f"template first reaches the floor in step {first}",
-        cause="a formula that only works for the default numbers, or rounding: check the "
-        "smallest n with y0 + g dt² n(n+1)/2 <= 0 directly",
+        cause=cause,
     )
 
 
@@ -55,11 +67,23 @@ def test_height_after_for_any_start(task1, steps, y0, dt, g):
     """height_after agrees with the running template for any steps, height, dt and g."""
     got = float(task1.height_after(steps, y0, dt, g))
     expected = template_height(y0, dt, g, steps)
+    defaults = {"y0": 1.5, "dt": 0.1, "g": -0.001}  # the template's values
+    given_values = {"y0": y0, "dt": dt, "g": g}
+    cause = next(
+        (
+            f"the template's {name} = {value} used instead of the argument {name}"
+            for name, value in defaults.items()
+            if given_values[name] != value
+            and np.isclose(got, template_height(**{**given_values, name: value}, steps=steps))
+        ),
+        "the template's recurrence: each step adds g·dt² to the distance moved per step, so "
+        "after n steps y = y0 + g dt² (1 + 2 + ... + n)",
+    )
     expect(
         abs(got - expected) <= 1e-9 * max(1.0, abs(expected)),
         saw=f"height_after({steps}, {num(y0)}, {num(dt)}, {num(g)}) = {num(got, 6)}, the "
         f"template gives {num(expected, 6)}",
-        cause="the default values hard-coded instead of the arguments y0, dt, g",
+        cause=cause,
     )
 
 
@@ -89,3 +113,52 @@ def test_verlet_step_leaves_its_inputs_alone(task1):
         "x(t) and x(t - dt) (the template rotates its three buffers)",
     )
     expect(got.shape == current.shape, saw=f"verlet_step returned shape {got.shape}")
+
+
+@contextlib.contextmanager
+def answer_within(seconds: float, call: str) -> Iterator[None]:
+    """Fail the check if the block runs longer than ``seconds`` (one process only; the
+    grading sandbox has its own time limit per call, shorter than this)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupt(signum, frame):
+        raise CheckFailed(
+            f"{call} did not answer within {seconds:g} s. Usual cause: a search for the "
+            "first floor contact that never ends because the inputs were not checked first."
+        )
+
+    previous = signal.signal(signal.SIGALRM, interrupt)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+@pytest.mark.points(1)
+def test_steps_to_floor_refuses_a_start_on_or_below_the_floor(task1):
+    """steps_to_floor needs y0 > 0, g < 0, dt > 0: anything else is refused with ValueError."""
+    cases = (
+        (0.0, 0.1, -0.001, "a particle that starts on the floor"),
+        (-0.5, 0.1, -0.001, "a particle that starts below the floor"),
+        (1.0, 0.1, 0.0, "a particle that does not fall (g = 0)"),
+        (1.0, 0.0, -0.001, "a time step of 0"),
+    )
+    for y0, dt, g, what in cases:
+        call = f"steps_to_floor({y0}, {dt}, {g})"
+        try:
+            with answer_within(90.0, call):
+                got = task1.steps_to_floor(y0, dt, g)
+        except ValueError:
+            continue
+        except ZeroDivisionError:
+            got = "ZeroDivisionError"
+        expect(
+            False,
+            saw=f"{call} gave {got!r} for {what}",
+            cause="no check of the inputs: raise ValueError unless y0 > 0, g < 0 and dt > 0, "
+            "as the docstring asks (such a particle has no first floor contact)",
+        )

@@ -94,9 +94,23 @@ def test_stretched_pulls_compressed_pushes(task2):
             saw=f"a spring {verb} to {factor}·h between particles at x = 0 and x = "
             f"{num(factor * h)} gives accelerations {vec(a[0, 0, 0])} and {vec(a[1, 0, 0])}; "
             f"expected {vec(expected)} and {vec(-expected)}",
-            cause="the sign of (l - |x_i - x_j|) or of the direction x_i - x_j, or a rest "
-            "length other than the spacing",
+            cause=two_particle_cause(a[0, 0, 0], a[1, 0, 0], expected),
         )
+
+
+def two_particle_cause(first, second, expected):
+    """The usual cause of wrong accelerations of two particles joined by one spring."""
+    if np.allclose(first, -expected) and np.allclose(second, expected):
+        return "the sign of (l - |x_i - x_j|) or of the direction x_i - x_j"
+    if np.allclose(first, expected) or np.allclose(second, -expected):
+        return "the reaction: particle j must get -f_ij, equal and opposite to f_ij on i"
+    if np.allclose(first, -second) and first[0] * expected[0] > 0:
+        ratio = first[0] / expected[0]
+        return (
+            f"the size of the force is {num(ratio)}× eq. (1.2): check the stiffness k, the "
+            "rest length (one spacing h), and that the direction is a unit vector"
+        )
+    return "the sign of (l - |x_i - x_j|), the rest length (one spacing h), or the stiffness"
 
 
 @pytest.mark.points(3)

@@ -32,6 +32,34 @@ def springs_of(body):
     return np.stack([body.spring_a, body.spring_b], axis=1), body.rest_lengths.copy()
 
 
+def matrix_at_fault(task3, axis, angle):
+    """Why rotate_layout may be wrong because rotation_matrix is, or None."""
+    try:
+        got = np.asarray(task3.rotation_matrix(axis, angle), dtype=float)
+    except Exception as error:
+        return f"your rotation_matrix fails ({type(error).__name__}), and rotate_layout uses it"
+    if got.shape != (3, 3) or not np.allclose(got, msd.rotation_matrix(angle, axis), atol=1e-9):
+        return "your rotation_matrix is wrong (see its check), and rotate_layout uses it"
+    return None
+
+
+def rotation_at_fault(task3):
+    """Why drop_rotated_cube may be wrong because of another function of the task, or None."""
+    grid = oracles.template_positions((2, 3, 2), 0.5, (0.0, 1.0, 0.0))
+    try:
+        got = np.asarray(task3.rotate_layout(grid.copy(), (0.0, 0.0, 1.0), 45.0), dtype=float)
+    except Exception as error:
+        return f"your rotate_layout fails ({type(error).__name__}), and the cube is turned by it"
+    centroid = grid.reshape(-1, 3).mean(axis=0)
+    turned = (grid - centroid) @ msd.rotation_matrix(45.0, (0.0, 0.0, 1.0)).T + centroid
+    if got.shape != grid.shape or not np.allclose(got, turned, atol=1e-9):
+        return (
+            "your rotate_layout does not turn the layout right (see its check), and the "
+            "cube is turned by it"
+        )
+    return None
+
+
 def student_acceleration(task3, positions, springs, rest, stiffness):
     got = task3.spring_acceleration(positions.copy(), springs.copy(), rest.copy(), stiffness)
     return as_array(got, "spring_acceleration", positions.shape)
@@ -94,6 +122,9 @@ def test_rotate_layout_turns_about_centroid(task3):
                 "x @ R rotates by -angle; row vectors need x @ R.T": (
                     (grid - centroid) @ msd.rotation_matrix(angle, axis) + centroid
                 ),
+                "the angle argument is ignored (always 45°)": (
+                    (grid - centroid) @ msd.rotation_matrix(45.0, axis).T + centroid
+                ),
             },
         )
         moved = got.reshape(-1, 3).mean(axis=0) - centroid
@@ -102,7 +133,9 @@ def test_rotate_layout_turns_about_centroid(task3):
             saw=f"rotate_layout(grid, {axis}, {angle}) moved the centroid by {vec(moved)} and "
             f"puts particles up to {num(np.max(np.abs(got - expected)))} away from the rotated "
             "grid",
-            cause=mistake or "rotate every position p to R (p - c) + c, c the centroid",
+            cause=mistake
+            or matrix_at_fault(task3, axis, angle)
+            or "rotate every position p to R (p - c) + c, c the centroid",
         )
 
 
@@ -127,6 +160,7 @@ def compare_with_engine(got, body, x, what):
             "-f_ij is never added to particle j": oracles.one_sided_acceleration(
                 x, springs, rest, stiffness
             ),
+            **oracles.spring_list_mistakes(x, springs, rest, stiffness),
         },
     )
     expect(
@@ -210,12 +244,13 @@ def test_tilted_cube_collapses_upright_one_stands(task3):
                 got < 0.3,
                 saw=f"a cube with axis springs only, tilted {angle}° about {axis}, kept "
                 f"{percent(got)} of its thickness",
-                cause="springs beyond the 6 axis neighbours, or the cube was not rotated",
+                cause=rotation_at_fault(task3)
+                or "springs beyond the 6 axis neighbours, or the cube was not rotated",
             )
         else:
             expect(
                 got > 0.9,
                 saw=f"a cube turned {angle}° about the vertical axis {axis} kept only "
                 f"{percent(got)} of its thickness; its springs still carry gravity vertically",
-                cause="rotating about the wrong axis",
+                cause=rotation_at_fault(task3) or "rotating about the wrong axis",
             )

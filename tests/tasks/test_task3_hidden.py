@@ -8,7 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import msdlab as msd
-from msdlab.course.feedback import as_array, expect, num, relative_error
+from msdlab.course import oracles
+from msdlab.course.feedback import as_array, expect, matching_variant, num, relative_error
 
 import reference_hidden as reference
 
@@ -41,7 +42,11 @@ def test_rotations_compose_and_invert(task3, axis, first, second):
         saw="scaling the axis by 3 changed the rotation",
         cause="the axis is not normalised before use",
     )
-    expect(np.allclose(r1, msd.rotation_matrix(first, axis), atol=1e-9), saw="not the rotation")
+    expect(
+        np.allclose(r1, msd.rotation_matrix(first, axis), atol=1e-9),
+        saw=f"rotation_matrix({axis}, {num(first)}) is not the turn by {num(first)}° about {axis}",
+        cause="radians where degrees are given, or a term of Rodrigues' formula missing",
+    )
 
 
 @pytest.mark.points(2)
@@ -62,7 +67,12 @@ def test_any_spring_list(task3, seed, n, e):
         got.shape == x.shape and relative_error(got, expected) < 1e-9,
         saw=f"for {e} random springs between {n} particles the accelerations are off by "
         f"{num(relative_error(got, expected) if got.shape == x.shape else np.inf)} (relative)",
-        cause="a particle with several springs must get the sum of all of them (np.add.at, "
+        cause=(
+            matching_variant(got, oracles.spring_list_mistakes(x, springs, rest, 0.7))
+            if got.shape == x.shape
+            else None
+        )
+        or "a particle with several springs must get the sum of all of them (np.add.at, "
         "np.bincount or a loop; a[i] += f keeps only one of repeated indices)",
     )
     expect(
@@ -80,9 +90,16 @@ def test_zero_length_spring_gives_no_nan(task3):
     got = np.asarray(task3.spring_acceleration(x, springs, np.array([0.5, 0.5]), 1.0), float)
     expected = reference.pair_acceleration(x, springs, np.array([0.5, 0.5]), 1.0)
     expect(
-        np.all(np.isfinite(got)) and np.allclose(got, expected, atol=1e-12),
+        np.all(np.isfinite(got)),
         saw=f"with a zero-length spring the accelerations are {got.tolist()}",
         cause="dividing by the spring length without a guard for zero length",
+    )
+    expect(
+        np.allclose(got, expected, atol=1e-12),
+        saw=f"with a zero-length spring beside a stretched one the accelerations are "
+        f"{got.tolist()}, eq. (1.1)-(1.2) give {expected.tolist()}",
+        cause="the zero-length spring should add nothing and the other one act as usual; "
+        "see the checks of the spring sum for what is wrong there",
     )
 
 
@@ -108,3 +125,23 @@ def test_cube_tilted_about_x_collapses(task3):
             cause="a different experiment: check the rotation, the lift to y = LIFT, the "
             "number of steps, dt, gravity and the floor",
         )
+
+
+@pytest.mark.points(1)
+def test_drop_rotated_cube_uses_steps_and_neighbours(task3):
+    """One step leaves the cube as it was; with 1, √2, √3 springs the tilted cube stands."""
+    still = float(task3.drop_rotated_cube((0.0, 0.0, 1.0), 45.0, (1,), steps=1))
+    expect(
+        abs(still - 1.0) < 0.01,
+        saw=f"drop_rotated_cube(..., steps=1) = {num(still)}: in a single step the cube "
+        "cannot change its shape that much",
+        cause="the number of steps is ignored (run `steps` steps, not a fixed number)",
+    )
+    held = float(task3.drop_rotated_cube((0.0, 0.0, 1.0), 45.0, (1, 2, 3)))
+    expected = reference.drop_rotated_cube((0.0, 0.0, 1.0), 45.0, (1, 2, 3))
+    expect(
+        abs(held - expected) < 0.1,
+        saw=f"with springs to neighbours (1, 2, 3) the tilted cube's flatness ratio is "
+        f"{num(held)}, the experiment gives {num(expected)} (it stands)",
+        cause="the neighbours argument is ignored: pass it to msd.Body.grid",
+    )

@@ -38,6 +38,23 @@ def student_springs(task4, shape, spacing, neighbours):
     return springs.astype(np.int64), rest
 
 
+def springs_at_fault(task4):
+    """Why drop_rotated_cube may be wrong because of grid_springs, or None."""
+    expected, body = engine_pairs((2, 2, 3), (1, 2, 3))
+    try:
+        springs, rest = student_springs(task4, (2, 2, 3), 1.0, (1, 2, 3))
+    except Exception as error:
+        return f"your grid_springs fails ({type(error).__name__}), and the cube is built with it"
+    lengths = {frozenset(p): r for p, r in zip(springs.tolist(), rest.tolist())}
+    wrong_rest = any(
+        not np.isclose(lengths.get(frozenset(p), -1.0), r)
+        for p, r in zip(zip(body.spring_a.tolist(), body.spring_b.tolist()), body.rest_lengths)
+    )
+    if len(springs) != len(expected) or set(lengths) != expected or wrong_rest:
+        return "your grid_springs is wrong (see its checks), and the cube is built with it"
+    return None
+
+
 def missing_and_extra(springs, expected):
     found = [frozenset(p) for p in springs.tolist()]
     return expected - set(found), set(found) - expected, len(found) - len(set(found))
@@ -51,16 +68,28 @@ def test_neighbour_offsets_26(task4):
         expect(
             offsets.ndim == 2 and offsets.shape[1:] == (3,),
             saw=f"neighbour_offsets({wanted}) has shape {offsets.shape}, expected (M, 3)",
+            cause="no offsets at all: none of squared length "
+            f"{' or '.join(map(str, wanted))} was kept (e.g. a test that leaves out the body "
+            "diagonals)"
+            if offsets.size == 0
+            else "",
         )
         unique = {tuple(o) for o in offsets.astype(int).tolist()}
         lengths = sorted({int(np.sum(np.square(o))) for o in unique})
+        if 0 in lengths:
+            cause = "the zero offset (the particle itself) is included"
+        elif lengths != sorted(wanted):
+            cause = f"offsets of squared lengths {lengths}, not the {sorted(wanted)} asked for"
+        elif len(unique) * 2 == count:
+            cause = "only one of o and -o (both directions are neighbours)"
+        else:
+            cause = "offsets listed twice, or some of them missing"
         expect(
             len(offsets) == len(unique) == count and lengths == sorted(wanted),
             saw=f"neighbour_offsets({wanted}) gives {len(offsets)} offsets ({len(unique)} "
             f"different) of squared lengths {lengths}; an interior particle has {count} such "
             "neighbours",
-            cause="only one of o and -o (both directions are neighbours), the zero offset "
-            "included, or offsets of other squared lengths",
+            cause=cause,
         )
         expect(
             all(tuple(-np.array(o)) in unique for o in unique),
@@ -83,10 +112,22 @@ def test_grid_springs_each_pair_once(task4):
             saw=f"for {kinds} springs of a {SHAPE} grid you give {len(springs)} springs, "
             f"{len(expected)} expected: {len(missing)} missing, {len(extra)} that are not "
             f"neighbour pairs, {repeated} listed twice (e.g. particles {example})",
-            cause="both i→j and j→i listed (a spring counted twice doubles its force), "
-            "neighbours across the border wrapped around, or C order mixed up "
-            "(index = (i·ny + j)·nz + k)",
+            cause=pairs_cause(missing, extra, repeated, len(springs), len(expected)),
         )
+
+
+def pairs_cause(missing, extra, repeated, given, expected):
+    """The usual cause of a wrong list of grid springs."""
+    if repeated or (given == 2 * expected and not missing):
+        return "both i→j and j→i listed (a spring counted twice doubles its force)"
+    if missing and not extra:
+        return (
+            "springs missing at the border: each offset joins every particle whose "
+            "neighbour (i, j, k) + offset is inside the grid, up to the last one"
+        )
+    if missing and extra and given == expected:
+        return "C order mixed up: particle (i, j, k) is row (i·ny + j)·nz + k"
+    return "neighbours across the border wrapped around, or offsets of the wrong kind"
 
 
 @pytest.mark.points(2)
@@ -123,14 +164,15 @@ def test_rotated_cube_holds_its_shape(task4):
         held > 0.9,
         saw=f"with 26 neighbours, tilted {angle}° about z, the cube kept {percent(held)} of its "
         "thickness; the diagonal springs give it the shear stiffness to stand",
-        cause="missing diagonal springs or wrong rest lengths, or a different experiment",
+        cause=springs_at_fault(task4)
+        or "missing diagonal springs or wrong rest lengths, or a different experiment",
     )
     folded = float(task4.drop_rotated_cube(axis, angle, (1,)))
     expect(
         folded < 0.3,
         saw=f"with axis springs only the tilted cube kept {percent(folded)} of its thickness; "
         "it has no shear stiffness and should fold flat",
-        cause="drop_rotated_cube ignores squared_distances",
+        cause=springs_at_fault(task4) or "drop_rotated_cube ignores squared_distances",
     )
 
 
@@ -143,10 +185,26 @@ def test_step_cost_reports_springs_and_time(task4):
         expect(
             springs == expected,
             saw=f"step_cost(6, {neighbours}) counts {springs} springs, a 6³ grid has {expected}",
-            cause="springs counted twice or the wrong neighbours",
+            cause="springs counted twice"
+            if springs == 2 * expected
+            else "the wrong neighbours, or a grid other than n³ (is n ignored?)",
         )
         expect(
             math.isfinite(seconds) and 0 < seconds < 1.0,
             saw=f"step_cost(6, {neighbours}) reports {num(seconds)} s per step",
             cause="the total time not divided by the number of steps, or a wrong clock",
         )
+    springs, _ = task4.step_cost(3, (1,), 1)
+    expect(
+        springs == 54,
+        saw=f"step_cost(3, (1,)) counts {springs} springs, a 3³ grid has 54 axis springs",
+        cause="the size n is ignored: build the n³ grid",
+    )
+    few = float(task4.step_cost(10, (1, 2, 3), 3)[1])  # a step costs more than a run's set-up
+    many = float(task4.step_cost(10, (1, 2, 3), 60)[1])
+    expect(
+        many < 6 * few,
+        saw=f"step_cost reports {num(few)} s per step for 3 steps but {num(many)} s per step "
+        "for 60 steps of the same grid: the time grows with the number of steps",
+        cause="the total time of all steps reported instead of the time per step (divide by steps)",
+    )

@@ -30,20 +30,42 @@ def test_any_grid_shape_and_neighbours(task4, shape, neighbours, spacing):
     body = oracles.grid_body(shape, spacing, 1.0, neighbours)
     expected = {frozenset(p) for p in zip(body.spring_a.tolist(), body.spring_b.tolist())}
     found = [frozenset(p) for p in springs.tolist()]
+    positions = body.positions
+
+    def kinds(pairs):
+        """The squared lengths (in grid units) of index pairs of the grid at rest."""
+        return sorted(
+            {
+                round(float(np.sum(np.square(positions[a] - positions[b]))) / spacing**2)
+                for a, b in map(tuple, pairs)
+                if a != b
+            }
+        )
+
+    missing, wrong = expected - set(found), set(found) - expected
+    if missing and not wrong and kinds(missing) != kinds(expected):
+        cause = f"all springs of squared length {kinds(missing)} are missing"
+    elif wrong and not missing and set(kinds(wrong)) - set(neighbours):
+        cause = (
+            f"springs of squared length {kinds(wrong)} given, {sorted(neighbours)} were asked for"
+        )
+    else:
+        cause = "a loop bound or border test that only works for some grid sizes"
     expect(
         len(found) == len(expected) and set(found) == expected,
         saw=f"for a {shape} grid with neighbours {neighbours}: {len(found)} springs given, "
-        f"{len(expected)} expected ({len(expected - set(found))} missing, "
-        f"{len(set(found) - expected)} wrong)",
-        cause="a loop bound or border test that only works for some grid sizes",
+        f"{len(expected)} expected ({len(missing)} missing, {len(wrong)} wrong)",
+        cause=cause,
     )
-    positions = body.positions
     distance = np.linalg.norm(positions[springs[:, 0]] - positions[springs[:, 1]], axis=1)
     expect(
         np.allclose(rest, distance, rtol=1e-9),
         saw=f"rest lengths differ from the distances at rest by up to "
         f"{num(np.max(np.abs(rest - distance), initial=0.0))}",
-        cause="rest lengths not scaled by the spacing",
+        cause="rest lengths not scaled by the spacing"
+        if np.allclose(rest, distance / spacing, rtol=1e-9)
+        else "rest lengths that are not spacing·√(squared length) of each spring (the "
+        "distance at rest)",
     )
 
 
@@ -68,4 +90,16 @@ def test_cube_tilted_about_x_holds(task4):
         f"thickness; the experiment as described gives {percent(expected)}",
         cause="a different experiment: check the rotation, the lift to y = LIFT, the number "
         "of steps, dt, gravity and the floor",
+    )
+
+
+@pytest.mark.points(1)
+def test_drop_rotated_cube_runs_the_steps_asked_for(task4):
+    """drop_rotated_cube(..., steps=1) leaves the cube as it was: ratio 1."""
+    still = float(task4.drop_rotated_cube((0.0, 0.0, 1.0), 45.0, (1,), steps=1))
+    expect(
+        abs(still - 1.0) < 0.01,
+        saw=f"drop_rotated_cube(..., steps=1) = {num(still)}: in a single step the cube "
+        "cannot change its shape that much",
+        cause="the number of steps is ignored (run `steps` steps, not a fixed number)",
     )

@@ -55,6 +55,20 @@ def step_mistakes(x, v, dt, lam, dynamics):
     }
 
 
+def step_at_fault(task5):
+    """Why a measurement may be wrong because DampedVerlet is, or None."""
+    dynamics, x, v = one_step_case(1)
+    try:
+        got = np.asarray(task5.DampedVerlet(0.5).step(x.copy(), v.copy(), 0.3, dynamics)[0])
+    except Exception as error:
+        return f"your DampedVerlet fails ({type(error).__name__}), and the measurement uses it"
+    if got.shape != x.shape or not np.allclose(got, engine_step(0.5, x, v, 0.3, dynamics)):
+        return (
+            "your DampedVerlet.step is not eq. (1.4) (see its checks), and the measurement uses it"
+        )
+    return None
+
+
 @pytest.mark.points(3)
 def test_one_step_is_equation_1_4(task5):
     """One step gives x(t+dt) = (2-λ)x(t) - (1-λ)x(t-dt) + a(t)dt² and v = (x(t+dt) - x(t))/dt."""
@@ -84,6 +98,36 @@ def test_one_step_is_equation_1_4(task5):
             cause="returning the old velocity, or a central difference: the next step "
             "recovers x(t) as x(t+dt) - v·dt, so v must be (x(t+dt) - x(t))/dt",
         )
+
+
+@pytest.mark.points(2)
+def test_velocity_dependent_forces_see_the_velocity(task5):
+    """With dashpots and drag, a(t) depends on v: the step must use a(x, v) with the given v."""
+    dt, lam = 0.2, 0.1
+    rng = np.random.default_rng(5)
+    body = msd.Body.grid((2, 2, 3), 0.5, 0.5, neighbours=(1, 2), damping=0.4)
+    x = body.positions + 0.05 * rng.standard_normal(body.positions.shape)
+    v = rng.standard_normal(x.shape)
+    dynamics = msd.Dynamics(body, [msd.Gravity(GRAVITY), msd.ViscousDamping(0.3)])
+    expected = engine_step(lam, x, v, dt, dynamics)
+    x_new = as_array(task5.DampedVerlet(lam).step(x.copy(), v.copy(), dt, dynamics)[0], "step")
+    still = np.zeros_like(v)
+    mistakes = {
+        "the acceleration evaluated at zero velocity, a(x, 0): dashpots and drag depend on "
+        "v, pass the velocity you were given": (
+            (2 - lam) * x - (1 - lam) * (x - v * dt) + dynamics.acceleration(x, still) * dt**2
+        ),
+        "x(t - dt) taken as x + v·dt instead of x - v·dt": (
+            (2 - lam) * x - (1 - lam) * (x + v * dt) + dynamics.acceleration(x, v) * dt**2
+        ),
+    }
+    expect(
+        np.allclose(x_new, expected, rtol=1e-12, atol=1e-14),
+        saw=f"with dashpots and drag (forces that depend on v), λ = {lam}, dt = {dt}: new "
+        f"positions off by up to {num(np.max(np.abs(x_new - expected)))}",
+        cause=matching_variant(x_new, mistakes, rtol=1e-9)
+        or "a(t) = dynamics.acceleration(x, v) with the x and v the step was given",
+    )
 
 
 @pytest.mark.points(3)
@@ -238,8 +282,9 @@ def test_measured_stable_dt_as_predicted(task5):
             abs(measured[lam] / predicted - 1) < 0.06,
             saw=f"with λ = {lam} you measured a largest stable dt of {num(measured[lam])}, the "
             f"predicted limit √(4 - 2λ)/ω is {num(predicted)}",
-            cause="a different body than jelly(n), or a measurement that does not use your "
-            "DampedVerlet",
+            cause=step_at_fault(task5)
+            or "a different body than jelly(n), a measurement that does not use your "
+            "DampedVerlet, or the damping λ is not passed on",
         )
     expect(
         measured[0.5] < measured[0.0],

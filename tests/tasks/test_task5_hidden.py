@@ -75,3 +75,17 @@ def test_solved_setting_matches_the_engine(task5):
         "800 steps (floor contact included)",
         cause="a velocity that is not (x(t+dt) - x(t))/dt, so the floor's edits are lost",
     )
+
+
+@pytest.mark.points(1)
+def test_measured_stable_dt_of_another_jelly(task5):
+    """measured_stable_dt(λ, n) measures the jelly of n³ particles it is asked about."""
+    measured = float(task5.measured_stable_dt(0.2, 2, 300, 0.01))
+    body = msd.Body.grid((2, 2, 2), 1.0, 0.5, neighbours=(1, 2, 3))
+    predicted = msd.max_stable_dt(body, msd.Verlet(0.2))
+    expect(
+        abs(measured / predicted - 1) < 0.06,
+        saw=f"measured_stable_dt(0.2, n=2) = {num(measured)}, the 2³ jelly's predicted limit is "
+        f"{num(predicted)}",
+        cause="n is ignored (measure jelly(n)), or the damping λ is not passed on",
+    )

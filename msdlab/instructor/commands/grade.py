@@ -16,7 +16,7 @@ import sys
 import time
 from pathlib import Path
 
-from ...course import PROJECT_ROOT
+from ...course import PROJECT_ROOT, TASKS
 from .. import grading, sandbox
 
 
@@ -56,6 +56,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "seeing only its task files; process: a plain child process, weaker, named in "
         "every row's notes",
     )
+    parser.add_argument(
+        "--allow-delegation",
+        default="",
+        metavar="TASKS",
+        help="comma-separated tasks (e.g. 2,5) whose checks let submissions call the engine's "
+        "answer to them; by default such calls are refused and the row's notes say so",
+    )
     parser.set_defaults(run=run)
 
 
@@ -90,6 +97,7 @@ def run(args: argparse.Namespace) -> int:
         call_timeout=args.call_timeout,
         memory_mb=args.memory,
         isolation=args.isolation,
+        allow_delegation=_tasks(args.allow_delegation),
     )
     grading.write_csv(grades, args.out)
     if args.feedback is not None:
@@ -102,3 +110,11 @@ def run(args: argparse.Namespace) -> int:
               "isolated by the operating system)")  # fmt: skip
     print(f"grades written to {args.out}")
     return 0 if all(grade.graded for grade in grades) else 1
+
+
+def _tasks(text: str) -> list[int]:
+    """ "2,5" -> [2, 5]; a clear error for anything but task numbers."""
+    parts = [part.strip().removeprefix("task") for part in text.split(",") if part.strip()]
+    if not all(part.isdigit() and int(part) in TASKS for part in parts):
+        raise ValueError(f"--allow-delegation takes task numbers {TASKS} like 2,5; got {text!r}")
+    return [int(part) for part in parts]

@@ -34,6 +34,8 @@ def height_after(steps, y0=1.5, dt=DT, g=GRAVITY[1]):
 
 
 def steps_to_floor(y0=1.5, dt=DT, g=GRAVITY[1]):
+    if y0 <= 0 or g >= 0 or dt <= 0:
+        raise ValueError("the particle must start above the floor and fall, with dt > 0")
     steps, y_old, y = 0, y0, y0
     while y > 0:
         y_old, y = y, 2 * y - y_old + g * dt * dt

@@ -1,0 +1,485 @@
+"""How strong is a check set? Run it on the solutions, the templates and mutants of the solutions.
+
+The checks of a task (``test_taskN.py`` and ``test_taskN_hidden.py``) are run here, in this
+process, on any version of the task's file (`run_checks`): each check is called with the
+task module, under the same refusal of delegation as in pytest (`msdlab.course.delegation`)
+and a time limit. `validate` runs them on
+
+- the solution: every check must pass;
+- the template: every check must fail (a check a template passes gives points for nothing);
+- mutants of the solution (`mutants`): small changes to the code inside the solution blocks
+  (operators, operands, constants, comparisons, dropped terms, signs). A mutant is *killed*
+  when a check fails on it; the report names the checks that kill each mutant and lists the
+  survivors, which are either equivalent to the solution or a mistake no check catches.
+  A mutant runs only the checks that reach the function it changes (`reached`).
+
+Mutation tools such as mutmut mutate a whole package and report per test-suite run; a
+per-check kill matrix of a single file's solution blocks, judged by checks that take the
+module as a fixture, is simpler to make here with `ast` than to extract from them.
+"""
+
+from __future__ import annotations
+
+import ast
+import contextlib
+import importlib.util
+import random
+import shutil
+import signal
+import sys
+import tempfile
+import warnings
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+
+from ..course import delegation
+from ..course.loader import FolderImplementation
+
+BEGIN, END = "### BEGIN SOLUTION", "### END SOLUTION"
+
+
+@dataclass(frozen=True)
+class Check:
+    """A graded check: its name (without ``test_``), task, points and function."""
+
+    name: str
+    task: int
+    points: int
+    hidden: bool
+    function: Callable[..., Any]
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What a check said about one version of a task file."""
+
+    passed: bool
+    exception: str = ""
+    message: str = ""
+
+
+@dataclass(frozen=True)
+class Mutant:
+    """The solution with one change: where, what was there, what is there now."""
+
+    task: int
+    line: int
+    old: str
+    new: str
+    source: str
+
+    @property
+    def label(self) -> str:
+        return f"line {self.line}: {self.old} -> {self.new}"
+
+
+@dataclass
+class TaskReport:
+    """The result of `validate` for one task."""
+
+    task: int
+    checks: list[str]
+    solution_failures: dict[str, Outcome] = field(default_factory=dict)
+    template_passes: list[str] = field(default_factory=list)
+    kills: dict[str, list[str]] = field(default_factory=dict)  # mutant label -> checks
+    mutants: int = 0
+
+    @property
+    def survivors(self) -> list[str]:
+        return [label for label, checks in self.kills.items() if not checks]
+
+    @property
+    def kill_rate(self) -> float:
+        return 1.0 - len(self.survivors) / self.mutants if self.mutants else 1.0
+
+
+# ---------------------------------------------------------------------------- running checks
+def collect_checks(checks: Path, task: int) -> list[Check]:
+    """The graded checks of ``task`` in the folder ``checks`` (public and hidden)."""
+    found = []
+    folder = str(Path(checks).resolve())
+    if folder not in sys.path:
+        sys.path.insert(0, folder)  # the hidden checks import their references by name
+    for suffix, hidden in (("", False), ("_hidden", True)):
+        path = Path(checks) / f"test_task{task}{suffix}.py"
+        if not path.is_file():
+            continue
+        module = _import(path, f"msdlab_validate_checks_task{task}{suffix}")
+        for name, function in vars(module).items():
+            if not (name.startswith("test_") and callable(function)):
+                continue
+            marks = [*_marks(module), *_marks(function)]
+            points = next((m.args[0] for m in marks if m.name == "points"), None)
+            if points is not None:
+                found.append(Check(name.removeprefix("test_"), task, points, hidden, function))
+    return found
+
+
+def run_checks(
+    checks: Sequence[Check],
+    module: Any,
+    folder: Path | None,
+    *,
+    seconds: float = 30.0,
+    stop_at_first_failure: bool = False,
+) -> dict[str, Outcome]:
+    """Each check's `Outcome` on ``module`` (a task module loaded from ``folder``)."""
+    _hypothesis_profile()
+    outcomes: dict[str, Outcome] = {}
+    for check in checks:
+        try:
+            with (
+                delegation.refusing(check.task, folder),
+                _time_limit(seconds),
+                warnings.catch_warnings(),  # mutants overflow and divide by zero a lot
+                np.errstate(all="ignore"),
+            ):
+                warnings.simplefilter("ignore")
+                check.function(**{f"task{check.task}": module})
+        except (KeyboardInterrupt, SystemExit):
+            raise
+        except BaseException as error:  # whatever the code under test raises
+            outcomes[check.name] = Outcome(False, type(error).__name__, _message(error))
+            if stop_at_first_failure:
+                break
+        else:
+            outcomes[check.name] = Outcome(True)
+    return outcomes
+
+
+def run_source(
+    source: str, task: int, checks: Sequence[Check], **options: Any
+) -> dict[str, Outcome]:
+    """`run_checks` on a task file given as text (written to a fresh folder and imported)."""
+    with _task_file(source, task) as (module, folder, failure):
+        if failure is not None:  # a version that does not even import fails every check
+            return {check.name: failure for check in checks}
+        return run_checks(checks, module, folder, **options)
+
+
+def reached(
+    source: str,
+    task: int,
+    checks: Sequence[Check],
+    outcomes: dict[str, Outcome] | None = None,
+    **options: Any,
+) -> dict[str, set]:
+    """Per check, the top-level functions and classes of the task file it can reach.
+
+    The checks are run on ``source`` (the solution) with a module that records which of
+    its names each check uses; the file's own calls between its functions are added, so
+    a change inside a function matters only to the checks listed with it. The checks'
+    outcomes on ``source`` go to ``outcomes`` if given.
+    """
+    calls = _calls_between_definitions(source)
+    used: dict[str, set] = {}
+    with _task_file(source, task) as (module, folder, failure):
+        if failure is not None:
+            raise ValueError(f"task{task}.py does not import: {failure.message}")
+        for check in checks:
+            recorder = _Recorder(module)
+            (outcomes if outcomes is not None else {}).update(
+                run_checks([check], recorder, folder, **options)
+            )
+            found, todo = set(), list(recorder.names)
+            while todo:
+                name = todo.pop()
+                if name not in found:
+                    found.add(name)
+                    todo += calls.get(name, ())
+            used[check.name] = found
+    return used
+
+
+def definition_at(source: str, line: int) -> str | None:
+    """The name of the top-level function or class whose code holds ``line``."""
+    for node in ast.parse(source).body:
+        inside = node.lineno <= line <= (getattr(node, "end_lineno", None) or node.lineno)
+        if isinstance(node, (ast.FunctionDef, ast.ClassDef)) and inside:
+            return node.name
+    return None
+
+
+class _Recorder:
+    """A task module that notes the names the checks take from it."""
+
+    def __init__(self, module: Any) -> None:
+        self._module, self.names = module, set()
+
+    def __getattr__(self, name: str) -> Any:
+        self.names.add(name)
+        return getattr(self._module, name)
+
+
+def _calls_between_definitions(source: str) -> dict[str, set[str]]:
+    """For each top-level function or class: the file's other top-level names it uses."""
+    tree = ast.parse(source)
+    defined = {n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
+    return {
+        node.name: {n.id for n in ast.walk(node) if isinstance(n, ast.Name) and n.id in defined}
+        - {node.name}
+        for node in tree.body
+        if isinstance(node, (ast.FunctionDef, ast.ClassDef))
+    }
+
+
+@contextlib.contextmanager
+def _task_file(source: str, task: int) -> Iterator[tuple[Any, Path, Outcome | None]]:
+    """The task module made from ``source`` in a fresh folder (or why it does not import)."""
+    folder = Path(tempfile.mkdtemp(prefix="msdlab-validate-"))
+    try:
+        (folder / f"task{task}.py").write_text(source)
+        try:
+            module = FolderImplementation(folder).task(task)
+        except Exception as error:
+            yield None, folder, Outcome(False, type(error).__name__, _message(error))
+        else:
+            yield module, folder, None
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def _marks(holder: object) -> list[Any]:
+    marks = getattr(holder, "pytestmark", [])
+    marks = marks if isinstance(marks, list) else [marks]
+    return [getattr(mark, "mark", mark) for mark in marks]
+
+
+def _import(path: Path, name: str) -> ModuleType:
+    if name in sys.modules:
+        return sys.modules[name]
+    spec = importlib.util.spec_from_file_location(name, path)
+    if spec is None or spec.loader is None:
+        raise ImportError(f"cannot load the checks {path}")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def _message(error: BaseException) -> str:
+    lines = [str(error).strip()] if str(error).strip() else []
+    lines += [str(n) for n in getattr(error, "__notes__", ()) if str(n).startswith("Falsifying")]
+    return "\n".join(lines)
+
+
+def _hypothesis_profile() -> None:
+    """The checks' reproducible profile, without hypothesis's own failure printouts."""
+    from hypothesis import Verbosity, settings
+
+    settings.register_profile(
+        "msdlab-validate",
+        deadline=None,
+        derandomize=True,
+        database=None,
+        verbosity=Verbosity.quiet,
+    )
+    settings.load_profile("msdlab-validate")
+
+
+class CheckTimeout(BaseException):
+    """A check ran longer than its time limit (an endless loop in the code under test?).
+
+    Not an `Exception`, so that hypothesis does not catch it and shrink an endless example.
+    """
+
+
+@contextlib.contextmanager
+def _time_limit(seconds: float) -> Iterator[None]:
+    """Interrupt the block after ``seconds`` (main thread only; elsewhere no limit)."""
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupt(signum: int, frame: Any) -> None:
+        raise CheckTimeout(f"no answer within {seconds:g} s (an endless loop?)")
+
+    previous = signal.signal(signal.SIGALRM, interrupt)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+# ---------------------------------------------------------------------------------- mutants
+_SWAPPED_OPERATORS = {
+    ast.Add: ast.Sub, ast.Sub: ast.Add, ast.Mult: ast.Div, ast.Div: ast.Mult,
+    ast.Pow: ast.Mult, ast.FloorDiv: ast.Div, ast.Mod: ast.FloorDiv,
+}  # fmt: skip
+_SWAPPED_COMPARISONS = {
+    ast.Lt: ast.LtE, ast.LtE: ast.Lt, ast.Gt: ast.GtE, ast.GtE: ast.Gt,
+    ast.Eq: ast.NotEq, ast.NotEq: ast.Eq, ast.In: ast.NotIn, ast.NotIn: ast.In,
+}  # fmt: skip
+_NOT_COMMUTATIVE = (ast.Sub, ast.Div, ast.MatMult, ast.Pow, ast.FloorDiv, ast.Mod)
+
+
+def solution_lines(source: str) -> set[int]:
+    """The line numbers (1-based) inside the solution blocks of a task file."""
+    lines, inside = set(), False
+    for number, text in enumerate(source.splitlines(), start=1):
+        if BEGIN in text:
+            inside = True
+        elif END in text:
+            inside = False
+        elif inside:
+            lines.add(number)
+    return lines
+
+
+def mutants(source: str, task: int) -> list[Mutant]:
+    """Every single-change mutant of the code in the solution blocks of ``source``."""
+    inside = solution_lines(source)
+    found: dict[tuple[int, int, str], Mutant] = {}
+    for node in ast.walk(ast.parse(source)):
+        if getattr(node, "lineno", None) not in inside or node.lineno != node.end_lineno:
+            continue
+        for replacement in _replacements(node):
+            new = ast.unparse(replacement)
+            old = ast.get_source_segment(source, node) or ""
+            if not old or new == ast.unparse(node):
+                continue
+            key = (node.lineno, node.col_offset, new)
+            if key not in found:
+                changed = _replace(source, node, new)
+                found[key] = Mutant(task, node.lineno, old, new, changed)
+    return sorted(found.values(), key=lambda m: (m.line, m.old, m.new))
+
+
+def _replacements(node: ast.AST) -> Iterator[ast.AST]:
+    """The mutations of one node (new nodes; the original is left alone)."""
+    if isinstance(node, ast.BinOp):
+        swapped = _SWAPPED_OPERATORS.get(type(node.op))
+        if swapped is not None:
+            yield ast.BinOp(node.left, swapped(), node.right)
+        if isinstance(node.op, _NOT_COMMUTATIVE):
+            yield ast.BinOp(node.right, node.op, node.left)
+        if isinstance(node.op, (ast.Add, ast.Sub)):  # a dropped term
+            yield node.left
+            yield node.right
+        if isinstance(node.op, (ast.Mult, ast.Div)):  # a dropped factor
+            yield node.left
+    elif isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub):
+        yield node.operand
+    elif isinstance(node, ast.Compare) and len(node.ops) == 1:
+        swapped = _SWAPPED_COMPARISONS.get(type(node.ops[0]))
+        if swapped is not None:
+            yield ast.Compare(node.left, [swapped()], node.comparators)
+    elif isinstance(node, ast.AugAssign):
+        swapped = _SWAPPED_OPERATORS.get(type(node.op))
+        if swapped is not None:
+            yield ast.AugAssign(node.target, swapped(), node.value)
+    elif isinstance(node, ast.Constant) and type(node.value) in (int, float):
+        yield ast.Constant(node.value + 1)
+        yield ast.Constant(node.value - 1)
+        if isinstance(node.value, float) and node.value not in (0.0, 1.0):
+            yield ast.Constant(node.value * 2)
+    elif isinstance(node, ast.Constant) and isinstance(node.value, bool):
+        yield ast.Constant(not node.value)
+
+
+def _replace(source: str, node: ast.AST, new: str) -> str:
+    """``source`` with the text of ``node`` (one line; offsets in UTF-8 bytes) replaced."""
+    lines = source.splitlines(keepends=True)
+    line = lines[node.lineno - 1].encode()
+    text = line[: node.col_offset] + new.encode() + line[node.end_col_offset :]
+    lines[node.lineno - 1] = text.decode()
+    return "".join(lines)
+
+
+# --------------------------------------------------------------------------------- the report
+def validate(
+    course: Path,
+    tasks: Sequence[int],
+    *,
+    sample: int | None = None,
+    seed: int = 0,
+    seconds: float = 30.0,
+    progress: Callable[[str], None] | None = None,
+) -> list[TaskReport]:
+    """Run the checks of ``tasks`` on the solutions, the templates and mutants (see module).
+
+    ``course`` holds ``solutions/``, ``assignments/`` and ``tests/tasks/``; ``sample``
+    limits the mutants per task to a random sample of that size (``seed``).
+    """
+    course = Path(course)
+    reports = []
+    delegation.install()
+    for task in tasks:
+        checks = collect_checks(course / "tests" / "tasks", task)
+        source = (course / "solutions" / f"task{task}.py").read_text()
+        report = TaskReport(task, [c.name for c in checks])
+        solved: dict[str, Outcome] = {}
+        uses = reached(source, task, checks, solved, seconds=seconds)
+        report.solution_failures = {n: o for n, o in solved.items() if not o.passed}
+        template = course / "assignments" / f"task{task}.py"
+        if template.is_file():
+            outcomes = run_source(template.read_text(), task, checks, seconds=seconds)
+            report.template_passes = [n for n, o in outcomes.items() if o.passed]
+        chosen = mutants(source, task)
+        if sample is not None and sample < len(chosen):
+            chosen = sorted(random.Random(seed).sample(chosen, sample), key=lambda m: m.line)
+        report.mutants = len(chosen)
+        for number, mutant in enumerate(chosen, start=1):
+            changed = definition_at(source, mutant.line)
+            concerned = [c for c in checks if changed is None or changed in uses[c.name]]
+            outcomes = run_source(mutant.source, task, concerned, seconds=seconds)
+            report.kills[mutant.label] = [n for n, o in outcomes.items() if not o.passed]
+            if progress is not None:
+                progress(f"task {task}: mutant {number}/{len(chosen)} {mutant.label}")
+        reports.append(report)
+    return reports
+
+
+def format_report(reports: Sequence[TaskReport], verbose: bool = False) -> str:
+    """The instructor's text: per task the solution and template verdicts, kills, survivors."""
+    out = []
+    for report in reports:
+        out.append(f"task {report.task}: {len(report.checks)} checks, {report.mutants} mutants")
+        solution = (
+            "all pass"
+            if not report.solution_failures
+            else "FAIL: "
+            + ", ".join(
+                f"{n} ({o.exception}: {o.message.splitlines()[0] if o.message else ''})"
+                for n, o in report.solution_failures.items()
+            )
+        )
+        out.append(f"  solution: {solution}")
+        template = (
+            "all fail"
+            if not report.template_passes
+            else "PASSES: " + ", ".join(report.template_passes)
+        )
+        out.append(f"  template: {template}")
+        killers: dict[str, int] = dict.fromkeys(report.checks, 0)
+        for checks in report.kills.values():
+            for name in checks:
+                killers[name] += 1
+        out.append("  mutants killed per check:")
+        out += [f"    {killers[n]:4d}  {n}" for n in report.checks]
+        if verbose:
+            out.append("  kills:")
+            out += [
+                f"    {label}: {', '.join(checks)}"
+                for label, checks in report.kills.items()
+                if checks
+            ]
+        out.append(f"  survivors ({len(report.survivors)}):")
+        out += [f"    {label}" for label in report.survivors]
+        out.append(f"  kill rate: {report.kill_rate:.0%}")
+    total = sum(r.mutants for r in reports)
+    survived = sum(len(r.survivors) for r in reports)
+    if total:
+        out.append(
+            f"all tasks: {total - survived}/{total} mutants killed ({1 - survived / total:.0%})"
+        )
+    return "\n".join(out)

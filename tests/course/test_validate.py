@@ -1,0 +1,58 @@
+"""`msdlab validate`: the solutions pass, the templates fail, and the mutants of the solution
+blocks are killed by checks named in the report (a small sample here; all of them take long)."""
+
+from __future__ import annotations
+
+import textwrap
+
+from msdlab.cli import main
+from msdlab.course import PROJECT_ROOT
+from msdlab.instructor import validate
+
+SOURCE = textwrap.dedent(
+    '''
+    def given(x):
+        return x - 1
+
+
+    def answer(x, y):
+        """Docs."""
+        ### BEGIN SOLUTION
+        if x < y:
+            return -x + 2 * y
+        ### END SOLUTION
+        return 0
+    '''
+)
+
+
+def test_mutants_change_only_the_solution_blocks_one_thing_at_a_time():
+    found = validate.mutants(SOURCE, 1)
+    labels = {m.label for m in found}
+    assert {
+        "line 9: x < y -> x <= y",  # a changed comparison
+        "line 10: -x + 2 * y -> -x - 2 * y",  # a swapped operator
+        "line 10: -x -> x",  # a sign flip
+        "line 10: 2 -> 3",  # an off-by-one constant
+        "line 10: -x + 2 * y -> -x",  # a dropped term
+    } <= labels
+    assert all(m.line in (9, 10) for m in found)  # `given` and `return 0` stay as they are
+    for mutant in found:
+        changed = [a for a, b in zip(SOURCE.splitlines(), mutant.source.splitlines()) if a != b]
+        assert len(changed) == 1
+        compile(mutant.source, "mutant", "exec")
+
+
+def test_validate_reports_solution_template_and_kills(capsys):
+    reports = validate.validate(PROJECT_ROOT, [5], sample=4, seed=1)
+    (report,) = reports
+    assert not report.solution_failures and not report.template_passes
+    assert report.mutants == 4 and len(report.kills) == 4
+    text = validate.format_report(reports, verbose=True)
+    assert "solution: all pass" in text and "template: all fail" in text
+    assert "kill rate:" in text and "mutants killed per check:" in text
+
+
+def test_validate_command_refuses_an_unknown_task(capsys):
+    assert main(["validate", "7"]) != 0
+    assert "no task 7" in capsys.readouterr().err
