@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import collections
 import contextlib
-import csv
 import fcntl
 import os
 import queue
@@ -202,36 +201,11 @@ def reserved_uids(count: int) -> Iterator[list[int | None]]:
             handle.close()
 
 
-def write_csv(grades: Sequence[Grade], path: Path) -> None:
-    """One row per submission: submission, task1 ... task5, total, notes."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    columns = ["submission", *(f"task{t}" for t in TASKS), "total", "notes"]
-    with path.open("w", newline="", encoding="utf-8") as handle:
-        writer = csv.DictWriter(handle, fieldnames=columns)
-        writer.writeheader()
-        writer.writerows(grade.row() for grade in grades)
-
-
-def feedback(grade: Grade) -> str:
-    """The feedback text of one submission: its points, each check, and what failed and why."""
-    lines = [f"# {grade.submission}", ""]
-    if grade.report is None:
-        lines += ["Your submission could not be graded:", *[f"- {n}" for n in grade.notes]]
-        return "\n".join(lines) + "\n"
-    points = ", ".join(f"task{t} {grade.points(t)}" for t in TASKS)
-    lines += [f"{grade.total}/{grade.report.points} points ({points})", ""]
-    lines += [f"Note: {note}" for note in grade.notes]
-    lines += ["", "```", grade.report.table(), "```", ""]
-    details = grade.report.details()
-    if details:
-        lines += ["## What the failing checks saw", "", "```", details, "```"]
-    return "\n".join(lines) + "\n"
-
-
 def summary(grades: Sequence[Grade], seconds: float) -> str:
     """Count, mean points per task, and failures by reason."""
     graded = [g for g in grades if g.graded]
-    lines = [f"graded {len(graded)} of {len(grades)} submissions in {seconds:.0f} s"]
+    plural = "" if len(grades) == 1 else "s"
+    lines = [f"graded {len(graded)} of {len(grades)} submission{plural} in {seconds:.0f} s"]
     if graded:
         possible = {t: sum(c.points for c in graded[0].report.checks if c.task == t) for t in TASKS}
         means = [
@@ -240,7 +214,7 @@ def summary(grades: Sequence[Grade], seconds: float) -> str:
         ]
         total = sum(g.total for g in graded) / len(graded)
         lines.append(f"mean: {', '.join(means)}; total {total:.1f}/{sum(possible.values())}")
-    reasons = collections.Counter(_reason(note) for g in grades for note in g.notes)
+    reasons = collections.Counter(r for g in grades for r in {_reason(n) for n in g.notes})
     if reasons:
         lines.append("problems: " + ", ".join(f"{r} ×{n}" for r, n in reasons.most_common()))
     return "\n".join(lines)
@@ -335,7 +309,10 @@ def _problems(report: CheckReport) -> list[str]:
                 kinds.append(_KNOWN[check.exception])
             elif check.exception == "SubmissionRaised" and "sys.exit" in text:
                 kinds.append("called sys.exit")
-            elif check.exception in ("SubmissionError", "FileNotFoundError"):
+            elif (
+                check.exception in ("SubmissionError", "FileNotFoundError")
+                and " is missing from " not in text  # the copy's note already says so
+            ):
                 kinds.append(text or "task file could not be loaded")
         notes += [f"task{task}: {kind}" for kind in dict.fromkeys(kinds)]
     return notes
