@@ -180,8 +180,7 @@ def _from_folder(identifier: str, source: Path, folder: Path) -> Entry:
         entry.folder = inner
         entry.notes.append(f"graded from the {BUNDLE_FOLDER}/ folder inside the submission")
     if not task_files(entry.folder):
-        names = ", ".join(f"task{t}.py" for t in TASKS)
-        entry.problem = f"no task files ({names}) in the submission"
+        entry.problem = f"no task files (task{TASKS[0]}.py ... task{TASKS[-1]}.py) handed in"
     return entry
 
 

@@ -18,6 +18,7 @@ status 0 if every submission was graded, 1 otherwise.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import sys
 import time
@@ -85,11 +86,14 @@ def run(args: argparse.Namespace) -> int:
         if args.resume:
             todo = [e for e in todo if book.fingerprint_of(e.id) != prints[e.id]]
         skipped = len(entries) - len(todo) - sum(e.problem is not None for e in entries.values())
-        unusable = [
-            grading.Grade(e.id, None, [*e.notes, e.problem]) for e in entries.values() if e.problem
-        ]
+        unusable = [grading.Grade(e.id, None, [e.problem]) for e in entries.values() if e.problem]
         for grade in unusable:
-            book.record(grade, entries[grade.submission], None, args.detail)
+            book.record(
+                shown(grade, entries[grade.submission]),
+                entries[grade.submission],
+                None,
+                args.detail,
+            )
         plural = "" if len(todo) == 1 else "s"
         resumed = f" ({skipped} unchanged since graded, skipped)" if skipped else ""
         print(
@@ -100,8 +104,7 @@ def run(args: argparse.Namespace) -> int:
 
         def progress(grade: grading.Grade, done: int, count: int) -> None:
             entry = entries[grade.submission]
-            grade.notes[:0] = entry.notes
-            book.record(grade, entry, prints[grade.submission], args.detail)
+            book.record(shown(grade, entry), entry, prints[grade.submission], args.detail)
             book.write(args.out)  # after each: an interrupted run keeps what was graded
             if grade.graded:
                 result = f"{grade.total}/{grade.report.points} points"
@@ -136,13 +139,18 @@ def run(args: argparse.Namespace) -> int:
     return 0 if all(grade.graded for grade in grades) else 1
 
 
+def shown(grade: grading.Grade, entry: intake.Entry) -> grading.Grade:
+    """``grade`` with the intake's notes on its submission first (for the CSV and feedback)."""
+    return dataclasses.replace(grade, notes=[*entry.notes, *grade.notes])
+
+
 def write_feedback(
     folder: Path, grades: list[grading.Grade], entries: dict[str, intake.Entry]
 ) -> None:
     """DIR/students/ID.md, DIR/instructor/ID.md and DIR/summary.md."""
     for kind in ("students", "instructor"):
         (folder / kind).mkdir(parents=True, exist_ok=True)
-    for grade in grades:
+    for grade in (shown(g, entries[g.submission]) for g in grades):
         stem = intake.file_stem(grade.submission)
         (folder / "students" / f"{stem}.md").write_text(
             feedback.for_student(grade), encoding="utf-8"
