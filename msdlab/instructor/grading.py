@@ -29,6 +29,7 @@ from pathlib import Path
 
 from ..course import TASKS
 from ..course.report import CheckReport
+from . import reference_cache
 
 MAX_FILE_BYTES = 1_000_000
 FIRST_UID = 61000  # as root, sandboxes run as reserved user ids from here on
@@ -96,10 +97,12 @@ def grade(
     call_timeout: float = 60.0,
     memory_mb: int = 2048,
     uid: int | None = None,
+    references: Path | None = None,
 ) -> Grade:
     """Grade one submission with the checks in ``checks`` (see the module docstring).
 
-    As root the sandbox runs as user ``uid`` (default: one reserved for this call).
+    As root the sandbox runs as user ``uid`` (default: one reserved for this call);
+    ``references`` is a folder the judges share for references (`reference_cache`).
     """
     if uid is None and os.geteuid() == 0:
         with reserved_uids(1) as (reserved,):
@@ -125,6 +128,8 @@ def grade(
         environment = dict(os.environ, PYTHONDONTWRITEBYTECODE="1", MSDLAB_KERNEL="numpy")
         if uid is not None:
             environment["MSDLAB_SANDBOX_UID"] = str(uid)
+        if references is not None:
+            environment[reference_cache.ENV] = str(references)
         failure = _run_judge(command, workspace, environment, timeout)
         if uid is not None:
             _kill_user(uid)
@@ -157,7 +162,7 @@ def grade_all(
     def one(submission: Submission) -> Grade:
         uid = slots.get()
         try:
-            result = grade(submission, checks, uid=uid, **limits)
+            result = grade(submission, checks, uid=uid, references=references, **limits)
         finally:
             slots.put(uid)
         with lock:
@@ -166,7 +171,12 @@ def grade_all(
                 progress(result, len(finished), len(submissions))
         return result
 
-    with reserved_uids(jobs) as uids, ThreadPoolExecutor(max_workers=jobs) as pool:
+    with (
+        reserved_uids(jobs) as uids,
+        tempfile.TemporaryDirectory(prefix="msdlab-references-") as shared,
+        ThreadPoolExecutor(max_workers=jobs) as pool,
+    ):
+        references = Path(shared)
         for uid in uids:
             slots.put(uid)
         return list(pool.map(one, submissions))

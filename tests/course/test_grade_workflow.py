@@ -14,7 +14,7 @@ import pytest
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
 from msdlab.course.report import CheckReport, CheckResult
-from msdlab.instructor import feedback, gradebook, intake
+from msdlab.instructor import feedback, gradebook, intake, reference_cache
 from msdlab.instructor.grading import Grade
 
 SOLUTIONS = PROJECT_ROOT / "solutions"
@@ -215,3 +215,18 @@ WRONG_COUNT = """
 def particle_count(n: int = N) -> int:
     return n * n  # wrong on purpose
 """
+
+
+def test_references_are_computed_once_per_run_and_read_back_exactly(tmp_path, monkeypatch):
+    calls = []
+
+    @reference_cache.cached
+    def reference(x: float, steps: int = 3) -> float:
+        calls.append(x)
+        return x / 3.0 + steps
+
+    assert reference(0.1) == reference(0.1) and len(calls) == 2  # no cache folder: no cache
+    monkeypatch.setenv(reference_cache.ENV, str(tmp_path))
+    first = reference(0.1)
+    assert reference(0.1) == first == 0.1 / 3.0 + 3 and len(calls) == 3
+    assert reference(0.1, steps=4) != first and len(calls) == 4
