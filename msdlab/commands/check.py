@@ -1,25 +1,34 @@
 """``msdlab check [TASK]``: run the checks of one task (or all) on your task files and score them.
 
 The checks (tests/tasks) run in a fresh pytest process on a folder laid out
-like assignments/ (default: ./assignments, else the course's assignments/). The
-table shows each check, its points, pass or fail and what the check saw;
-the exit status is 0 only if every check passed.
+like assignments/ (default: ./assignments, else the course's assignments/); each
+call into your files may take --call-timeout seconds. The table shows each
+check, its points, pass or fail and what the check saw (a long message once,
+below it); the last line says what the hidden checks, which run only when your
+work is graded, are worth. The exit status is 0 only if every check passed.
 """
 
 from __future__ import annotations
 
 import argparse
 import shutil
+import tempfile
 from pathlib import Path
 
-from ..course import TASKS
+from ..course import TASKS, manifest
+from ..course.report import CheckReport
 from ..course.runner import (
+    CALL_TIMEOUT,
     CHECKS,
     ChecksDidNotRun,
     checks_folder,
     implementation_folder,
+    install_command,
+    missing_test_tools,
     run_checks,
 )
+
+HIDDEN_FILES = "test_*_hidden.py"
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -51,40 +60,81 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--timeout", type=float, default=900.0, help="give up after this many seconds (%(default)s)"
     )
+    parser.add_argument(
+        "--call-timeout",
+        type=float,
+        default=CALL_TIMEOUT,
+        help="seconds one call into your task files may take (%(default)s)",
+    )
     parser.add_argument("-v", "--verbose", action="store_true", help="show pytest's own output too")
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     task = parse_task(args.task)
+    if args.timeout <= 0 or args.call_timeout <= 0:
+        raise ValueError("--timeout and --call-timeout must be positive numbers of seconds")
+    missing = missing_test_tools()
+    if missing:
+        print(f"msdlab check needs {' and '.join(missing)} (the test extras); install them with:")
+        print(f"  {install_command(Path.cwd())}")
+        return 2
     checks = checks_folder(args.checks, Path.cwd())
     folder = implementation_folder(args.impl, Path.cwd())
+    hidden = args.hidden
+    if hidden and not any(checks.glob(HIDDEN_FILES)):
+        print("The hidden checks are not in this copy of the course: they run when your work")
+        print("is graded. Running the public checks only.")
+        hidden = False
     scope = f"task {task}" if task else "all tasks"
     print(f"msdlab check: {scope} on {folder}")
-    try:
-        report, output = run_checks(
-            checks,
-            folder,
-            task,
-            hidden=args.hidden,
-            verbose=args.verbose,
-            timeout=args.timeout,
-            save=args.report,
+    with tempfile.TemporaryDirectory(prefix="msdlab-check-") as scratch:
+        points = Path(scratch) / manifest.FILE_NAME
+        try:
+            report, output = run_checks(
+                checks,
+                folder,
+                task,
+                hidden=hidden,
+                verbose=args.verbose,
+                timeout=args.timeout,
+                save=args.report,
+                call_timeout=args.call_timeout,
+                points=points,
+            )
+        except ChecksDidNotRun as error:
+            print(error.output)
+            print(error)
+            return 2
+        worth = max(
+            manifest.hidden_points(points, task),
+            manifest.hidden_points(checks / manifest.FILE_NAME, task),
         )
-    except ChecksDidNotRun as error:
-        print(error.output)
-        print(error)
-        return 2
     if args.verbose:
         print(output)
     width = shutil.get_terminal_size((100, 24)).columns
     print()
     print(report.table(width))
+    print(score_line(report, worth))
     details = report.details(width)
     if details:
-        print("\nwhat the failing checks saw:\n")
+        print("\nin full:\n")
         print(details)
     return 0 if report.all_passed else 1
+
+
+def score_line(report: CheckReport, hidden_worth: int) -> str:
+    """'public P of Q points; hidden checks worth H more run when graded' (or the hidden score
+    when they ran)."""
+    public = [c for c in report.checks if not c.hidden]
+    hidden = [c for c in report.checks if c.hidden]
+    line = f"public {sum(c.earned for c in public)} of {sum(c.points for c in public)} points"
+    if hidden:
+        earned, points = sum(c.earned for c in hidden), sum(c.points for c in hidden)
+        return f"{line}; hidden {earned} of {points} points"
+    if hidden_worth:
+        return f"{line}; hidden checks worth {hidden_worth} more run when graded"
+    return line
 
 
 def parse_task(text: str | None) -> int | None:

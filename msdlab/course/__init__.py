@@ -10,6 +10,8 @@ is `msdlab.instructor`, which the student bundle does not contain.)
 - `runner`: run the checks in a fresh pytest process (``msdlab check``, the notebooks).
 - `notebook`: the notebooks' helper for trying and checking a task.
 - `report`: the machine-readable result of a check run, and its text table.
+- `call_limit`: the time limit on each call into a task file (``msdlab check --call-timeout``).
+- `manifest`: what the checks of each task are worth, hidden ones included.
 - `pytest_plugin`: ``--impl``, the task fixtures, markers, points and the JSON report.
 """
 

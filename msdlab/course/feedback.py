@@ -47,8 +47,11 @@ def vec(values: Sequence[float] | np.ndarray, digits: int = 3) -> str:
 
 
 def percent(fraction: float) -> str:
-    """A fraction as a percentage, e.g. 0.4 -> '40 %', 2e-5 -> '0.002 %', 650 -> '65000 %'."""
+    """A fraction as a percentage, e.g. 0.4 -> '40 %', 2e-5 -> '0.002 %', 650 -> '65000 %',
+    1e83 -> '1e+85 %' (scientific notation from a million per cent on)."""
     value = 100.0 * float(fraction)
+    if abs(value) >= 1e6 or not np.isfinite(value):
+        return f"{num(value, 2)} %"
     return f"{value:.0f} %" if abs(value) >= 100 else f"{num(value, 2)} %"
 
 

@@ -19,6 +19,8 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any, Protocol
 
+from . import call_limit
+
 NAMED = ("solutions", "assignments")
 
 
@@ -38,18 +40,20 @@ class Implementation(Protocol):
 class TaskModule:
     """A loaded task file; a missing name gives an error that says which file lacks it."""
 
-    def __init__(self, module: ModuleType, path: Path) -> None:
+    def __init__(self, module: ModuleType, path: Path, call_timeout: float = 0.0) -> None:
         self._module = module
         self._path = path
+        self._call_timeout = call_timeout  # seconds per call (0: no limit), see `call_limit`
 
     def __getattr__(self, name: str) -> Any:
         try:
-            return getattr(self._module, name)
+            value = getattr(self._module, name)
         except AttributeError:
             raise AttributeError(
                 f"{self._path.name} has no '{name}': keep the names of the template "
                 f"(file {self._path})"
             ) from None
+        return call_limit.limited(value, self._call_timeout, self._path.name)
 
     def __repr__(self) -> str:
         return f"<task module {self._path}>"
@@ -62,8 +66,9 @@ class FolderImplementation:
     solutions and a student's folder) can be loaded in one process.
     """
 
-    def __init__(self, folder: Path, label: str | None = None) -> None:
+    def __init__(self, folder: Path, label: str | None = None, call_timeout: float = 0.0) -> None:
         self.folder = Path(folder).resolve()
+        self.call_timeout = call_timeout
         if not self.folder.is_dir():
             raise SubmissionError(f"no implementation folder at {self.folder}")
         self.label = label or str(self.folder)
@@ -73,7 +78,8 @@ class FolderImplementation:
     def task(self, number: int) -> TaskModule:
         if number not in self._modules:
             path = self.folder / f"task{number}.py"
-            self._modules[number] = TaskModule(self._import(number, path), path)
+            module = self._import(number, path)
+            self._modules[number] = TaskModule(module, path, self.call_timeout)
         return self._modules[number]
 
     def _import(self, number: int, path: Path) -> ModuleType:
@@ -125,11 +131,12 @@ def course_root(start: Path) -> Path:
     return start
 
 
-def load(spec: str | Path, root: Path) -> FolderImplementation:
-    """The implementation an ``--impl`` value names (see `resolve`)."""
+def load(spec: str | Path, root: Path, call_timeout: float = 0.0) -> FolderImplementation:
+    """The implementation an ``--impl`` value names (see `resolve`); each call into it may
+    take ``call_timeout`` seconds (0: no limit)."""
     folder = resolve(spec, root)
     label = str(spec) if str(spec) in NAMED else str(folder)
-    return FolderImplementation(folder, label)
+    return FolderImplementation(folder, label, call_timeout)
 
 
 def _line_in(error: BaseException, path: Path) -> str:

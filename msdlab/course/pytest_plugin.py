@@ -9,6 +9,10 @@
   load submissions another way.
 - Markers ``task1`` ... ``task5``, ``points(n)`` and ``hidden``. A graded check
   has exactly one task marker and its points; ``hidden`` checks are instructor-only.
+- ``--call-timeout=S``: each call into the task modules may take S seconds
+  (`msdlab.course.call_limit`; default: no limit).
+- ``--msdlab-points=PATH`` writes the points of every collected check, public and
+  hidden, per task (`msdlab.course.manifest`).
 - ``--msdlab-report=PATH`` writes the JSON `CheckReport` of the graded checks;
   a points summary ends the terminal output.
 - `hypothesis_profiles`, called by the checks' conftest: profiles ``ci`` (no
@@ -27,7 +31,7 @@ from typing import Any
 
 import pytest
 
-from . import TASKS, delegation, loader
+from . import TASKS, call_limit, delegation, loader, manifest
 from .report import CheckReport, CheckResult
 
 ENV_IMPL = "MSDLAB_IMPL"
@@ -67,6 +71,20 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         "answer to them (by default it is refused, see msdlab.course.delegation)",
     )
     group.addoption(
+        "--call-timeout",
+        type=float,
+        default=0.0,
+        metavar="S",
+        help="seconds one call into the implementation may take (default 0: no limit)",
+    )
+    group.addoption(
+        "--msdlab-points",
+        default=None,
+        metavar="PATH",
+        help="write the points of every graded check collected, public and hidden, per task, "
+        "as JSON to PATH (before -m deselects any)",
+    )
+    group.addoption(
         "--msdlab-report",
         default=None,
         metavar="PATH",
@@ -99,7 +117,7 @@ def implementation(pytestconfig: pytest.Config) -> Iterator[loader.Implementatio
         config=pytestconfig, spec=spec, root=root
     )
     if provided is None:
-        yield loader.load(spec, root)
+        yield loader.load(spec, root, pytestconfig.getoption("call_timeout"))
         return
     try:
         yield provided
@@ -126,6 +144,12 @@ task4 = _task_fixture(4)
 task5 = _task_fixture(5)
 
 
+def pytest_runtest_setup(item: pytest.Item) -> None:
+    """Each check starts afresh: a function that timed out in an earlier check runs again."""
+    call_limit.forgive()
+
+
+@pytest.hookimpl(tryfirst=True)  # before -m deselects: --msdlab-points counts every check
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Record task, points and hidden for each graded check; refuse checks without points."""
     problems = []
@@ -146,6 +170,10 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         item.stash[_GRADED] = (tasks[0], value, item.get_closest_marker("hidden") is not None)
     if problems:
         raise pytest.UsageError("graded checks are badly marked:\n  " + "\n  ".join(problems))
+    path = config.getoption("msdlab_points")
+    if path:
+        graded = [item.stash[_GRADED] for item in items if _GRADED in item.stash]
+        manifest.write(Path(path), graded)
     if any(_GRADED in item.stash for item in items):
         delegation.install()  # before the implementation is imported
 
@@ -239,11 +267,12 @@ def _describe(call: pytest.CallInfo) -> tuple[str | None, str]:
         return None, ""
     error = call.excinfo.value
     lines = [str(error).strip()] if str(error).strip() else []
-    lines += [  # hypothesis's failing example; its other notes name lines of the checks
-        str(note)
-        for note in getattr(error, "__notes__", ())
-        if str(note).startswith(("Falsifying example", "Failing test case"))
-    ]
+    if not isinstance(error, (NotImplementedError, call_limit.CallTimedOut)):
+        lines += [  # hypothesis's failing example; its other notes name lines of the checks
+            str(note)
+            for note in getattr(error, "__notes__", ())
+            if str(note).startswith(("Falsifying example", "Failing test case"))
+        ]
     return type(error).__name__, "\n".join(lines)
 
 

@@ -112,18 +112,30 @@ class CheckReport:
         return cls(data["implementation"], checks, data.get("duration", 0.0))
 
     def table(self, width: int = 100) -> str:
-        """Check, points, result and the short message of every check, then the totals."""
+        """Check, points, result and message of every check, then the totals.
+
+        A failing check's message is in the table when it fits on its row, else the row
+        says ``see [n]`` and `details` prints message n in full, once for all the checks
+        that saw the same. A task whose checks all failed with the same message is one row.
+        """
         if not self.checks:
             return "no graded checks ran"
-        name_width = min(max(len(_label(c)) for c in self.checks), max(width // 2, 30))
-        message_width = max(width - name_width - 17, 20)
+        rows = _rows(self.checks)
+        numbers = _numbers(rows, width)
+        name_width = min(max(len(label) for label, _ in rows), max(width // 2, 30))
+        message_width = max(width - name_width - 18, 20)
         lines = [f"{'check':<{name_width}}  points  result  message"]
-        for check in self.checks:
-            result = "pass" if check.passed else check.outcome.upper()
-            message = "" if check.passed else _shorten(check.summary, message_width)
-            points = f"{check.earned}/{check.points}"
+        for label, checks in rows:
+            first = checks[0]
+            result = "pass" if first.passed else first.outcome.upper()
+            message = ""
+            if not first.passed:
+                text = first.summary
+                fits = len(text) <= message_width and _complete(first)
+                message = text if fits else f"see [{numbers[_full_message(first)]}]"
+            earned, points = sum(c.earned for c in checks), sum(c.points for c in checks)
             lines.append(
-                f"{_shorten(_label(check), name_width):<{name_width}}  {points:>6}  "
+                f"{_shorten(label, name_width):<{name_width}}  {f'{earned}/{points}':>6}  "
                 f"{result:<6}  {message}".rstrip()
             )
         passed = sum(check.passed for check in self.checks)
@@ -134,18 +146,56 @@ class CheckReport:
         return "\n".join(lines)
 
     def details(self, width: int = 100) -> str:
-        """The full message of every check that did not pass."""
+        """The full messages the table refers to as ``[n]``, each once."""
+        rows = _rows(self.checks)
+        numbers = _numbers(rows, width)
         blocks = []
-        for check in self.checks:
-            if check.passed:
-                continue
+        for message, number in numbers.items():
             body = "\n".join(
                 textwrap.fill(line, width, initial_indent="  ", subsequent_indent="  ")
-                for line in _full_message(check).splitlines()
+                for line in message.splitlines()
                 if line.strip()
             )
-            blocks.append(f"{_label(check)} ({check.outcome}):\n{body}")
+            blocks.append(f"[{number}]\n{body}")
         return "\n\n".join(blocks)
+
+
+def _rows(checks: list[CheckResult]) -> list[tuple[str, list[CheckResult]]]:
+    """(label, checks) per table row: one per check, or one for a whole task whose checks
+    all failed with the same message."""
+    rows: list[tuple[str, list[CheckResult]]] = []
+    tasks = sorted({c.task for c in checks})
+    for task in tasks:
+        group = [c for c in checks if c.task == task]
+        same = {(c.outcome, _full_message(c)) for c in group}
+        if len(group) > 1 and len(same) == 1 and not group[0].passed:
+            hidden = " incl. hidden" if any(c.hidden for c in group) else ""
+            rows.append((f"task{task} (all {len(group)} checks{hidden})", group))
+        else:
+            rows += [(_label(c), [c]) for c in group]
+    order = {id(c): i for i, c in enumerate(checks)}
+    return sorted(rows, key=lambda row: order[id(row[1][0])])
+
+
+def _numbers(rows: list[tuple[str, list[CheckResult]]], width: int) -> dict[str, int]:
+    """Full message -> its number, for the failing rows whose message does not fit."""
+    name_width = min(max(len(label) for label, _ in rows), max(width // 2, 30)) if rows else 0
+    message_width = max(width - name_width - 18, 20)
+    numbers: dict[str, int] = {}
+    for _, checks in rows:
+        first = checks[0]
+        if first.passed:
+            continue
+        full = _full_message(first)
+        if len(first.summary) <= message_width and _complete(first):
+            continue
+        numbers.setdefault(full, len(numbers) + 1)
+    return numbers
+
+
+def _complete(check: CheckResult) -> bool:
+    """Whether the table's one-line summary of a check says all its message does."""
+    return "\n" not in check.message.strip()
 
 
 def _label(check: CheckResult) -> str:
@@ -154,6 +204,8 @@ def _label(check: CheckResult) -> str:
 
 
 def _full_message(check: CheckResult) -> str:
+    if check.exception == "NotImplementedError":
+        return "to do: " + re.sub(r"^Task \d+: ", "", check.message.strip())
     if check.exception and check.exception not in ("CheckFailed", "AssertionError"):
         return f"{check.exception}: {check.message}"
     return check.message or "(no message)"

@@ -6,7 +6,9 @@ task (or all) in a checks folder, on a folder of task files.
 
 from __future__ import annotations
 
+import importlib.util
 import os
+import shlex
 import shutil
 import subprocess
 import sys
@@ -17,6 +19,9 @@ from . import PROJECT_ROOT, TASKS, loader
 from .report import CheckReport
 
 CHECKS = Path("tests") / "tasks"
+CALL_TIMEOUT = 10.0
+"""Seconds one call into a task file may take by default (`call_limit`); the slowest call the
+reference solutions make takes well under a second."""
 
 
 class ChecksDidNotRun(RuntimeError):
@@ -36,15 +41,22 @@ def run_checks(
     verbose: bool = False,
     timeout: float = 900.0,
     save: Path | None = None,
+    call_timeout: float = CALL_TIMEOUT,
+    points: Path | None = None,
 ) -> tuple[CheckReport, str]:
     """Run the checks of ``task`` (None: all tasks) on the task files in ``folder``.
 
     Returns the report and pytest's output; ``save`` keeps a copy of the JSON
-    report. Hidden checks run only with ``hidden``.
+    report, ``points`` gets the points manifest of every check found (`manifest`).
+    Hidden checks run only with ``hidden``. Each call into a task file may take
+    ``call_timeout`` seconds, the whole run ``timeout``.
     """
     with tempfile.TemporaryDirectory(prefix="msdlab-check-") as scratch:
         report_path = Path(scratch) / "report.json"
         command = pytest_command(checks, folder, task, hidden, report_path, verbose)
+        command.append(f"--call-timeout={call_timeout:g}")
+        if points is not None:
+            command.append(f"--msdlab-points={points}")
         try:
             process = subprocess.run(
                 command,
@@ -56,7 +68,8 @@ def run_checks(
             )
         except subprocess.TimeoutExpired:
             raise ChecksDidNotRun(
-                f"the checks did not finish within {timeout:g} s: is there an endless loop?"
+                f"the checks did not finish within {timeout:g} s: is there an endless loop at "
+                "the top level of a task file, or one the per-call limit cannot interrupt?"
             ) from None
         output = process.stdout + process.stderr
         if not report_path.exists() or process.returncode not in (0, 1):
@@ -66,6 +79,21 @@ def run_checks(
         if save is not None:
             shutil.copyfile(report_path, save)
         return CheckReport.read(report_path), output
+
+
+def missing_test_tools() -> list[str]:
+    """The modules the checks need that are not installed (pytest, hypothesis)."""
+    return [name for name in ("pytest", "hypothesis") if importlib.util.find_spec(name) is None]
+
+
+def install_command(cwd: Path) -> str:
+    """The command that installs the test extras into this Python: of the course folder
+    ``cwd`` is in when it is an installable project, else of the msdlab package."""
+    python = shlex.quote(sys.executable)
+    for root in (loader.course_root(cwd), PROJECT_ROOT):
+        if (root / "pyproject.toml").is_file():
+            return f"{python} -m pip install -e {shlex.quote(f'{root}[test]')}"
+    return f"{python} -m pip install 'msdlab[test]'"
 
 
 def checks_folder(given: Path | None, cwd: Path) -> Path:

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import collections
 import contextlib
-import csv
 import fcntl
 import os
 import queue
@@ -30,6 +29,7 @@ from pathlib import Path
 
 from ..course import TASKS
 from ..course.report import CheckReport
+from . import reference_cache
 
 MAX_FILE_BYTES = 1_000_000
 FIRST_UID = 61000  # as root, sandboxes run as reserved user ids from here on
@@ -99,18 +99,20 @@ def grade(
     uid: int | None = None,
     isolation: str = "namespace",
     allow_delegation: Sequence[int] = (),
+    references: Path | None = None,
 ) -> Grade:
     """Grade one submission with the checks in ``checks`` (see the module docstring).
 
     As root the sandbox runs as user ``uid`` (default: one reserved for this call).
     ``isolation`` is the sandbox's level (`sandbox.ISOLATION_LEVELS`); a weaker one
-    than ``namespace`` is named in the row's notes.
+    than ``namespace`` is named in the row's notes. ``references`` is a folder the
+    judges share for references (`reference_cache`).
     """
     if uid is None and os.geteuid() == 0:
         with reserved_uids(1) as (reserved,):
             return grade(submission, checks, timeout=timeout, call_timeout=call_timeout,
                          memory_mb=memory_mb, uid=reserved, isolation=isolation,
-                         allow_delegation=allow_delegation)  # fmt: skip
+                         allow_delegation=allow_delegation, references=references)  # fmt: skip
     started = time.monotonic()
     workspace = Path(tempfile.mkdtemp(prefix="msdlab-grade-"))
     try:
@@ -136,6 +138,8 @@ def grade(
             notes.append(f"graded with the weaker isolation '{isolation}'")
         if uid is not None:
             environment["MSDLAB_SANDBOX_UID"] = str(uid)
+        if references is not None:
+            environment[reference_cache.ENV] = str(references)
         failure = _run_judge(command, workspace, environment, timeout)
         if uid is not None:
             _kill_user(uid)
@@ -176,6 +180,7 @@ def grade_all(
                 uid=uid,
                 isolation=isolation,
                 allow_delegation=allow_delegation,
+                references=references,
                 **limits,
             )
         finally:
@@ -186,7 +191,12 @@ def grade_all(
                 progress(result, len(finished), len(submissions))
         return result
 
-    with reserved_uids(jobs) as uids, ThreadPoolExecutor(max_workers=jobs) as pool:
+    with (
+        reserved_uids(jobs) as uids,
+        tempfile.TemporaryDirectory(prefix="msdlab-references-") as shared,
+        ThreadPoolExecutor(max_workers=jobs) as pool,
+    ):
+        references = Path(shared)
         for uid in uids:
             slots.put(uid)
         return list(pool.map(one, submissions))
@@ -221,36 +231,11 @@ def reserved_uids(count: int) -> Iterator[list[int | None]]:
             handle.close()
 
 
-def write_csv(grades: Sequence[Grade], path: Path) -> None:
-    """One row per submission: submission, task1 ... task5, total, notes."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    columns = ["submission", *(f"task{t}" for t in TASKS), "total", "notes"]
-    with path.open("w", newline="", encoding="utf-8") as handle:
-        writer = csv.DictWriter(handle, fieldnames=columns)
-        writer.writeheader()
-        writer.writerows(grade.row() for grade in grades)
-
-
-def feedback(grade: Grade) -> str:
-    """The feedback text of one submission: its points, each check, and what failed and why."""
-    lines = [f"# {grade.submission}", ""]
-    if grade.report is None:
-        lines += ["Your submission could not be graded:", *[f"- {n}" for n in grade.notes]]
-        return "\n".join(lines) + "\n"
-    points = ", ".join(f"task{t} {grade.points(t)}" for t in TASKS)
-    lines += [f"{grade.total}/{grade.report.points} points ({points})", ""]
-    lines += [f"Note: {note}" for note in grade.notes]
-    lines += ["", "```", grade.report.table(), "```", ""]
-    details = grade.report.details()
-    if details:
-        lines += ["## What the failing checks saw", "", "```", details, "```"]
-    return "\n".join(lines) + "\n"
-
-
 def summary(grades: Sequence[Grade], seconds: float) -> str:
     """Count, mean points per task, and failures by reason."""
     graded = [g for g in grades if g.graded]
-    lines = [f"graded {len(graded)} of {len(grades)} submissions in {seconds:.0f} s"]
+    plural = "" if len(grades) == 1 else "s"
+    lines = [f"graded {len(graded)} of {len(grades)} submission{plural} in {seconds:.0f} s"]
     if graded:
         possible = {t: sum(c.points for c in graded[0].report.checks if c.task == t) for t in TASKS}
         means = [
@@ -259,7 +244,7 @@ def summary(grades: Sequence[Grade], seconds: float) -> str:
         ]
         total = sum(g.total for g in graded) / len(graded)
         lines.append(f"mean: {', '.join(means)}; total {total:.1f}/{sum(possible.values())}")
-    reasons = collections.Counter(_reason(note) for g in grades for note in g.notes)
+    reasons = collections.Counter(r for g in grades for r in {_reason(n) for n in g.notes})
     if reasons:
         lines.append("problems: " + ", ".join(f"{r} ×{n}" for r, n in reasons.most_common()))
     return "\n".join(lines)
@@ -357,7 +342,10 @@ def _problems(report: CheckReport) -> list[str]:
             elif check.exception == "DelegationRefused":
                 used = text.split("your code used ", 1)[-1].split(",", 1)[0]
                 kinds.append(f"delegation refused: called the engine's answer {used}")
-            elif check.exception in ("SubmissionError", "FileNotFoundError"):
+            elif (
+                check.exception in ("SubmissionError", "FileNotFoundError")
+                and " is missing from " not in text  # the copy's note already says so
+            ):
                 kinds.append(text or "task file could not be loaded")
         notes += [f"task{task}: {kind}" for kind in dict.fromkeys(kinds)]
     return notes

@@ -2,16 +2,22 @@
 
 `build` copies what ships (see `release_rules`) into a new folder, strips the
 notebooks' outputs (they were made with the solutions), writes the students'
-README and pyproject, and refuses to finish if any line of a solution block
+README, ``.gitignore``, pyproject and the points manifest (what the hidden
+checks, which do not ship, are worth), and refuses to finish if any line of a solution block
 turns up anywhere in the bundle.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
+from ..course import manifest
+from ..course.runner import CHECKS
 from .release_rules import shipped_files, solution_leaks, solution_lines
 
 STUDENT_README = """\
@@ -38,15 +44,38 @@ until you write them, each check says what is still to do.
 | task | file | what you write |
 | --- | --- | --- |
 | 1 | `assignments/task1.py` | answers about the template's `msd_kernel` (eq. 1.3) |
-| 2 | `assignments/task2.py` | the spring acceleration of eq. (1.1)-(1.2), rest length 1 |
+| 2 | `assignments/task2.py` | spring acceleration, eq. (1.1)-(1.2), rest length one grid spacing |
 | 3 | `assignments/task3.py` | a rotated layout, and what axis springs alone do with it |
 | 4 | `assignments/task4.py` | √2 and √3 neighbours, and what they cost |
 | 5 | `assignments/task5.py` | Verlet with damping, eq. (1.3)-(1.4), as an integrator |
 
 Fill in the lines that raise `NotImplementedError`, keeping names and
-signatures, then check one task at a time: `msdlab check 2`. The notebooks in
+signatures, then check one task at a time: `msdlab check 2`. Each call into
+your files may take a few seconds (`--call-timeout S` to change); the last
+line shows your public points and what the hidden checks, which run when
+your work is graded, are worth. The notebooks in
 `notebooks/` (`pip install jupyterlab && jupyter lab notebooks`) walk through
 each task with plots and animations.
+"""
+
+STUDENT_GITIGNORE = """\
+# virtual environments
+.venv/
+venv/
+env/
+# what msdlab writes
+msdlab-output/
+*.gif
+*.mp4
+# caches and build by-products
+__pycache__/
+*.py[cod]
+.pytest_cache/
+.hypothesis/
+.ipynb_checkpoints/
+*.egg-info/
+build/
+dist/
 """
 
 
@@ -76,13 +105,30 @@ def build(out: Path, root: Path, force: bool = False) -> list[Path]:
         shutil.copyfile(root / "pyproject.toml", out / "pyproject.toml")
         written.append(out / "pyproject.toml")
     (out / "README.md").write_text(STUDENT_README, encoding="utf-8")
-    written.append(out / "README.md")
+    (out / ".gitignore").write_text(STUDENT_GITIGNORE, encoding="utf-8")
+    points = out / CHECKS / manifest.FILE_NAME
+    _write_points(root / CHECKS, points)
+    written += [out / "README.md", out / ".gitignore", points]
     leaks = solution_leaks(written, solution_lines(root / "solutions"))
     if leaks:
         shutil.rmtree(out)
         found = "\n  ".join(str(leak).replace(f"{out}/", "") for leak in leaks)
         raise ReleaseError(f"solution text found in the release:\n  {found}")
     return sorted(written)
+
+
+def _write_points(checks: Path, path: Path) -> None:
+    """The points manifest of every check, hidden ones included (`msdlab.course.manifest`),
+    from collecting the course's checks; the hidden check files themselves do not ship."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    command = [
+        sys.executable, "-m", "pytest", str(checks), "--collect-only", "-q", "-o", "addopts=",
+        "-p", "no:cacheprovider", "-p", "no:nbval", f"--msdlab-points={path}",
+    ]  # fmt: skip
+    environment = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
+    done = subprocess.run(command, cwd=checks, env=environment, capture_output=True, text=True)
+    if done.returncode != 0 or not path.is_file():
+        raise ReleaseError(f"the checks in {checks} could not be collected:\n{done.stdout[-2000:]}")
 
 
 def _write_stripped(source: Path, target: Path) -> None:

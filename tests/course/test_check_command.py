@@ -2,15 +2,19 @@
 
 from __future__ import annotations
 
+import re
 import shutil
+import sys
 
 import pytest
 
 from msdlab.cli import main
-from msdlab.course import PROJECT_ROOT
+from msdlab.commands import check
+from msdlab.course import PROJECT_ROOT, manifest
 from msdlab.course.report import CheckReport
 
 SOLUTIONS = PROJECT_ROOT / "solutions"
+CHECKS = PROJECT_ROOT / "tests" / "tasks"
 
 
 def test_all_checks_of_a_task_pass_on_the_solutions(capsys, tmp_path):
@@ -24,13 +28,50 @@ def test_all_checks_of_a_task_pass_on_the_solutions(capsys, tmp_path):
     assert saved.all_passed and saved.tasks() == [1] and not any(c.hidden for c in saved.checks)
 
 
-def test_templates_fail_with_what_to_do(capsys):
+def test_templates_fail_with_what_to_do_each_said_once(capsys):
     assert main(["check", "task1", "--impl", "assignments"]) == 1
     out = capsys.readouterr().out
-    assert "FAILED  to do: return the number of particles" in out
-    assert "NotImplementedError: Task 1: return the number of particles" in out  # details
+    assert re.search(r"task1 particle_count +0/1  FAILED  see \[1\]", out)
+    assert out.count("to do: return the number of particles") == 1  # in full, once
     assert "total: 0/9 points, 0 of 5 checks passed" in out
-    assert "what the failing checks saw:" in out
+    assert "public 0 of 9 points; hidden checks worth 5 more run when graded" in out
+
+
+def test_an_endless_loop_is_stopped_and_named(capsys, tmp_path):
+    shutil.copy(SOLUTIONS / "task1.py", tmp_path / "task1.py")
+    with (tmp_path / "task1.py").open("a") as handle:
+        handle.write("\ndef particle_count(n=N):\n    while True:\n        pass\n")
+    assert main(["check", "1", "--impl", str(tmp_path), "--call-timeout", "0.5"]) == 1
+    out = capsys.readouterr().out
+    assert "task1.py: particle_count did not return within 0.5 s (check particle_count)" in out
+    assert "total: 8/9 points" in out  # the other checks do not wait for it
+
+
+def test_a_syntax_error_is_reported_once(capsys, tmp_path):
+    (tmp_path / "task1.py").write_text("def particle_count(n:\n")
+    assert main(["check", "1", "--impl", str(tmp_path)]) == 1
+    out = capsys.readouterr().out
+    assert "task1 (all 5 checks)" in out and out.count("SyntaxError") == 1
+
+
+def test_missing_test_tools_name_the_install_command(capsys, monkeypatch):
+    monkeypatch.setattr(check, "missing_test_tools", lambda: ["pytest"])
+    assert main(["check", "1"]) == 2
+    out = capsys.readouterr().out
+    assert "needs pytest" in out and f"{sys.executable} -m pip install -e " in out
+    assert "[test]" in out
+
+
+def test_without_hidden_files_hidden_says_so_and_the_manifest_counts_them(capsys, tmp_path):
+    checks = tmp_path / "checks"
+    checks.mkdir()
+    for name in ("conftest.py", "test_task1.py"):
+        shutil.copy(CHECKS / name, checks)
+    manifest.write(checks / manifest.FILE_NAME, [(1, 9, False), (1, 5, True), (2, 7, True)])
+    assert main(["check", "1", "--hidden", "--checks", str(checks), "--impl", "solutions"]) == 0
+    out = capsys.readouterr().out
+    assert "The hidden checks are not in this copy of the course" in out
+    assert "public 9 of 9 points; hidden checks worth 5 more run when graded" in out
 
 
 def test_default_is_the_students_assignments_folder(capsys, tmp_path, monkeypatch):
@@ -40,7 +81,8 @@ def test_default_is_the_students_assignments_folder(capsys, tmp_path, monkeypatc
     assert main(["check", "1", "--hidden"]) == 0
     out = capsys.readouterr().out
     assert str(tmp_path / "assignments") in out
-    assert "(hidden)" in out and "total: 15/15 points" in out
+    assert "(hidden)" in out and "total: 14/14 points" in out
+    assert "public 9 of 9 points; hidden 5 of 5 points" in out
 
 
 @pytest.mark.parametrize(

@@ -189,10 +189,11 @@ def test_grade_command_writes_rows_feedback_and_exit_status(tmp_path, capsys):
     out = tmp_path / "grades.csv"
     status = main(["grade", str(good), str(empty), "--out", str(out), "--feedback",
                    str(tmp_path / "feedback"), "--checks", str(checks), "--jobs", "2"])  # fmt: skip
-    rows = {row["submission"]: row for row in csv.DictReader(out.open())}
-    assert status == 0 and set(rows) == {"alice", "nobody"}
+    rows = {row["id"]: row for row in csv.DictReader(out.open())}
+    assert status == 1 and set(rows) == {"(max points)", "alice", "nobody"}  # nobody: no files
     assert list(rows["alice"]) == [
-        "submission",
+        "id",
+        "source",
         "task1",
         "task2",
         "task3",
@@ -200,12 +201,13 @@ def test_grade_command_writes_rows_feedback_and_exit_status(tmp_path, capsys):
         "task5",
         "total",
         "notes",
+        "fingerprint",
     ]
-    assert rows["alice"]["task1"] == rows["alice"]["total"] != "0"
-    assert "missing: task1.py" in rows["nobody"]["notes"] and rows["nobody"]["total"] == "0"
-    assert "points" in (tmp_path / "feedback" / "alice.md").read_text()
+    assert rows["alice"]["task1"] == rows["alice"]["total"] == rows["(max points)"]["total"] != "0"
+    assert "no task files" in rows["nobody"]["notes"] and rows["nobody"]["total"] == "0"
+    assert "points" in (tmp_path / "feedback" / "students" / "alice.md").read_text()
     output = capsys.readouterr()
-    assert "[2/2]" in output.err and "graded 2 of 2" in output.out
+    assert "[1/1]" in output.err and "graded 1 of 2" in output.out
 
 
 def test_a_submission_that_outlasts_its_time_limit_still_gets_a_row(tmp_path):
@@ -216,7 +218,7 @@ def test_a_submission_that_outlasts_its_time_limit_still_gets_a_row(tmp_path):
     out = tmp_path / "grades.csv"
     status = main(["grade", str(slow), "--out", str(out), "--checks", str(checks), "--timeout", "8",
                    "--call-timeout", "30"])  # fmt: skip
-    (row,) = csv.DictReader(out.open())
+    row = {row["id"]: row for row in csv.DictReader(out.open())}["slow"]
     assert status == 1
     assert row["total"] == "0" and "timed out after 8 s" in row["notes"]
 

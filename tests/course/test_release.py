@@ -4,6 +4,7 @@ own quick start works."""
 from __future__ import annotations
 
 import json
+import re
 import shutil
 import site
 import subprocess
@@ -107,3 +108,20 @@ def test_the_bundles_quick_start_works(bundle, tmp_path):
     )
     assert check.returncode == 1, check.stderr
     assert "to do:" in check.stdout and "total: 0/" in check.stdout
+    assert "hidden checks worth" in check.stdout and "more run when graded" in check.stdout
+    hidden = subprocess.run(
+        [scripts / "msdlab", "check", "1", "--hidden"], cwd=bundle, capture_output=True, text=True
+    )
+    assert "hidden checks are not in this copy" in hidden.stdout and "(hidden)" not in hidden.stdout
+    usage = subprocess.run([scripts / "msdlab", "--help"], capture_output=True, text=True)
+    listed = re.findall(r"^    (\w+)", usage.stdout, flags=re.MULTILINE)
+    assert listed == ["demo", "scenes", "run", "check"], usage.stdout
+
+
+def test_bundle_readme_and_gitignore(bundle):
+    readme = (bundle / "README.md").read_text()
+    assert "rest length one grid spacing" in readme and "rest length 1 " not in readme
+    ignored = (bundle / ".gitignore").read_text().split()
+    assert {".venv/", "msdlab-output/", "__pycache__/", ".hypothesis/"} <= set(ignored)
+    points = json.loads((bundle / "tests" / "tasks" / "points.json").read_text())
+    assert all(counts["hidden"] > 0 for counts in points["tasks"].values())

@@ -1,23 +1,31 @@
 """``msdlab grade SUBMISSION... --out grades.csv``: grade a class's submissions.
 
-Each SUBMISSION is a folder laid out like assignments/. Every submission is
-graded in its own workspace by a fresh process running the instructor's checks
-(hidden ones included); the submission's code runs in a sandbox and can only
-answer with data, under a time and memory limit. Every submission gets a CSV
-row (submission, task1 ... task5, total, notes) and, with --feedback, a
-feedback file. Exit status 0 if every submission was graded, 1 otherwise.
+Each SUBMISSION is a folder laid out like assignments/, a folder holding
+assignments/, or a zip file of either; its row's id is its path relative to the
+submissions' common parent (class/alice/assignments -> alice), or the id given
+by --roster FILE (CSV rows 'id,folder-or-zip'). Every submission is graded in
+its own workspace by a fresh process running the instructor's checks (hidden
+ones included); the submission's code runs in a sandbox and can only answer
+with data, under a time and memory limit. Every submission gets a CSV row (id,
+source, task1 ... task5, total, notes; per check with --detail); the first row
+holds the maximum points. Rows of earlier runs in the CSV are kept, a
+submission graded again gets its row replaced, and --resume skips those
+already graded with the same checks. --feedback DIR writes DIR/students/ID.md
+(to hand out), DIR/instructor/ID.md (everything) and DIR/summary.md. Exit
+status 0 if every submission was graded, 1 otherwise.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import sys
 import time
 from pathlib import Path
 
 from ...course import PROJECT_ROOT, TASKS
-from .. import grading, sandbox
+from .. import feedback, gradebook, grading, intake, sandbox
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -27,9 +35,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("submissions", nargs="+", type=Path, metavar="SUBMISSION")
+    parser.add_argument("submissions", nargs="*", type=Path, metavar="SUBMISSION")
+    parser.add_argument(
+        "--roster", type=Path, default=None, help="CSV of 'id,folder-or-zip' rows instead"
+    )
     parser.add_argument("--out", type=Path, required=True, help="CSV file to write")
     parser.add_argument("--feedback", type=Path, default=None, help="folder for feedback files")
+    parser.add_argument("--detail", action="store_true", help="also a column per check")
+    parser.add_argument(
+        "--resume", action="store_true", help="skip submissions graded with the same checks"
+    )
     parser.add_argument(
         "--jobs", type=int, default=os.cpu_count() or 1, help="submissions at once (%(default)s)"
     )
@@ -75,41 +90,100 @@ def run(args: argparse.Namespace) -> int:
     if problem is not None:
         print(f"msdlab grade: {problem}", file=sys.stderr)
         return 2
-    submissions = grading.find_submissions(args.submissions)
-    width = max(len(s.name) for s in submissions)
-    print(f"grading {len(submissions)} submissions, {args.jobs} at a time", file=sys.stderr)
+    if bool(args.roster) == bool(args.submissions):
+        raise ValueError("give SUBMISSION folders or zip files, or --roster FILE (not both)")
+    book = gradebook.Gradebook.load(args.out)
+    checks = args.checks.resolve()
+    with (
+        intake.from_roster(args.roster)
+        if args.roster
+        else intake.from_paths(args.submissions) as found
+    ):
+        entries = {entry.id: entry for entry in found.entries}
+        prints = {i: gradebook.fingerprint(checks, e.folder) for i, e in entries.items()}
+        todo = [e for e in entries.values() if e.problem is None]
+        if args.resume:
+            todo = [e for e in todo if book.fingerprint_of(e.id) != prints[e.id]]
+        skipped = len(entries) - len(todo) - sum(e.problem is not None for e in entries.values())
+        unusable = [grading.Grade(e.id, None, [e.problem]) for e in entries.values() if e.problem]
+        for grade in unusable:
+            book.record(
+                shown(grade, entries[grade.submission]),
+                entries[grade.submission],
+                None,
+                args.detail,
+            )
+        plural = "" if len(todo) == 1 else "s"
+        resumed = f" ({skipped} unchanged since graded, skipped)" if skipped else ""
+        print(
+            f"grading {len(todo)} submission{plural}{resumed}, {args.jobs} at a time",
+            file=sys.stderr,
+        )
+        width = max(len(e.id) for e in entries.values())
 
-    def progress(grade: grading.Grade, done: int, count: int) -> None:
-        if grade.graded:
-            result = f"{grade.total}/{grade.report.points} points"
-        else:
-            result = "NOT GRADED: " + "; ".join(grade.notes)
-        print(f"[{done:>{len(str(count))}}/{count}] {grade.submission:<{width}}  {result}  "
-              f"({grade.seconds:.1f} s)", file=sys.stderr)  # fmt: skip
+        def progress(grade: grading.Grade, done: int, count: int) -> None:
+            entry = entries[grade.submission]
+            book.record(shown(grade, entry), entry, prints[grade.submission], args.detail)
+            book.write(args.out)  # after each: an interrupted run keeps what was graded
+            if grade.graded:
+                result = f"{grade.total}/{grade.report.points} points"
+            else:
+                result = "NOT GRADED: " + "; ".join(grade.notes)
+            print(f"[{done:>{len(str(count))}}/{count}] {grade.submission:<{width}}  {result}  "
+                  f"({grade.seconds:.1f} s)", file=sys.stderr)  # fmt: skip
 
-    started = time.monotonic()
-    grades = grading.grade_all(
-        submissions,
-        args.checks.resolve(),
-        jobs=args.jobs,
-        progress=progress,
-        timeout=args.timeout,
-        call_timeout=args.call_timeout,
-        memory_mb=args.memory,
-        isolation=args.isolation,
-        allow_delegation=_tasks(args.allow_delegation),
-    )
-    grading.write_csv(grades, args.out)
-    if args.feedback is not None:
-        args.feedback.mkdir(parents=True, exist_ok=True)
-        for grade in grades:
-            (args.feedback / f"{grade.submission}.md").write_text(grading.feedback(grade))
+        started = time.monotonic()
+        grades = (
+            grading.grade_all(
+                [grading.Submission(e.id, e.folder) for e in todo],
+                checks,
+                jobs=args.jobs,
+                progress=progress,
+                timeout=args.timeout,
+                call_timeout=args.call_timeout,
+                memory_mb=args.memory,
+                isolation=args.isolation,
+                allow_delegation=_tasks(args.allow_delegation),
+            )
+            if todo
+            else []
+        )
+        book.write(args.out)
+        grades = unusable + grades
+        if args.feedback is not None:
+            write_feedback(args.feedback, grades, entries)
     print(grading.summary(grades, time.monotonic() - started))
     if args.isolation != "namespace":
         print(f"isolation: {args.isolation} (weaker than namespace; submissions were not "
               "isolated by the operating system)")  # fmt: skip
-    print(f"grades written to {args.out}")
+    kept = len(book.rows) - len(grades)
+    print(
+        f"grades written to {args.out}" + (f" ({kept} rows of earlier runs kept)" if kept else "")
+    )
     return 0 if all(grade.graded for grade in grades) else 1
+
+
+def shown(grade: grading.Grade, entry: intake.Entry) -> grading.Grade:
+    """``grade`` with the intake's notes on its submission first (for the CSV and feedback)."""
+    return dataclasses.replace(grade, notes=[*entry.notes, *grade.notes])
+
+
+def write_feedback(
+    folder: Path, grades: list[grading.Grade], entries: dict[str, intake.Entry]
+) -> None:
+    """DIR/students/ID.md, DIR/instructor/ID.md and DIR/summary.md."""
+    for kind in ("students", "instructor"):
+        (folder / kind).mkdir(parents=True, exist_ok=True)
+    for grade in (shown(g, entries[g.submission]) for g in grades):
+        stem = intake.file_stem(grade.submission)
+        (folder / "students" / f"{stem}.md").write_text(
+            feedback.for_student(grade), encoding="utf-8"
+        )
+        source = intake.readable(str(entries[grade.submission].source))
+        (folder / "instructor" / f"{stem}.md").write_text(
+            feedback.for_instructor(grade, source), encoding="utf-8"
+        )
+    (folder / "summary.md").write_text(feedback.class_summary(grades), encoding="utf-8")
 
 
 def _tasks(text: str) -> list[int]:

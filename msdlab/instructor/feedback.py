@@ -1,0 +1,153 @@
+"""Feedback files of a grading run: one to hand to each student, one for the instructor.
+
+- `for_student`: the public checks in full (points, result, what a failing one saw);
+  hidden checks only as "N hidden checks: P of Q points" per task, with no name,
+  message or generated input; a task not attempted (or whose file did not load)
+  as one line; no path of the grader's temporary folders.
+- `for_instructor`: every check with its full message, and the grading notes.
+- `class_summary`: the score distribution per task and the checks failed most often.
+"""
+
+from __future__ import annotations
+
+import collections
+import re
+import statistics
+from collections.abc import Sequence
+
+from ..course import TASKS
+from ..course.report import CheckResult
+from .grading import Grade
+
+_TEMPORARY = re.compile(
+    r"[^\s'\"()]*msdlab-(?:grade|intake|sandbox|check)-[^/\s'\"()]*((?:/[^/\s'\"():,;]+)*)"
+)
+
+
+def scrub(text: str) -> str:
+    """``text`` without the grader's temporary paths: a file there is named by its name."""
+
+    def name(match: re.Match) -> str:
+        rest = match.group(1).rstrip(".")
+        return rest.rsplit("/", 1)[-1] if rest and rest != "/submission" else "the submission"
+
+    return _TEMPORARY.sub(name, text)
+
+
+def for_student(grade: Grade) -> str:
+    """The Markdown feedback a student may read."""
+    lines = [f"# Feedback: {grade.submission}", ""]
+    if grade.report is None:
+        lines += ["Your submission could not be graded:", ""]
+        lines += [f"- {scrub(note)}" for note in grade.notes]
+        return "\n".join(lines) + "\n"
+    report = grade.report
+    public = [c for c in report.checks if not c.hidden]
+    hidden = [c for c in report.checks if c.hidden]
+    lines.append(
+        f"**{grade.total} of {report.points} points**: public checks "
+        f"{_earned(public)} of {_points(public)}, hidden checks {_earned(hidden)} of "
+        f"{_points(hidden)}."
+    )
+    lines += ["", *[f"Note: {scrub(note)}" for note in grade.notes]]
+    for task in report.tasks():
+        checks = [c for c in report.checks if c.task == task]
+        lines += ["", _task_heading(task, checks)]
+        reason = _one_reason(checks)
+        if reason is not None:
+            lines.append(reason)
+            continue
+        lines.append("")
+        for check in (c for c in checks if not c.hidden):
+            lines.append(f"- {check.name}: {check.earned} of {check.points} points, "
+                         f"{'passed' if check.passed else check.outcome}")  # fmt: skip
+            if not check.passed:
+                lines += [f"  > {scrub(line)}" for line in _message(check).splitlines() if line]
+        secret = [c for c in checks if c.hidden]
+        if secret:
+            lines.append(
+                f"- {len(secret)} hidden checks: {_earned(secret)} of {_points(secret)} points"
+            )
+    return "\n".join(lines) + "\n"
+
+
+def for_instructor(grade: Grade, source: str = "") -> str:
+    """The Markdown feedback with everything: notes, every check and every message."""
+    lines = [f"# {grade.submission}", ""]
+    if source:
+        lines += [f"Handed in: `{source}`", ""]
+    if grade.report is None:
+        lines += ["Not graded:", *[f"- {note}" for note in grade.notes]]
+        return "\n".join(lines) + "\n"
+    points = ", ".join(f"task{t} {grade.points(t)}" for t in TASKS)
+    lines += [f"{grade.total}/{grade.report.points} points ({points}), "
+              f"graded in {grade.seconds:.1f} s", ""]  # fmt: skip
+    lines += [f"Note: {note}" for note in grade.notes]
+    lines += ["", "```", scrub(grade.report.table()), "```", ""]
+    details = grade.report.details()
+    if details:
+        lines += ["## What the failing checks saw", "", "```", scrub(details), "```"]
+    return "\n".join(lines) + "\n"
+
+
+def class_summary(grades: Sequence[Grade]) -> str:
+    """Markdown: per task the spread of points, then the checks failed most often."""
+    graded = [g for g in grades if g.report is not None]
+    lines = ["# Grading summary", "", f"{len(graded)} of {len(grades)} submissions graded.", ""]
+    if not graded:
+        return "\n".join(lines)
+    lines += ["| task | points | mean | median | min | max | how many got how many points |",
+              "| --- | --- | --- | --- | --- | --- | --- |"]  # fmt: skip
+    possible = {t: sum(c.points for c in graded[0].report.checks if c.task == t) for t in TASKS}
+    for task in (*TASKS, None):
+        scores = [g.points(task) if task else g.total for g in graded]
+        worth = possible[task] if task else sum(possible.values())
+        spread = collections.Counter(scores)
+        counts = ", ".join(f"{points}: {spread[points]}" for points in sorted(spread))
+        lines.append(
+            f"| {f'task{task}' if task else 'total'} | {worth} | {statistics.mean(scores):.1f} | "
+            f"{statistics.median(scores):g} | {min(scores)} | {max(scores)} | {counts} |"
+        )
+    failed = collections.Counter(
+        (c.task, c.name, c.hidden) for g in graded for c in g.report.checks if not c.passed
+    )
+    if failed:
+        lines += ["", "Checks failed most often:", ""]
+        for (task, name, hidden), count in failed.most_common(10):
+            kind = " (hidden)" if hidden else ""
+            lines.append(f"- task{task} {name}{kind}: failed by {count} of {len(graded)}")
+    return "\n".join(lines) + "\n"
+
+
+def _task_heading(task: int, checks: list[CheckResult]) -> str:
+    return f"## Task {task}: {_earned(checks)} of {_points(checks)} points"
+
+
+def _one_reason(checks: list[CheckResult]) -> str | None:
+    """One line for a task whose every check failed for the same reason (not attempted, a
+    file that does not load), else None."""
+    public = [c for c in checks if not c.hidden] or checks
+    if any(c.passed for c in checks):
+        return None
+    if all(c.exception == "NotImplementedError" for c in public):
+        return "Not attempted yet (every check found NotImplementedError)."
+    reasons = {(c.exception, c.summary) for c in public}
+    if len(reasons) == 1 and len(public) > 1:
+        exception, summary = reasons.pop()
+        if exception in ("SubmissionError", "FileNotFoundError", "SyntaxError"):
+            return f"Every check stopped at: {scrub(summary)}"
+    return None
+
+
+def _message(check: CheckResult) -> str:
+    if check.exception and check.exception not in ("CheckFailed", "AssertionError"):
+        return f"{check.exception}: {check.message}"
+    return check.message or "(no message)"
+
+
+def _earned(checks: Sequence[CheckResult]) -> int:
+    return sum(c.earned for c in checks)
+
+
+def _points(checks: Sequence[CheckResult]) -> int:
+    return sum(c.points for c in checks)

@@ -1,0 +1,232 @@
+"""The instructor's grading workflow: which submission is whose, the grades file, and the
+feedback to hand out (the sandboxing itself is tested in test_grading.py)."""
+
+from __future__ import annotations
+
+import csv
+import os
+import shutil
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from msdlab.cli import main
+from msdlab.course import PROJECT_ROOT
+from msdlab.course.report import CheckReport, CheckResult
+from msdlab.instructor import feedback, gradebook, intake, reference_cache
+from msdlab.instructor.grading import Grade
+
+SOLUTIONS = PROJECT_ROOT / "solutions"
+CHECKS = PROJECT_ROOT / "tests" / "tasks"
+
+
+def folder_of_tasks(path: Path, *tasks: int) -> Path:
+    path.mkdir(parents=True)
+    for task in tasks:
+        shutil.copy(SOLUTIONS / f"task{task}.py", path)
+    return path
+
+
+def test_ids_are_paths_relative_to_the_common_parent(tmp_path):
+    alice = folder_of_tasks(tmp_path / "class" / "alice" / "assignments", 1)
+    bob = folder_of_tasks(tmp_path / "class" / "s2" / "bob" / "assignments", 1)
+    with intake.from_paths([alice, bob]) as found:
+        assert [e.id for e in found.entries] == ["alice", "s2/bob"]
+    with intake.from_paths([alice]) as found:  # one submission keeps its student's name
+        assert [e.id for e in found.entries] == ["alice"]
+
+
+def test_bundle_folders_zips_and_empty_folders(tmp_path):
+    folder_of_tasks(tmp_path / "carol" / "assignments", 1, 2)
+    (tmp_path / "dave").mkdir()
+    (tmp_path / "dave" / "notes.txt").write_text("I did not finish")
+    with zipfile.ZipFile(tmp_path / "erin.zip", "w") as bundle:
+        bundle.write(SOLUTIONS / "task1.py", "erin-work/task1.py")
+    with zipfile.ZipFile(tmp_path / "evil.zip", "w") as bundle:
+        bundle.writestr("../task1.py", "print('escaped')")
+    paths = [tmp_path / name for name in ("carol", "dave", "erin.zip", "evil.zip")]
+    with intake.from_paths(paths) as found:
+        carol, dave, erin, evil = found.entries
+        assert carol.folder == tmp_path / "carol" / "assignments" and carol.problem is None
+        assert "assignments/ folder inside" in carol.notes[0]
+        assert "no task files" in dave.problem
+        assert erin.id == "erin" and (erin.folder / "task1.py").is_file()
+        assert "outside its folder" in evil.problem
+        unpacked = erin.folder
+    assert not unpacked.exists()  # unpacked zips go when the intake closes
+
+
+def test_any_folder_name_gives_a_readable_unique_id_and_a_bounded_file_name(tmp_path):
+    odd = os.fsdecode(b"caf\xe9")  # not UTF-8
+    long = "x" * 200
+    paths = [
+        folder_of_tasks(tmp_path / name, 1) for name in (odd, "caf\N{REPLACEMENT CHARACTER}", long)
+    ]
+    with intake.from_paths(paths) as found:
+        ids = [e.id for e in found.entries]
+    assert len(set(ids)) == 3 and all(i.encode("utf-8") for i in ids)
+    stems = [intake.file_stem(i) for i in ids]
+    assert len(set(stems)) == 3 and max(map(len, stems)) <= intake.MAX_STEM
+    assert intake.file_stem("alice") == "alice"
+    assert intake.file_stem("../../etc") != intake.file_stem("etc") and "/" not in intake.file_stem(
+        "a/b"
+    )
+
+
+def test_roster_gives_ids_and_refuses_repeats(tmp_path):
+    folder_of_tasks(tmp_path / "sub1", 1)
+    roster = tmp_path / "roster.csv"
+    roster.write_text("id,folder\nalice,sub1\n")
+    with intake.from_roster(roster) as found:
+        assert [(e.id, e.folder) for e in found.entries] == [("alice", tmp_path / "sub1")]
+    roster.write_text("alice,sub1\nalice,sub1\n")
+    with pytest.raises(ValueError, match="two submissions have the id 'alice'"):
+        intake.from_roster(roster)
+
+
+def report(*checks: CheckResult) -> CheckReport:
+    return CheckReport("submission", list(checks))
+
+
+PUBLIC_FAIL = CheckResult(
+    "t::test_a", "rest_state", 2, 2, False, "failed", "CheckFailed",
+    "net force 0.5 at /tmp/msdlab-grade-ab12/submission/task2.py line 3",
+)  # fmt: skip
+PUBLIC_PASS = CheckResult("t::test_b", "pulls", 2, 3, False, "passed")
+HIDDEN_FAIL = CheckResult(
+    "t::test_c", "secret_corner", 2, 2, True, "failed", "CheckFailed",
+    "wrong\nFalsifying example: secret_input(shape=(7, 1, 1))",
+)  # fmt: skip
+HIDDEN_PASS = CheckResult("t::test_d", "secret_size", 2, 1, True, "passed")
+TODO = [
+    CheckResult(f"t::{n}", n, 3, 2, h, "failed", "NotImplementedError", "Task 3: rotate it")
+    for n, h in (("one", False), ("two", False), ("three", True))
+]
+
+
+def test_student_feedback_hides_hidden_checks_and_temporary_paths():
+    grade = Grade("alice", report(PUBLIC_FAIL, PUBLIC_PASS, HIDDEN_FAIL, HIDDEN_PASS, *TODO))
+    text = feedback.for_student(grade)
+    assert "secret" not in text and "Falsifying" not in text and "msdlab-grade" not in text
+    assert "2 hidden checks: 1 of 3 points" in text
+    assert "net force 0.5 at task2.py line 3" in text and "rest_state: 0 of 2 points" in text
+    task3 = text.split("## Task 3")[1].strip().splitlines()
+    assert len(task3) == 2 and "Not attempted" in task3[1]  # heading and one line
+    everything = feedback.for_instructor(grade)
+    assert "secret_corner" in everything and "secret_input" in everything
+
+
+def test_class_summary_spread_and_most_failed():
+    grades = [
+        Grade("a", report(PUBLIC_FAIL, PUBLIC_PASS)),
+        Grade("b", report(PUBLIC_FAIL, PUBLIC_PASS)),
+        Grade("c", None, ["not graded: timed out"]),
+    ]
+    text = feedback.class_summary(grades)
+    assert "2 of 3 submissions graded" in text and "| task2 | 5 | 3.0 | 3 | 3 | 3 | 3: 2 |" in text
+    assert "task2 rest_state: failed by 2 of 2" in text
+
+
+def test_gradebook_cells_are_never_formulas_and_survive_a_round_trip(tmp_path):
+    book = gradebook.Gradebook()
+    entry = intake.Entry("=HYPERLINK(1)", tmp_path, tmp_path)
+    grade = Grade(entry.id, report(PUBLIC_FAIL, PUBLIC_PASS), ["-1 is what @you returned"])
+    book.record(grade, entry, "abc", detail=True)
+    path = tmp_path / "grades.csv"
+    book.write(path)
+    cells = [cell for row in csv.reader(path.open()) for cell in row]
+    assert not any(cell.startswith(gradebook.FORMULA_STARTS) for cell in cells)
+    rows = list(csv.DictReader(path.open()))
+    assert rows[0]["id"] == intake.MAX_POINTS_ID and rows[0]["task2"] == "5"
+    assert rows[0]["task2 rest_state"] == "2" and rows[1]["task2 pulls"] == "3"
+    again = gradebook.Gradebook.load(path)
+    assert again.rows["=HYPERLINK(1)"]["notes"] == "-1 is what @you returned"
+    assert again.fingerprint_of("=HYPERLINK(1)") == "abc"
+
+
+def test_a_failed_write_leaves_the_previous_file(tmp_path, monkeypatch):
+    path = tmp_path / "grades.csv"
+    book = gradebook.Gradebook()
+    book.write(path)
+    before = path.read_bytes()
+    entry = intake.Entry("alice", tmp_path, tmp_path)
+    book.record(Grade("alice", report(PUBLIC_PASS)), entry, "abc", detail=False)
+
+    def crash(*args: object) -> None:
+        raise OSError("disk full")
+
+    monkeypatch.setattr(os, "replace", crash)
+    with pytest.raises(OSError, match="disk full"):
+        book.write(path)
+    assert path.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == ["grades.csv"]
+
+
+def test_fingerprint_follows_checks_and_submission(tmp_path):
+    checks = folder_of_tasks(tmp_path / "checks")
+    (checks / "test_x.py").write_text("def test(): pass\n")
+    submission = folder_of_tasks(tmp_path / "sub", 1)
+    first = gradebook.fingerprint(checks, submission)
+    assert gradebook.fingerprint(checks, submission) == first
+    (submission / "task1.py").write_text("# changed\n")
+    assert gradebook.fingerprint(checks, submission) != first
+    changed = gradebook.fingerprint(checks, submission)
+    (checks / "test_x.py").write_text("def test(): assert True\n")
+    assert gradebook.fingerprint(checks, submission) != changed
+
+
+def test_grade_command_keys_rows_by_student_resumes_and_regrades_one(tmp_path, capsys):
+    checks = folder_of_tasks(tmp_path / "checks")
+    for name in ("conftest.py", "test_task1.py", "test_task1_hidden.py", "reference_hidden.py"):
+        shutil.copy(CHECKS / name, checks)
+    alice = folder_of_tasks(tmp_path / "class" / "alice" / "assignments", 1)
+    folder_of_tasks(tmp_path / "class" / "carol" / "assignments", 1)
+    (tmp_path / "class" / "dave").mkdir()
+    given = [str(alice), str(tmp_path / "class" / "carol"), str(tmp_path / "class" / "dave")]
+    out, notes = tmp_path / "grades.csv", tmp_path / "feedback"
+    common = ["--out", str(out), "--checks", str(checks), "--jobs", "2", "--call-timeout", "20"]
+    assert main(["grade", *given, *common, "--feedback", str(notes)]) == 1  # dave: nothing
+    printed = capsys.readouterr()
+    assert "grading 2 submissions" in printed.err and "handed in ×1" in printed.out
+    rows = {row["id"]: row for row in csv.DictReader(out.open())}
+    assert list(rows) == [intake.MAX_POINTS_ID, "alice", "carol", "dave"]
+    assert rows["alice"]["task1"] == rows[intake.MAX_POINTS_ID]["task1"] == "14"
+    assert rows["carol"]["task1"] == "14" and "assignments/ folder" in rows["carol"]["notes"]
+    assert "no task files" in rows["dave"]["notes"] and rows["alice"]["source"] == str(alice)
+    assert {p.name for p in (notes / "students").iterdir()} == {"alice.md", "carol.md", "dave.md"}
+    student = (notes / "students" / "alice.md").read_text()
+    assert "hidden checks: 5 of 5 points" in student and "(hidden)" not in student
+    assert "particle_count_for_any_size" in (notes / "instructor" / "alice.md").read_text()
+    assert "| task1 | 14 |" in (notes / "summary.md").read_text()
+
+    assert main(["grade", *given[:2], *common, "--resume"]) == 0
+    assert "grading 0 submissions (2 unchanged since graded, skipped)" in capsys.readouterr().err
+
+    (alice / "task1.py").write_text((alice / "task1.py").read_text() + WRONG_COUNT)
+    assert main(["grade", str(alice), *common, "--resume"]) == 0
+    printed = capsys.readouterr()
+    assert "grading 1 submission," in printed.err and "graded 1 of 1 submission " in printed.out
+    rows = {row["id"]: row for row in csv.DictReader(out.open())}
+    assert rows["alice"]["task1"] == "12" and rows["carol"]["task1"] == "14"
+    assert len(rows) == 4
+
+
+WRONG_COUNT = """
+def particle_count(n: int = N) -> int:
+    return n * n  # wrong on purpose
+"""
+
+
+def test_references_are_computed_once_per_run_and_read_back_exactly(tmp_path, monkeypatch):
+    calls = []
+
+    @reference_cache.cached
+    def reference(x: float, steps: int = 3) -> float:
+        calls.append(x)
+        return x / 3.0 + steps
+
+    assert reference(0.1) == reference(0.1) and len(calls) == 2  # no cache folder: no cache
+    monkeypatch.setenv(reference_cache.ENV, str(tmp_path))
+    first = reference(0.1)
+    assert reference(0.1) == first == 0.1 / 3.0 + 3 and len(calls) == 3
+    assert reference(0.1, steps=4) != first and len(calls) == 4
