@@ -1,5 +1,5 @@
 """The instructor's sub-commands of the ``msdlab`` command line."""
 
-from . import grade, release, templates
+from . import grade, gradescope, release, templates
 
-COMMANDS = [templates, grade, release]
+COMMANDS = [templates, grade, gradescope, release]

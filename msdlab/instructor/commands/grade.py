@@ -6,6 +6,7 @@ graded in its own workspace by a fresh process running the instructor's checks
 answer with data, under a time and memory limit. Every submission gets a CSV
 row (submission, task1 ... task5, total, notes) and, with --feedback, a
 feedback file. Exit status 0 if every submission was graded, 1 otherwise.
+With --cluster the submissions are graded by Dask workers (msdlab[cluster]).
 """
 
 from __future__ import annotations
@@ -16,8 +17,10 @@ import sys
 import time
 from pathlib import Path
 
+from ...analysis.cluster import connect
 from ...course import PROJECT_ROOT
 from .. import grading
+from ..cluster_grading import grade_all_on_cluster
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -48,6 +51,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default=PROJECT_ROOT / "tests" / "tasks",
         help="folder of the checks, hidden ones included (default: the course's tests/tasks)",
     )
+    parser.add_argument(
+        "--cluster",
+        metavar="ADDRESS|local:N",
+        help="grade on a Dask scheduler, or on N local worker processes (instead of --jobs)",
+    )
     parser.set_defaults(run=run)
 
 
@@ -58,7 +66,8 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError("--jobs >= 1, --timeout and --call-timeout > 0 and --memory >= 256 MB")
     submissions = grading.find_submissions(args.submissions)
     width = max(len(s.name) for s in submissions)
-    print(f"grading {len(submissions)} submissions, {args.jobs} at a time", file=sys.stderr)
+    where = f"on the cluster {args.cluster}" if args.cluster else f"{args.jobs} at a time"
+    print(f"grading {len(submissions)} submissions, {where}", file=sys.stderr)
 
     def progress(grade: grading.Grade, done: int, count: int) -> None:
         if grade.graded:
@@ -69,15 +78,16 @@ def run(args: argparse.Namespace) -> int:
               f"({grade.seconds:.1f} s)", file=sys.stderr)  # fmt: skip
 
     started = time.monotonic()
-    grades = grading.grade_all(
-        submissions,
-        args.checks.resolve(),
-        jobs=args.jobs,
-        progress=progress,
-        timeout=args.timeout,
-        call_timeout=args.call_timeout,
-        memory_mb=args.memory,
-    )
+    limits = dict(timeout=args.timeout, call_timeout=args.call_timeout, memory_mb=args.memory)
+    if args.cluster:
+        with connect(args.cluster) as client:
+            grades = grade_all_on_cluster(
+                submissions, args.checks.resolve(), client, progress=progress, **limits
+            )
+    else:
+        grades = grading.grade_all(
+            submissions, args.checks.resolve(), jobs=args.jobs, progress=progress, **limits
+        )
     grading.write_csv(grades, args.out)
     if args.feedback is not None:
         args.feedback.mkdir(parents=True, exist_ok=True)

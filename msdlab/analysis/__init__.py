@@ -1,0 +1,1 @@
+"""Analyses that run many simulations: parameter sweeps and where they run."""
