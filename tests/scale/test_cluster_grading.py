@@ -18,7 +18,7 @@ from msdlab.course import PROJECT_ROOT
 from msdlab.instructor import grading
 from msdlab.instructor.cluster_grading import grade_all_on_cluster
 
-pytest.importorskip("dask.distributed", reason="needs the cluster extra: pip install -e '.[cluster]'")
+pytest.importorskip("dask.distributed", reason="needs the extra: pip install -e '.[cluster]'")
 
 WORKSPACE = re.compile(r"msdlab-grade-\w+")  # each grading's own temporary folder
 
@@ -63,5 +63,5 @@ def test_a_worker_killed_mid_submission_costs_a_retry(tmp_path: Path, task1_chec
 
 @pytest.mark.parametrize("spec", ["local:0", "local:x", "local", ""])
 def test_bad_cluster_specs_are_refused(spec: str) -> None:
-    with pytest.raises(ValueError, match="local:N|scheduler address"):
+    with pytest.raises(ValueError, match=r"local:N|scheduler address"):
         parse_cluster(spec)

@@ -32,7 +32,8 @@ finally:
 def autograder(tmp_path_factory: pytest.TempPathFactory, task1_checks: Path) -> Path:
     """The zip built by the command and unpacked where Gradescope puts it."""
     out = tmp_path_factory.mktemp("build") / "autograder.zip"
-    assert main(["gradescope", str(out), "--checks", str(task1_checks), "--call-timeout", "10"]) == 0
+    options = ["--checks", str(task1_checks), "--call-timeout", "10"]
+    assert main(["gradescope", str(out), *options]) == 0
     root = tmp_path_factory.mktemp("autograder")
     with zipfile.ZipFile(out) as archive:
         archive.extractall(root / "source")
