@@ -1,6 +1,7 @@
-"""Analysis on top of the engine: measured blow-up time steps and convergence orders.
+"""Analysis on top of the engine: measured blow-up time steps, convergence
+orders, parameter sweeps and the Dask cluster they (and grading) can run on.
 
-Re-exported from `msdlab`.
+The measurements are re-exported from `msdlab`.
 """
 
 from .measure import Convergence, bisect_blowup, convergence_order, measure_blowup_dt

@@ -1,4 +1,8 @@
-"""``msdlab run SCENE``: run a scene, print its energy ledger, save or show an animation."""
+"""``msdlab run SCENE``: run a scene, print its energy ledger, save or show an animation.
+
+With ``--sweep key=v1,v2,...`` (repeatable) it runs every combination of the values
+instead and writes one table of outcomes (--out), on a Dask cluster with --cluster.
+"""
 
 from __future__ import annotations
 
@@ -6,6 +10,7 @@ import argparse
 import ast
 from pathlib import Path
 
+from ..analysis import sweep
 from ..errors import SimulationDiverged
 from ..integrators import (
     RK4,
@@ -62,12 +67,32 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         action="store_true",
         help="trampoline only: run the report's seven experiments and print their outcomes",
     )
+    parser.add_argument(
+        "--sweep",
+        action="append",
+        default=[],
+        metavar="KEY=V1,V2,...",
+        help="run every combination of these values of a setting (or dt, integrator, duration)"
+        " and write one table of outcomes (repeatable)",
+    )
+    parser.add_argument(
+        "--out", type=Path, metavar="FILE.csv", help="the sweep's table (default: SCENE-sweep.csv)"
+    )
+    parser.add_argument(
+        "--cluster",
+        metavar="ADDRESS|local:N",
+        help="run the sweep on a Dask scheduler or N local worker processes (msdlab[cluster])",
+    )
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     scene = get_scene(args.scene)
     settings = parse_settings(scene, args.set)
+    if args.sweep and (args.save or args.show or args.experiments):
+        raise ValueError(
+            "--sweep writes a table; run one setting for --save, --show, --experiments"
+        )
     if args.save is not None:
         from ..viz.animation import check_format
 
@@ -78,6 +103,10 @@ def run(args: argparse.Namespace) -> int:
         check_display()
     if args.experiments:
         return _experiments(scene, settings, args)
+    if args.sweep:
+        return _sweep(scene, settings, args)
+    if args.cluster or args.out:
+        raise ValueError("--cluster and --out go with --sweep KEY=V1,V2,...")
     sim = _build(scene, settings, args)
     steps = round((args.duration or scene.duration) / sim.dt)
     print(f"{scene.name}: {sim!r}")
@@ -171,4 +200,26 @@ def _experiments(scene: Scene, settings: dict[str, object], args: argparse.Names
     bar.close()
     print(f"ball centre heights in m after {duration:g} s (deepest, mean of the last second):")
     print(experiment_table(outcomes))
+    return 0
+
+
+def _sweep(scene: Scene, settings: dict[str, object], args: argparse.Namespace) -> int:
+    axes = sweep.parse_sweeps(scene, args.sweep)
+    out = args.out or Path(f"{scene.name}-sweep.csv")
+    count = len(sweep.combinations(axes))
+    options = dict(fixed=settings, duration=args.duration or scene.duration, dt=args.dt,
+                   integrators=INTEGRATORS, integrator=args.integrator)  # fmt: skip
+    print(f"{scene.name}: sweeping {' × '.join(axes)}, {count} runs")
+    if args.cluster:
+        from ..analysis.cluster import connect
+
+        with connect(args.cluster) as client:
+            rows = sweep.sweep(scene, axes, client=client, **options)
+    else:
+        bar = ProgressBar(count, "sweep", delay=0.0)
+        rows = sweep.sweep(scene, axes, progress=bar, **options)
+        bar.close()
+    sweep.write_table(rows, out)
+    print(sweep.format_table(rows))
+    print(f"table written to {out}")
     return 0

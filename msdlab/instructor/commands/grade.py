@@ -12,7 +12,8 @@ holds the maximum points. Rows of earlier runs in the CSV are kept, a
 submission graded again gets its row replaced, and --resume skips those
 already graded with the same checks. --feedback DIR writes DIR/students/ID.md
 (to hand out), DIR/instructor/ID.md (everything) and DIR/summary.md. Exit
-status 0 if every submission was graded, 1 otherwise.
+status 0 if every submission was graded, 1 otherwise. With --cluster the
+submissions are graded by Dask workers (msdlab[cluster]).
 """
 
 from __future__ import annotations
@@ -24,8 +25,10 @@ import sys
 import time
 from pathlib import Path
 
+from ...analysis.cluster import connect
 from ...course import PROJECT_ROOT, TASKS
 from .. import feedback, gradebook, grading, intake, sandbox
+from ..cluster_grading import grade_all_on_cluster
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -78,6 +81,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="comma-separated tasks (e.g. 2,5) whose checks let submissions call the engine's "
         "answer to them; by default such calls are refused and the row's notes say so",
     )
+    parser.add_argument(
+        "--cluster",
+        metavar="ADDRESS|local:N",
+        help="grade on a Dask scheduler, or on N local worker processes (instead of --jobs)",
+    )
     parser.set_defaults(run=run)
 
 
@@ -113,10 +121,11 @@ def run(args: argparse.Namespace) -> int:
                 None,
                 args.detail,
             )
+        where = f"on the cluster {args.cluster}" if args.cluster else f"{args.jobs} at a time"
         plural = "" if len(todo) == 1 else "s"
         resumed = f" ({skipped} unchanged since graded, skipped)" if skipped else ""
         print(
-            f"grading {len(todo)} submission{plural}{resumed}, {args.jobs} at a time",
+            f"grading {len(todo)} submission{plural}{resumed}, {where}",
             file=sys.stderr,
         )
         width = max(len(e.id) for e in entries.values())
@@ -133,21 +142,21 @@ def run(args: argparse.Namespace) -> int:
                   f"({grade.seconds:.1f} s)", file=sys.stderr)  # fmt: skip
 
         started = time.monotonic()
-        grades = (
-            grading.grade_all(
-                [grading.Submission(e.id, e.folder) for e in todo],
-                checks,
-                jobs=args.jobs,
-                progress=progress,
-                timeout=args.timeout,
-                call_timeout=args.call_timeout,
-                memory_mb=args.memory,
-                isolation=args.isolation,
-                allow_delegation=_tasks(args.allow_delegation),
-            )
-            if todo
-            else []
+        options = dict(
+            timeout=args.timeout,
+            call_timeout=args.call_timeout,
+            memory_mb=args.memory,
+            isolation=args.isolation,
+            allow_delegation=_tasks(args.allow_delegation),
         )
+        graded = [grading.Submission(e.id, e.folder) for e in todo]
+        if not graded:
+            grades = []
+        elif args.cluster:
+            with connect(args.cluster) as client:
+                grades = grade_all_on_cluster(graded, checks, client, progress=progress, **options)
+        else:
+            grades = grading.grade_all(graded, checks, jobs=args.jobs, progress=progress, **options)
         book.write(args.out)
         grades = unusable + grades
         if args.feedback is not None:

@@ -1,0 +1,219 @@
+"""A Gradescope autograder for the course: the zip to upload and the script it runs.
+
+`build` writes the zip: ``setup.sh`` installs msdlab from the zip itself and the
+checks' Python dependencies from the package index; ``run_autograder`` runs
+``python3 -m msdlab.instructor.gradescope``, which grades the student's task
+files (at the top of ``/autograder/submission`` or in its ``assignments/``)
+with the instructor's checks, hidden ones included, by the same `grading.grade`
+as ``msdlab grade``, and writes ``/autograder/results/results.json`` in
+Gradescope's format: the total ``score``, one test per check (``name``,
+``score``, ``max_score``, ``status``, ``output`` for the student, ``visibility``)
+and the per-task totals in ``output`` and ``extra_data``.
+
+Isolation: each submission already runs in its own throw-away container on
+Gradescope, which holds nothing but the autograder and that one submission, so
+the container is the boundary. The sandbox's isolation level is a setting of
+the zip (default ``process``: a separate process with resource limits and the
+audit hook, which needs no privileges and no namespaces the container may lack).
+The root of the tree (``/autograder``) is the environment variable
+``MSDLAB_AUTOGRADER_ROOT``, so the script can be tried on a copy of the tree.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+import zipfile
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+from ..course import TASKS
+from ..course.report import CheckResult
+from . import grading
+
+CONFIG = "msdlab-autograder.json"
+HIDDEN_VISIBILITIES = ("after_published", "hidden")
+ROOT_VARIABLE = "MSDLAB_AUTOGRADER_ROOT"
+CHECK_DEPENDENCIES = ("pytest", "hypothesis")  # what the checks import, from the test extra
+
+SETUP = """\
+#!/usr/bin/env bash
+# Gradescope runs this once when it builds the autograder image: msdlab from this zip,
+# its dependencies and the checks' ({checks}) from the package index.
+set -euo pipefail
+cd "$(dirname "$0")"
+PYTHON="${{PYTHON:-python3}}"
+PACKAGES=(./msdlab {requirements})
+"$PYTHON" -m pip install --no-cache-dir "${{PACKAGES[@]}}" \\
+  || "$PYTHON" -m pip install --no-cache-dir --break-system-packages "${{PACKAGES[@]}}"
+"""
+
+RUN_AUTOGRADER = f"""\
+#!/usr/bin/env bash
+# Gradescope runs this for each submission: grade it into results/results.json.
+exec "${{PYTHON:-python3}}" -m msdlab.instructor.gradescope "${{{ROOT_VARIABLE}:-/autograder}}"
+"""
+
+
+@dataclass(frozen=True)
+class Settings:
+    """What the autograder does, stored in the zip: limits, isolation, hidden checks' visibility."""
+
+    hidden_visibility: str = "after_published"
+    isolation: str = "process"
+    timeout: float = 600.0
+    call_timeout: float = 60.0
+    memory_mb: int = 2048
+
+    def __post_init__(self) -> None:
+        if self.hidden_visibility not in HIDDEN_VISIBILITIES:
+            raise ValueError(
+                f"hidden checks' visibility is one of {', '.join(HIDDEN_VISIBILITIES)}, "
+                f"got {self.hidden_visibility!r}"
+            )
+        if self.timeout <= 0 or self.call_timeout <= 0 or self.memory_mb < 256:
+            raise ValueError("timeout and call_timeout > 0 s and memory_mb >= 256 MB")
+
+
+def build(out: Path, project: Path, checks: Path, settings: Settings) -> list[str]:
+    """Write the autograder zip ``out`` for the msdlab at ``project`` and the checks in
+    ``checks``; return the names it holds."""
+    if out.suffix != ".zip":
+        raise ValueError(f"the autograder is a .zip file, got {out}")
+    if not list(checks.glob("test_*.py")):
+        raise FileNotFoundError(f"no checks (test_*.py) in {checks}; give --checks DIR")
+    pyproject = (project / "pyproject.toml").read_text(encoding="utf-8")
+    requirements = " ".join(f'"{spec}"' for spec in _check_requirements(pyproject))
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as archive:
+        _add(archive, "setup.sh", SETUP.format(checks=", ".join(CHECK_DEPENDENCIES),
+                                               requirements=requirements))  # fmt: skip
+        _add(archive, "run_autograder", RUN_AUTOGRADER)
+        _add(archive, CONFIG, json.dumps(asdict(settings), indent=2) + "\n")
+        for name in ("pyproject.toml", "README.md"):
+            archive.write(project / name, f"msdlab/{name}")
+        for path in _files(project / "msdlab"):
+            archive.write(path, f"msdlab/{path.relative_to(project).as_posix()}")
+        for path in _files(checks):
+            archive.write(path, f"checks/{path.relative_to(checks).as_posix()}")
+        return archive.namelist()
+
+
+def submission_folder(submission: Path) -> Path:
+    """Where the task files are: the top of the submission, its ``assignments/``, or the one
+    folder below that holds them (a zip of the course folder)."""
+    candidates = [submission, submission / "assignments", *sorted(submission.glob("*/assignments"))]
+    candidates += sorted(path for path in submission.glob("*") if path.is_dir())
+    for folder in candidates:
+        if any((folder / f"task{task}.py").is_file() for task in TASKS):
+            return folder
+    return submission
+
+
+def results(grade: grading.Grade, hidden_visibility: str) -> dict[str, object]:
+    """The results.json content for one graded submission (Gradescope's format)."""
+    if grade.report is None:
+        reason = "\n".join(f"- {note}" for note in grade.notes)
+        output = f"Your submission could not be graded:\n{reason}"
+        test = {"name": "Grading", "score": 0, "max_score": 0, "status": "failed",
+                "output": output, "visibility": "visible"}  # fmt: skip
+        return {"score": 0, "output": output, "tests": [test], "extra_data": {"notes": grade.notes}}
+    tasks = {f"task{task}": {"score": grade.points(task), "max_score": _possible(grade, task)}
+             for task in grade.report.tasks()}  # fmt: skip
+    lines = [f"{grade.total}/{grade.report.points} points"]
+    lines += [f"{name}: {t['score']}/{t['max_score']}" for name, t in tasks.items()]
+    lines += [f"Note: {note}" for note in grade.notes]
+    tests, numbers = [], dict.fromkeys(tasks, 0)
+    for check in grade.report.checks:
+        numbers[f"task{check.task}"] += 1
+        tests.append({
+            "name": f"Task {check.task}: {check.name}",
+            "number": f"{check.task}.{numbers[f'task{check.task}']}",
+            "score": check.earned,
+            "max_score": check.points,
+            "status": "passed" if check.passed else "failed",
+            "output": _output(check),
+            "visibility": hidden_visibility if check.hidden else "visible",
+        })  # fmt: skip
+    return {
+        "score": grade.total,
+        "execution_time": round(grade.seconds),
+        "output": "\n".join(lines),
+        "tests": tests,
+        "extra_data": {"tasks": tasks, "notes": grade.notes},
+    }
+
+
+def run_autograder(root: Path) -> dict[str, object]:
+    """Grade ``root/submission`` with the checks in ``root/source`` into
+    ``root/results/results.json``; return its content."""
+    source = root / "source"
+    settings = Settings(**json.loads((source / CONFIG).read_text(encoding="utf-8")))
+    folder = submission_folder(root / "submission")
+    grade = grading.grade(
+        grading.Submission("submission", folder),
+        source / "checks",
+        timeout=settings.timeout,
+        call_timeout=settings.call_timeout,
+        memory_mb=settings.memory_mb,
+        isolation=settings.isolation,
+    )
+    content = results(grade, settings.hidden_visibility)
+    target = root / "results" / "results.json"
+    target.parent.mkdir(parents=True, exist_ok=True)
+    partial = target.with_suffix(".json.partial")
+    partial.write_text(json.dumps(content, indent=2) + "\n", encoding="utf-8")
+    partial.replace(target)
+    return content
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m msdlab.instructor.gradescope [ROOT]``, what ``run_autograder`` calls."""
+    parser = argparse.ArgumentParser(prog="python -m msdlab.instructor.gradescope")
+    parser.add_argument("root", type=Path, nargs="?", default=Path("/autograder"))
+    content = run_autograder(parser.parse_args(argv).root)
+    print(content["output"])
+    return 0
+
+
+def _check_requirements(pyproject: str) -> list[str]:
+    """The test extra's requirements of the checks' dependencies, as pyproject.toml pins them."""
+    names = "|".join(CHECK_DEPENDENCIES)
+    specs = re.findall(rf'"((?:{names})\b[^"]*)"', pyproject)
+    return list(dict.fromkeys(specs)) or list(CHECK_DEPENDENCIES)
+
+
+def _files(folder: Path) -> list[Path]:
+    skipped = ("__pycache__", ".pytest_cache", ".hypothesis")
+    return sorted(
+        path for path in folder.rglob("*")
+        if path.is_file() and not any(part in skipped for part in path.parts)
+    )  # fmt: skip
+
+
+def _add(archive: zipfile.ZipFile, name: str, text: str) -> None:
+    """A text file that Gradescope can execute (mode 755)."""
+    info = zipfile.ZipInfo(name)
+    info.external_attr = 0o100755 << 16
+    info.compress_type = zipfile.ZIP_DEFLATED
+    archive.writestr(info, text)
+
+
+def _possible(grade: grading.Grade, task: int) -> int:
+    assert grade.report is not None
+    return sum(c.points for c in grade.report.checks if c.task == task)
+
+
+def _output(check: CheckResult) -> str:
+    """What the student reads: nothing for a pass, else the summary, then the full message."""
+    if check.passed:
+        return ""
+    full = check.message.strip()
+    return check.summary if not full or full == check.summary else f"{check.summary}\n\n{full}"
+
+
+if __name__ == "__main__":
+    sys.exit(main())
