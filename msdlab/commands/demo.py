@@ -53,16 +53,15 @@ def run(args: argparse.Namespace) -> int:
         args.out / "demo.gif",
         max_frames=args.frames,
         fps=8,
-        dpi=60,
+        dpi=80,
         view=scene.view,
         up=scene.up,
         time_unit=scene.unit,
         title="jelly cube",
     )
     energy_plot = args.out / "demo_energy.png"
-    ax = plot_energy(trajectory.energies, time_unit=scene.unit, energy_unit="template units")
-    ax.figure.savefig(energy_plot, dpi=90, bbox_inches="tight")
-    plt.close(ax.figure)
+    figure = plot_energy(trajectory.energies, time_unit=scene.unit, save=energy_plot)
+    plt.close(figure)
     print(f"animation:   {animation.resolve()}")
     print(f"energy plot: {energy_plot.resolve()}")
     print(

@@ -107,6 +107,11 @@ def run(args: argparse.Namespace) -> int:
         return _sweep(scene, settings, args)
     if args.cluster or args.out:
         raise ValueError("--cluster and --out go with --sweep KEY=V1,V2,...")
+    if args.show and args.save is None:  # the live view at once, no run before it
+        from ..viz import show
+
+        show(_build(scene, settings, args), view=scene.view, up=scene.up, **_live_pace(scene))
+        return 0
     sim = _build(scene, settings, args)
     steps = round((args.duration or scene.duration) / sim.dt)
     print(f"{scene.name}: {sim!r}")
@@ -131,8 +136,16 @@ def run(args: argparse.Namespace) -> int:
     if args.show:
         from ..viz import show
 
-        show(_build(scene, settings, args), view=scene.view, up=scene.up)
+        show(_build(scene, settings, args), view=scene.view, up=scene.up, **_live_pace(scene))
     return 0
+
+
+def _live_pace(scene: Scene) -> dict[str, int]:
+    """Steps per frame and frame interval (ms) of the live view: the gallery's page steps
+    60 times a second (one step a frame), the other scenes show a step per 30 ms frame."""
+    if scene.unit == "frames":
+        return {"steps_per_frame": 2, "interval": 33}
+    return {"steps_per_frame": 1, "interval": 30}
 
 
 def parse_settings(scene: Scene, items: list[str]) -> dict[str, object]:

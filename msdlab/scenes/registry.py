@@ -47,15 +47,15 @@ SCENES: dict[str, Scene] = {
             frames=60,
             view=(-30.0, 20.0),
             up="y",
-            unit="time units",
+            unit="s",  # the template's units read as SI: s, m, kg, so energies in J
         ),
         Scene(
             "trampoline",
             trampoline.trampoline,
             "a 1 kg ball dropped on a pre-tensioned 7×7 net with a fixed rim (--experiments)",
             duration=5.0,
-            frames=100,
-            view=(45.0, 45.0),
+            frames=60,
+            view=(15.0, 12.0),  # from the side, just above the rim: the sag shows
         ),
         Scene(
             "cloth",

@@ -1,22 +1,32 @@
-"""Animations of a recorded `Trajectory` (matplotlib `FuncAnimation`), saved as GIF, MP4 or HTML.
+"""Animations of a recorded `Trajectory`, saved as GIF, MP4 or an offline HTML player.
 
-GIF needs pillow (a dependency), MP4 needs ffmpeg on the PATH, HTML is a
-self-contained page (frames embedded, with play controls).
+Frames are drawn once on a still background (blitting: only the body and the
+title are redrawn) and kept as palette images, so a 100-frame animation saves
+in a few seconds and stays small. GIF needs pillow (a dependency), MP4 needs
+ffmpeg on the PATH, HTML is a self-contained page: frames embedded as PNG, a
+player with play, step and a slider, and no external address.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import base64
+import io
+import uuid
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
+from matplotlib.animation import FFMpegWriter, FuncAnimation
+from matplotlib.artist import Artist
 from matplotlib.figure import Figure
+from PIL import Image
 
 from ..simulation import Trajectory
 from .view import BodyView, new_axes, strains
 
 FORMATS = (".gif", ".mp4", ".html")
+PALETTE_COLOURS = 64  # colours per frame image: plenty for coloured lines on white
 
 
 def check_format(path: str | Path) -> str:
@@ -34,37 +44,80 @@ def check_format(path: str | Path) -> str:
     return suffix
 
 
+def strain_scale(body, frames: np.ndarray, floor: float = 0.05) -> float:
+    """The strain drawn at full colour for ``frames`` (F, N, d): the 99th percentile of
+    |strain| over ten sampled frames, at least ``floor`` so a body at rest stays pale."""
+    if not body.n_springs:
+        return floor
+    sample = frames[:: max(1, len(frames) // 10)]
+    return max(floor, float(max(np.percentile(np.abs(strains(body, f)), 99) for f in sample)))
+
+
+@dataclass
+class _Movie:
+    """A figure with a drawn body and ``draw(i)``, which sets it to frame ``i``."""
+
+    figure: Figure
+    count: int
+    fps: float
+    draw: object  # Callable[[int], list[Artist]]
+
+    def images(self, dpi: float) -> Iterator[Image.Image]:
+        """Each frame as a palette image, drawn by blitting onto the still background."""
+        self.figure.set_dpi(dpi)
+        canvas = self.figure.canvas
+        changing: list[Artist] = self.draw(0)
+        for artist in changing:
+            artist.set_animated(True)
+        canvas.draw()  # the background: axes, ticks, colour bar
+        background = canvas.copy_from_bbox(self.figure.bbox)
+        for i in range(self.count):
+            canvas.restore_region(background)
+            for artist in self.draw(i):
+                artist.set_animated(True)
+                if hasattr(artist, "do_3d_projection"):  # what Axes3D.draw would do
+                    artist.do_3d_projection()
+                self.figure.draw_artist(artist)
+            rgba = np.asarray(canvas.buffer_rgba())
+            yield Image.fromarray(rgba[..., :3]).quantize(
+                PALETTE_COLOURS, Image.Quantize.FASTOCTREE
+            )
+
+
 def animate(
     trajectory: Trajectory,
     *,
-    max_frames: int = 100,
-    fps: float = 20.0,
+    max_frames: int = 60,
+    fps: float = 15.0,
     view: Sequence[float] | None = None,
     up: str = "z",
     time_unit: str = "s",
+    energy_unit: str = "J",
     title: str = "",
     spheres: Sequence[tuple[int, float]] = (),
 ) -> FuncAnimation:
-    """An animation of at most ``max_frames`` evenly spaced frames of ``trajectory``.
+    """A matplotlib animation of at most ``max_frames`` evenly spaced frames of ``trajectory``.
 
     ``view`` (azimuth, elevation), ``up`` and ``spheres`` are as in `BodyView`.
     """
-    return _build(trajectory, max_frames, fps, view, up, time_unit, title, spheres)[0]
+    movie = _build(trajectory, max_frames, fps, view, up, time_unit, energy_unit, title, spheres)
+    return FuncAnimation(movie.figure, movie.draw, frames=movie.count, interval=1000.0 / fps)
 
 
 def to_html(
     trajectory: Trajectory,
     *,
-    max_frames: int = 100,
-    fps: float = 20.0,
+    max_frames: int = 60,
+    fps: float = 15.0,
     view: Sequence[float] | None = None,
     up: str = "z",
     time_unit: str = "s",
+    energy_unit: str = "J",
     title: str = "",
     spheres: Sequence[tuple[int, float]] = (),
-    dpi: float = 72.0,
+    dpi: float = 80.0,
 ) -> str:
-    """The animation of ``trajectory`` as self-contained HTML (frames embedded, play controls).
+    """The animation of ``trajectory`` as a self-contained HTML player (works offline).
 
     For Jupyter: ``IPython.display.HTML(to_html(trajectory))`` (needs no ffmpeg).
     Options as in `animate`, frames drawn at ``dpi``; the figure is closed, so no
@@ -72,12 +125,98 @@ def to_html(
     """
     import matplotlib.pyplot as plt
 
-    animation, figure = _build(trajectory, max_frames, fps, view, up, time_unit, title, spheres)
-    figure.set_dpi(dpi)
+    movie = _build(trajectory, max_frames, fps, view, up, time_unit, energy_unit, title, spheres)
     try:
-        return animation.to_jshtml(fps=fps)
+        return html_player([_png(image) for image in movie.images(dpi)], fps)
     finally:
-        plt.close(figure)
+        plt.close(movie.figure)
+
+
+def save_animation(
+    trajectory: Trajectory,
+    path: str | Path,
+    *,
+    fps: float = 15.0,
+    dpi: int = 80,
+    max_frames: int = 60,
+    view: Sequence[float] | None = None,
+    up: str = "z",
+    time_unit: str = "s",
+    energy_unit: str = "J",
+    title: str = "",
+    spheres: Sequence[tuple[int, float]] = (),
+) -> Path:
+    """Write an animation of ``trajectory`` to ``path`` (.gif, .mp4 or .html); return the path.
+
+    At the default ``dpi`` = 80 a frame is 640 px wide.
+    """
+    path = Path(path)
+    suffix = check_format(path)
+    import matplotlib.pyplot as plt
+
+    movie = _build(trajectory, max_frames, fps, view, up, time_unit, energy_unit, title, spheres)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        if suffix == ".html":
+            page = html_player([_png(image) for image in movie.images(dpi)], fps)
+            path.write_text(f"<!DOCTYPE html>\n<html><body>\n{page}\n</body></html>\n", "utf-8")
+        elif suffix == ".gif":
+            first, *rest = movie.images(dpi)
+            first.save(path, save_all=True, append_images=rest, duration=1000.0 / fps, loop=0)
+        else:
+            animation = FuncAnimation(movie.figure, movie.draw, frames=movie.count)
+            animation.save(path, writer=FFMpegWriter(fps=fps), dpi=dpi)
+    finally:
+        plt.close(movie.figure)
+    return path
+
+
+def html_player(frames_png: Sequence[bytes], fps: float) -> str:
+    """An HTML player for PNG frames: play/pause, step, a slider and the frame number,
+    with the frames embedded and plain-text buttons (no fonts or scripts from the web)."""
+    name = f"msdlab_{uuid.uuid4().hex[:12]}"
+    sources = ",\n".join(
+        f'"data:image/png;base64,{base64.b64encode(png).decode()}"' for png in frames_png
+    )
+    last = len(frames_png) - 1
+    return f"""<div id="{name}" style="font-family: sans-serif">
+<img alt="animation frame" style="max-width: 100%"><br>
+<button data-do="back" title="previous frame">&#9664;&#9646;</button>
+<button data-do="play" title="play / pause">&#9654; play</button>
+<button data-do="next" title="next frame">&#9646;&#9654;</button>
+<input type="range" min="0" max="{last}" value="0" style="width: 50%; vertical-align: middle">
+<span></span>
+</div>
+<script>
+(function () {{
+  const frames = [{sources}];
+  const root = document.getElementById("{name}");
+  const image = root.querySelector("img"), slider = root.querySelector("input");
+  const label = root.querySelector("span"), play = root.querySelector('[data-do="play"]');
+  let index = 0, timer = null;
+  function show(i) {{
+    index = (i + frames.length) % frames.length;
+    image.src = frames[index]; slider.value = index;
+    label.textContent = "frame " + (index + 1) + " / " + frames.length;
+  }}
+  function stop() {{ clearInterval(timer); timer = null; play.innerHTML = "&#9654; play"; }}
+  function start() {{
+    timer = setInterval(() => show(index + 1), {1000.0 / fps:.1f});
+    play.innerHTML = "&#10073;&#10073; pause";
+  }}
+  root.querySelector('[data-do="back"]').onclick = () => {{ stop(); show(index - 1); }};
+  root.querySelector('[data-do="next"]').onclick = () => {{ stop(); show(index + 1); }};
+  play.onclick = () => (timer ? stop() : start());
+  slider.oninput = () => {{ stop(); show(Number(slider.value)); }};
+  show(0);
+}})();
+</script>"""
+
+
+def _png(image: Image.Image) -> bytes:
+    buffer = io.BytesIO()
+    image.save(buffer, format="PNG", optimize=False, compress_level=6)
+    return buffer.getvalue()
 
 
 def _build(
@@ -87,56 +226,34 @@ def _build(
     view: Sequence[float] | None,
     up: str,
     time_unit: str,
+    energy_unit: str,
     title: str,
     spheres: Sequence[tuple[int, float]],
-) -> tuple[FuncAnimation, Figure]:
+) -> _Movie:
     picks = np.unique(np.linspace(0, len(trajectory) - 1, max(1, max_frames)).astype(int))
     frames = trajectory.positions[picks]
     body = trajectory.body
-    sample = frames[:: max(1, len(frames) // 10)]
-    limit = 1e-3  # the strain drawn at full colour
-    if body.n_springs:
-        limit = max(limit, float(max(np.percentile(np.abs(strains(body, f)), 99) for f in sample)))
-    ax = new_axes(body, size=5.0)
-    drawing = BodyView(ax, body, frames[0], strain_limit=limit, view=view, up=up, spheres=spheres)
+    ax = new_axes(body)
+    drawing = BodyView(
+        ax,
+        body,
+        frames[0],
+        strain_limit=strain_scale(body, frames),
+        view=view,
+        up=up,
+        spheres=spheres,
+    )
     drawing.fit(frames)
-    label = ax.set_title("")
+    ledger = trajectory.energies.as_arrays()
+    times = trajectory.times[picks]
+    energies = np.interp(times, ledger["time"], ledger["total"]) if len(ledger["time"]) else None
+    label = ax.set_title(" ", loc="left")
 
-    def draw(i: int) -> list:
-        label.set_text(f"{title}  t = {trajectory.times[picks[i]]:.3g} {time_unit}".strip())
+    def draw(i: int) -> list[Artist]:
+        clock = f"t = {times[i]:.3g} {time_unit}"
+        energy = "" if energies is None else f"E = {energies[i]:.3g} {energy_unit}"
+        label.set_text(f"{title}   {clock}   {energy}".strip())
         return [*drawing.update(frames[i]), label]
 
     draw(0)
-    animation = FuncAnimation(ax.figure, draw, frames=len(frames), interval=1000.0 / fps)
-    return animation, ax.figure
-
-
-def save_animation(
-    trajectory: Trajectory,
-    path: str | Path,
-    *,
-    fps: float = 20.0,
-    dpi: int = 80,
-    max_frames: int = 100,
-    view: Sequence[float] | None = None,
-    up: str = "z",
-    time_unit: str = "s",
-    title: str = "",
-    spheres: Sequence[tuple[int, float]] = (),
-) -> Path:
-    """Write an animation of ``trajectory`` to ``path`` (.gif, .mp4 or .html); return the path."""
-    path = Path(path)
-    suffix = check_format(path)
-    import matplotlib.pyplot as plt
-
-    animation, figure = _build(trajectory, max_frames, fps, view, up, time_unit, title, spheres)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    try:
-        if suffix == ".html":
-            path.write_text(animation.to_jshtml(fps=fps), encoding="utf-8")
-        else:
-            writer = PillowWriter(fps=fps) if suffix == ".gif" else FFMpegWriter(fps=fps)
-            animation.save(path, writer=writer, dpi=dpi)
-    finally:
-        plt.close(figure)
-    return path
+    return _Movie(ax.figure, len(frames), fps, draw)

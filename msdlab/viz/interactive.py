@@ -15,17 +15,24 @@ from collections.abc import Sequence
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.backend_bases import MouseEvent
+from matplotlib.patches import Rectangle
 
 from ..errors import SimulationDiverged
-from ..interaction import Grab
+from ..interaction import Grab, Walls
 from ..simulation import Simulation
 from .view import BodyView, new_axes, spheres_of
+
+LIVE_STRAIN_LIMIT = 0.3  # strain drawn at full colour: what a drag or a fall reaches
+INSTRUCTIONS_2D = "drag a particle with the left mouse button · close the window (or q) to quit"
+INSTRUCTIONS_3D = "left button: drag a particle · right button: turn · q or close: quit"
+_running: list[Dragger] = []  # live views started by `show`, stopped when a new one starts
 
 
 class Dragger:
     """Runs ``sim`` in a figure with mouse grabbing: ``steps_per_frame`` steps per ``interval`` ms.
 
-    `advance` does one frame (the timer calls it; tests call it directly).
+    `advance` does one frame (the timer calls it; tests call it directly). The
+    axes hold the whole box of the scene's `Walls` when it has them.
     """
 
     def __init__(
@@ -42,8 +49,17 @@ class Dragger:
         self.steps_per_frame = int(steps_per_frame)
         self.grab = Grab()
         sim.constraints.append(self.grab)
-        self.ax = ax or new_axes(sim.body)
-        self.drawing = BodyView(self.ax, sim.body, view=view, up=up, spheres=spheres_of(sim))
+        self.ax = ax or new_axes(sim.body, layout="none")  # the mouse needs still axes
+        self.drawing = BodyView(
+            self.ax,
+            sim.body,
+            strain_limit=LIVE_STRAIN_LIMIT,
+            view=view,
+            up=up,
+            spheres=spheres_of(sim),
+        )
+        self._show_box()
+        self.ax.set_title(INSTRUCTIONS_3D if self.drawing.is_3d else INSTRUCTIONS_2D, fontsize=9)
         self._press: tuple[np.ndarray, np.ndarray] | None = None  # (screen px, target) at press
         if self.drawing.is_3d:
             self.ax.mouse_init(rotate_btn=3, pan_btn=2, zoom_btn=[])
@@ -60,6 +76,28 @@ class Dragger:
         """Start stepping on the figure's timer."""
         self.timer.start()
         return self
+
+    def stop(self) -> None:
+        """Stop stepping and stop listening to the mouse (the figure stays as it is)."""
+        self.timer.stop()
+        self.timer.remove_callback(self.advance)
+        for connection in self._connections:
+            self.ax.figure.canvas.mpl_disconnect(connection)
+        self._connections = []
+
+    def _show_box(self) -> None:
+        """Fit the axes to the walls (drawn as a frame) so the floor and sides are in view."""
+        walls = [c for c in (*self.sim.forces, *self.sim.constraints) if isinstance(c, Walls)]
+        if not walls or self.drawing.is_3d:
+            return
+        lower, upper = walls[0].lower, walls[0].upper
+        margin = 0.03 * float(np.max(upper - lower))
+        self.ax.set(
+            xlim=(lower[0] - margin, upper[0] + margin),
+            ylim=(lower[1] - margin, upper[1] + margin),
+        )
+        box = Rectangle(lower, *(upper - lower), fill=False, color="0.3", linewidth=2.0)
+        self.ax.add_patch(box)
 
     def advance(self) -> None:
         """Step the simulation one frame and redraw; on a blow-up, stop and say why."""
@@ -135,10 +173,18 @@ def check_display() -> None:
 
 
 def show(sim: Simulation, **options) -> Dragger:
-    """Open a window running ``sim`` with mouse dragging (blocks until it is closed)."""
+    """Open a window running ``sim`` with mouse dragging (blocks until it is closed, except
+    in Jupyter). A live view started earlier by `show` is stopped first, so re-running a
+    notebook cell leaves one simulation running."""
     import matplotlib.pyplot as plt
 
     check_display()
+    while _running:
+        _running.pop().stop()
     dragger = Dragger(sim, **options).start()
+    _running.append(dragger)
+    manager = dragger.ax.figure.canvas.manager
+    if manager is not None:
+        manager.set_window_title("msdlab: live view")
     plt.show()
     return dragger

@@ -10,6 +10,7 @@ brief's cube, whose floor is y = 0).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from pathlib import Path
 
 import numpy as np
 from matplotlib.artist import Artist
@@ -18,6 +19,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
+from matplotlib.ticker import MaxNLocator
 from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
 from ..body import Body
@@ -25,6 +27,7 @@ from ..interaction import SphereContact
 from ..simulation import Simulation
 
 UPS = ("x", "y", "z")
+BALL_COLOUR = "tab:green"  # not on the coolwarm scale of the springs
 _U, _V = np.meshgrid(np.linspace(0, 2 * np.pi, 13), np.linspace(0, np.pi, 7))
 _UNIT_SPHERE = np.stack([np.cos(_U) * np.sin(_V), np.sin(_U) * np.sin(_V), np.cos(_V)])
 
@@ -40,11 +43,14 @@ def spheres_of(sim: Simulation) -> list[tuple[int, float]]:
     return [(f.center, f.radius) for f in sim.forces if isinstance(f, SphereContact)]
 
 
-def new_axes(body: Body, figure: Figure | None = None, size: float = 6.0) -> Axes:
-    """Axes fit for ``body``: plain for 2-D, 3-D for 3-D."""
+def new_axes(
+    body: Body, figure: Figure | None = None, size: float = 8.0, layout: str = "constrained"
+) -> Axes:
+    """Axes fit for ``body``: plain for 2-D, 3-D for 3-D, on a ``size`` inches wide figure
+    (800 px at the default 100 dpi); ``layout`` "none" keeps the axes still between draws."""
     import matplotlib.pyplot as plt
 
-    figure = figure or plt.figure(figsize=(size, size * 0.8))
+    figure = figure or plt.figure(figsize=(size, size * 0.7), layout=layout)
     return figure.add_subplot(projection="3d" if body.dim == 3 else None)
 
 
@@ -79,7 +85,13 @@ class BodyView:
         limit = strain_limit or max(
             1e-3, float(np.max(np.abs(strains(body, positions)), initial=0))
         )
-        style = {"cmap": "coolwarm", "norm": Normalize(-limit, limit), "linewidths": 1.2}
+        thin = body.n_springs > 300  # a dense body: light springs, so the shape shows through
+        style = {
+            "cmap": "coolwarm",
+            "norm": Normalize(-limit, limit),
+            "linewidths": 0.6 if thin else 1.2,
+            "alpha": 0.7 if thin else 1.0,
+        }
         segments = self._segments(positions)
         if self.is_3d:
             self.springs = Line3DCollection(segments, **style)
@@ -87,19 +99,30 @@ class BodyView:
                 ax.add_collection3d(self.springs)
             azimuth, elevation = (45.0, 30.0) if view is None else view
             ax.view_init(elev=elevation, azim=azimuth - 90.0, vertical_axis=up)
+            for axis in (ax.xaxis, ax.yaxis, ax.zaxis):  # few ticks: no overlapping labels
+                axis.set_major_locator(MaxNLocator(4))
+            ax.tick_params(labelsize="small", pad=0)
         else:
             self.springs = LineCollection(segments, **style)
             ax.add_collection(self.springs)
             ax.set_aspect("equal")
         self.springs.set_array(strains(body, positions))
-        (self.free,) = ax.plot(*positions[~body.fixed].T, "o", ms=3, color="0.2")
+        dot = 2.0 if body.n_particles > 500 else 3.5
+        (self.free,) = ax.plot(*positions[~body.fixed].T, "o", ms=dot, color="0.15")
         (self.pinned,) = ax.plot(*positions[body.fixed].T, "s", ms=5, color="k")
         self.spheres = [(int(p), float(r)) for p, r in spheres]
         self.balls = [self._ball(positions[p], r) for p, r in self.spheres]
         self.fit(positions[None])
         if colorbar and body.n_springs:
-            pad = 0.12 if self.is_3d else 0.04
-            ax.figure.colorbar(self.springs, ax=ax, shrink=0.6, pad=pad, label="strain")
+            ax.figure.colorbar(
+                self.springs,
+                ax=ax,
+                shrink=0.5,
+                aspect=25,
+                fraction=0.03,
+                pad=0.08 if self.is_3d else 0.02,
+                label="strain",
+            )
 
     def update(self, positions: np.ndarray) -> list:
         """Redraw for ``positions`` (N, d); return the changed artists."""
@@ -132,16 +155,16 @@ class BodyView:
         self.ax.set(xlim=(low[0], high[0]), ylim=(low[1], high[1]), xlabel="x", ylabel="y")
         if self.is_3d:
             self.ax.set(zlim=(low[2], high[2]), zlabel="z")
-            self.ax.set_box_aspect(tuple(high - low))
+            self.ax.set_box_aspect(tuple(high - low), zoom=1.25)  # less white around the box
 
     def _segments(self, positions: np.ndarray) -> np.ndarray:
         return np.stack([positions[self.body.spring_a], positions[self.body.spring_b]], axis=1)
 
     def _ball(self, centre: np.ndarray, radius: float) -> Artist:
         if not self.is_3d:
-            return self.ax.add_patch(Circle(centre, radius, color="tab:orange", alpha=0.6))
+            return self.ax.add_patch(Circle(centre, radius, color=BALL_COLOUR, alpha=0.6))
         x, y, z = centre[:, None, None] + radius * _UNIT_SPHERE
-        return self.ax.plot_wireframe(x, y, z, color="tab:orange", linewidth=0.6)
+        return self.ax.plot_surface(x, y, z, color=BALL_COLOUR, alpha=0.8, linewidth=0)
 
 
 def plot_body(
@@ -154,10 +177,21 @@ def plot_body(
     spheres: Sequence[tuple[int, float]] = (),
     strain_limit: float | None = None,
     title: str | None = None,
-) -> Axes:
-    """Plot ``body`` (at ``positions``, default its own) with springs coloured by strain."""
+    save: str | Path | None = None,
+) -> Figure:
+    """Plot ``body`` (at ``positions``, default its own) with springs coloured by strain;
+    return the figure, also written to ``save`` (.png, .pdf, .svg) if given."""
     ax = ax or new_axes(body)
     BodyView(ax, body, positions, strain_limit=strain_limit, view=view, up=up, spheres=spheres)
     if title:
         ax.set_title(title)
-    return ax
+    return save_figure(ax.figure, save)
+
+
+def save_figure(figure: Figure, path: str | Path | None, dpi: float = 100.0) -> Figure:
+    """Write ``figure`` to ``path`` (format from its suffix) unless ``path`` is None; return it."""
+    if path is not None:
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        figure.savefig(path, dpi=dpi)
+    return figure

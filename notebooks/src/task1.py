@@ -150,7 +150,7 @@ print(f"highest particle now at y = {body.positions[:, 1].max():.2f}")
 # flat sheet.
 
 # %%
-HTML(viz.to_html(run, max_frames=35, up="y", view=(-30, 20), time_unit="time units"))
+HTML(viz.to_html(run, max_frames=35, up="y", view=(-30, 20), time_unit="s"))
 
 # %% [markdown]
 # ## Check your answers

@@ -33,7 +33,8 @@ def test_html_is_self_contained(rope_run, tmp_path):
     path = viz.save_animation(rope_run, tmp_path / "rope.html", max_frames=4, dpi=40)
     page = path.read_text()
     assert "<script" in page and page.count("data:image/png;base64") == 4
-    assert 'src="http' not in page
+    assert "http" not in page  # no icons or scripts from the web: it plays offline
+    assert 'data-do="play"' in page and 'type="range"' in page
 
 
 def test_to_html_is_inline_html_and_leaves_no_figure_open(rope_run):

@@ -122,3 +122,24 @@ def test_a_blow_up_stops_the_window_with_the_diagnosis():
 def test_show_without_a_display_says_so():
     with pytest.raises(RuntimeError, match="no display"):
         viz.show(gallery.mesh())
+
+
+def test_live_view_shows_the_whole_box_and_says_how_to_drag():
+    dragger = viz.Dragger(gallery.mesh())
+    x_low, x_high = dragger.ax.get_xlim()
+    y_low, y_high = dragger.ax.get_ylim()
+    assert x_low < 0.0 and x_high > gallery.WIDTH and y_low < 0.0 and y_high > gallery.HEIGHT
+    assert "drag" in dragger.ax.get_title() and "quit" in dragger.ax.get_title()
+    assert dragger.drawing.springs.norm.vmax == viz.interactive.LIVE_STRAIN_LIMIT
+
+
+def test_a_new_live_view_stops_the_previous_one(monkeypatch):
+    monkeypatch.setattr(viz.interactive, "check_display", lambda: None)
+    monkeypatch.setattr(plt, "show", lambda: None)
+    first = viz.show(gallery.mesh())
+    steps = first.sim.step_count
+    second = viz.show(gallery.mesh())
+    assert viz.interactive._running == [second]
+    first.timer._on_timer()  # a stopped timer has no callbacks left to run
+    assert first.sim.step_count == steps
+    second.stop()

@@ -25,28 +25,29 @@ def test_strain_is_relative_stretch():
 
 def test_2d_body_springs_carry_their_strains(tmp_path):
     sim = gallery.two_particles(pull=50.0)
-    ax = viz.plot_body(sim.body, title="pulled")
+    path = tmp_path / "body.png"
+    figure = viz.plot_body(sim.body, title="pulled", save=path)
+    ax = figure.axes[0]
     (springs,) = [c for c in ax.collections if isinstance(c, LineCollection)]
     np.testing.assert_allclose(springs.get_array(), [0.5])  # 150 px over a rest of 100
     np.testing.assert_allclose(springs.get_segments()[0], [[250.0, 200.0], [400.0, 200.0]])
     assert ax.get_title() == "pulled"
-    path = tmp_path / "body.png"
-    ax.figure.savefig(path)
     assert path.stat().st_size > 1000
+    assert figure.get_size_inches()[0] * 100 >= 600  # report-sized: at least 600 px wide
 
 
 def test_3d_body_uses_the_reports_view_angles():
     sim = trampoline.trampoline()
-    ax = viz.plot_body(sim.body, view=(45.0, 45.0), spheres=viz.spheres_of(sim))
+    ax = viz.plot_body(sim.body, view=(45.0, 45.0), spheres=viz.spheres_of(sim)).axes[0]
     assert (ax.azim, ax.elev) == (45.0 - 90.0, 45.0)  # azimuth measured from -y, as in MATLAB
-    ax = viz.plot_body(sim.body, view=(0.0, 0.0))
+    ax = viz.plot_body(sim.body, view=(0.0, 0.0)).axes[0]
     assert (ax.azim, ax.elev) == (-90.0, 0.0)  # looking along +y
     assert viz.spheres_of(sim) == [(49, 0.5)]
 
 
 def test_a_ball_is_drawn_where_the_particle_is():
     body = msd.Body.from_arrays([[0.0, 0.0], [1.0, 0.0]], [[0, 1]])
-    ax = viz.plot_body(body, spheres=[(1, 0.25)])
+    ax = viz.plot_body(body, spheres=[(1, 0.25)]).axes[0]
     (ball,) = [p for p in ax.patches if isinstance(p, Circle)]
     np.testing.assert_array_equal(ball.center, (1.0, 0.0))
     assert ball.radius == 0.25
@@ -76,7 +77,7 @@ def test_wrong_axes_or_vertical_axis_are_refused():
 
 def test_energy_plot_shows_the_ledger(tmp_path):
     trajectory = gallery.triangle().run(steps=200, record_every=10)
-    ax = viz.plot_energy(trajectory.energies, time_unit="frames")
+    ax = viz.plot_energy(trajectory.energies, time_unit="frames").axes[0]
     labels = [line.get_label() for line in ax.get_lines()]
     assert labels[:4] == ["kinetic", "elastic", "potential", "total"]
     assert "taken out: drag" in labels and labels[-1].startswith("drift")
