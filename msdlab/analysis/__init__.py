@@ -1,5 +1,5 @@
 """Analysis on top of the engine: measured blow-up time steps, convergence
-orders, parameter sweeps and the Dask cluster they (and grading) can run on.
+orders, and the Dask cluster that sweeps and grading can run on.
 
 The measurements are re-exported from `msdlab`.
 """
