@@ -48,7 +48,7 @@ def saboteur(csv_path: Path, feedback: Path) -> str:
     done
     head -c 300000000 /dev/zero > /tmp/fill
     while :; do
-        kill -9 -1; echo ha""cked > {csv_path}; echo ha""cked > {feedback}/saboteur.md; sleep 0.2
+        kill -9 -1; echo ha""cked > {csv_path}; echo ha""cked > {feedback}/students/saboteur.md; sleep 0.2
     done
     """
     return (
@@ -138,14 +138,14 @@ def test_hostile_submissions_earn_nothing_and_leave_nothing(grader):
         assert out.read_bytes() == written and "hacked" not in written.decode()
         assert hostile_processes() == []
         assert finished.returncode == 0, finished.stderr
-        rows = {row["submission"]: row for row in csv.DictReader(out.open())}
+        rows = {row["id"]: row for row in csv.DictReader(out.open())}
         assert rows["saboteur"]["total"] == rows["thief"]["total"] == "0", rows
-        honest = (feedback / "honest.md").read_text()
-        assert f"{rows['honest']['total']}/{rows['honest']['total']} points" in honest, honest
+        honest = (feedback / "students" / "honest.md").read_text()
+        assert f"**{rows['honest']['total']} of {rows['honest']['total']} points**" in honest
         assert int(rows["honest"]["total"]) > 0 and rows["honest"]["notes"] == ""
         planted = [p for d in sys.path[1:4] for p in Path(d).glob("numpy.py")]
         assert planted == []
-        assert not any("hacked" in path.read_text() for path in feedback.glob("*.md"))
+        assert not any("hacked" in path.read_text() for path in feedback.rglob("*.md"))
     finally:
         shutil.rmtree(root, ignore_errors=True)
 
@@ -196,12 +196,13 @@ def test_a_sandbox_that_dies_before_its_first_answer_is_an_error_not_a_fallback(
 def test_the_weaker_isolation_is_named_in_every_row_and_the_summary(tmp_path, capsys):
     nobody = tmp_path / "nobody"
     nobody.mkdir()
+    shutil.copy(PROJECT_ROOT / "assignments" / "task1.py", nobody)
     checks = tmp_path / "checks"
     checks.mkdir()
     (checks / "test_nothing.py").write_text("def test_nothing():\n    pass\n")
     out = tmp_path / "grades.csv"
     arguments = ["grade", str(nobody), "--out", str(out), "--checks", str(checks)]
     assert main([*arguments, "--isolation", "process"]) == 0
-    (row,) = csv.DictReader(out.open())
-    assert "weaker isolation 'process'" in row["notes"]
+    rows = {row["id"]: row for row in csv.DictReader(out.open())}
+    assert "weaker isolation 'process'" in rows["nobody"]["notes"]
     assert "isolation: process" in capsys.readouterr().out
