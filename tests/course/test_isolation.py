@@ -48,7 +48,8 @@ def saboteur(csv_path: Path, feedback: Path) -> str:
     done
     head -c 300000000 /dev/zero > /tmp/fill
     while :; do
-        kill -9 -1; echo ha""cked > {csv_path}; echo ha""cked > {feedback}/students/saboteur.md; sleep 0.2
+        kill -9 -1; echo ha""cked > {csv_path}
+        echo ha""cked > {feedback}/students/saboteur.md; sleep 0.2
     done
     """
     return (
