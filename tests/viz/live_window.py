@@ -9,10 +9,10 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("TkAgg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
-from msdlab import viz  # noqa: E402
-from msdlab.scenes import gallery  # noqa: E402
+from msdlab import viz
+from msdlab.scenes import gallery
 
 PARTICLE, PULL = 37, (90.0, 60.0)  # px in the scene: right and up
 work = Path(sys.argv[1])
