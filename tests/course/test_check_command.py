@@ -71,7 +71,7 @@ def test_without_hidden_files_hidden_says_so_and_the_manifest_counts_them(capsys
     assert main(["check", "1", "--hidden", "--checks", str(checks), "--impl", "solutions"]) == 0
     out = capsys.readouterr().out
     assert "The hidden checks are not in this copy of the course" in out
-    assert "public 9 of 9 points; hidden checks worth 6 more run when graded" in out
+    assert "public 9 of 9 points; hidden checks worth 5 more run when graded" in out
 
 
 def test_default_is_the_students_assignments_folder(capsys, tmp_path, monkeypatch):
