@@ -15,6 +15,11 @@ import reference_hidden as reference
 
 pytestmark = [pytest.mark.task3, pytest.mark.hidden]
 
+# The cube experiment is deterministic: rounding (another order of sums, another way to
+# rotate) moves its flatness ratio by less than 1e-9, while a spacing 5 % off moves it
+# by 1e-4 to 1e-2 (measured), so "the experiment as described" is compared this closely.
+SAME_EXPERIMENT = 1e-6
+
 axes = st.tuples(*3 * [st.floats(-2.0, 2.0)]).filter(lambda a: np.linalg.norm(a) > 0.1)
 angles = st.floats(-360.0, 360.0)
 
@@ -119,9 +124,9 @@ def test_cube_tilted_about_x_collapses(task3):
         got = float(task3.drop_rotated_cube(axis, angle, (1,)))
         expected = reference.drop_rotated_cube(axis, angle, (1,))
         expect(
-            abs(got - expected) < 0.1,
-            saw=f"drop_rotated_cube({axis}, {angle}) = {num(got)}, but the experiment as "
-            f"described gives a flatness ratio of {num(expected)}",
+            abs(got - expected) <= SAME_EXPERIMENT,
+            saw=f"drop_rotated_cube({axis}, {angle}) = {num(got, 8)}, but the experiment as "
+            f"described gives a flatness ratio of {num(expected, 8)}",
             cause="a different experiment: check the rotation, the lift to y = LIFT, the "
             "number of steps, dt, gravity and the floor",
         )

@@ -8,11 +8,16 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from msdlab.course import oracles
-from msdlab.course.feedback import as_array, expect, num, percent
+from msdlab.course.feedback import as_array, expect, num
 
 import reference_hidden as reference
 
 pytestmark = [pytest.mark.task4, pytest.mark.hidden]
+
+# The cube experiment is deterministic: rounding (another order of sums, another way to
+# rotate) moves its flatness ratio by less than 1e-9, while a spacing 5 % off moves it
+# by 1e-4 to 1e-2 (measured), so "the experiment as described" is compared this closely.
+SAME_EXPERIMENT = 1e-6
 
 
 @pytest.mark.points(2)
@@ -81,16 +86,16 @@ def test_cube_tilted_about_x_holds(task4):
         f"{num(expected)})",
         cause="missing diagonal springs",
     )
-    axis, angle = (0.0, 0.0, 1.0), 45.0
-    got = float(task4.drop_rotated_cube(axis, angle, (1, 2, 3)))
-    expected = reference.drop_rotated_cube(axis, angle, (1, 2, 3))
-    expect(
-        abs(got - expected) < 0.1,
-        saw=f"with 26 neighbours, tilted {angle}° about z, the cube kept {percent(got)} of its "
-        f"thickness; the experiment as described gives {percent(expected)}",
-        cause="a different experiment: check the rotation, the lift to y = LIFT, the number "
-        "of steps, dt, gravity and the floor",
-    )
+    for axis, angle in (((1.0, 0.0, 0.0), 30.0), ((0.0, 0.0, 1.0), 45.0)):
+        got = float(task4.drop_rotated_cube(axis, angle, (1, 2, 3)))
+        expected = reference.drop_rotated_cube(axis, angle, (1, 2, 3))
+        expect(
+            abs(got - expected) <= SAME_EXPERIMENT,
+            saw=f"with 26 neighbours, tilted {angle}° about {axis}, the flatness ratio is "
+            f"{num(got, 8)}; the experiment as described gives {num(expected, 8)}",
+            cause="a different experiment: check the spacing, the rotation, the lift to "
+            "y = LIFT, the number of steps, dt, gravity and the floor",
+        )
 
 
 @pytest.mark.points(1)
