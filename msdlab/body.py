@@ -319,9 +319,12 @@ class Body:
         offsets = neighbour_offsets(len(shape), neighbours)
         body = cls()
         body.add_particles(grid_positions(shape, spacing, origin), masses=mass)
+        k, c = Body.stiffness.check(body, stiffness, 1), Body.spring_damping.check(body, damping, 1)
         body._reserve("springs", grid_pair_count(shape, offsets))  # exactly: no regrowth
-        for offset, pairs in zip(offsets, grid_pair_blocks(shape, offsets)):
-            body.add_springs(pairs, stiffness, spacing * math.sqrt(offset @ offset), damping)
+        for offset, pairs in zip(offsets, grid_pair_blocks(shape, offsets)):  # valid by design
+            rest = spacing * math.sqrt(offset @ offset)
+            columns = {"spring_a": pairs[:, 0], "spring_b": pairs[:, 1], "rest_lengths": rest}
+            body._append("springs", len(pairs), stiffness=k, spring_damping=c, **columns)
         body.grid_shape = shape
         return body
 
