@@ -32,7 +32,7 @@ def _per_row(name: str, values: object, count: int, hint: str, zero: bool = True
     """``values`` checked finite and >= 0 (> 0 unless ``zero``): one value or ``count``."""
     array = check_non_negative(name, values, hint, zero=zero)
     if array.ndim and array.shape != (count,):
-        raise ValueError(f"{name} must be one value or {count} values, got shape {array.shape}")
+        raise ValueError(f"{name} needs one value or one per row ({count}), got {array.shape}")
     return array
 
 

@@ -10,8 +10,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 if TYPE_CHECKING:
     from .body import Body
 
@@ -38,7 +36,8 @@ class Field:
     def __get__(self, item: Bound | None, owner: type | None = None) -> Any:
         if item is None:
             return self
-        value = item._own[self.name] if item.body is None else self._column(item)[item.index]
+        body = item.body
+        value = item._own[self.name] if body is None else getattr(body, self.array)[item.index]
         return value if self.kind is None or value is None else self.kind(value)
 
     def __set__(self, item: Bound, value: Any) -> None:
@@ -48,10 +47,7 @@ class Field:
         if item.body is None:
             item._own[self.name] = value
         else:
-            self._column(item)[item.index] = value
-
-    def _column(self, item: Bound) -> np.ndarray:
-        return getattr(item.body, self.array)
+            getattr(item.body, self.array)[item.index] = value
 
 
 class Bound:

@@ -22,18 +22,18 @@ class SimulationDiverged(RuntimeError):
         super().__init__(f"simulation diverged in step {step} (t = {time:.6g} s): {diagnosis}")
 
 
-_diagnoses: list[Callable[..., str]] = []
+_diagnosis: list[Callable[..., str]] = []  # one function, registered from the analysis layer
 
 
 def register_diagnosis(diagnose: Callable[..., str]) -> None:
-    """Explain blow-ups with ``diagnose`` (the stability analysis registers itself)."""
-    _diagnoses[:] = [diagnose]
+    """Explain blow-ups with ``diagnose`` (`msdlab.analysis.stability` registers itself)."""
+    _diagnosis[:] = [diagnose]
 
 
 def diagnose_divergence(*blowup: object) -> str:
-    """The registered explanation of a blow-up, given
-    (body, integrator, dt, forces, reference positions, x, x_new, v_new)."""
-    return "; ".join(diagnose(*blowup) for diagnose in _diagnoses) or "no diagnosis registered"
+    """Why a step blew up, by the registered diagnosis, given (body, integrator, dt (s),
+    forces, reference positions, x, x_new, v_new): the core raises, the analysis explains."""
+    return _diagnosis[0](*blowup) if _diagnosis else "no diagnosis registered"
 
 
 def check_positive(name: str, value: float, hint: str = "") -> float:
