@@ -1,6 +1,6 @@
 """Analysis on top of the engine: the predicted stable time step and the diagnosis
-of a blow-up, measured blow-up time steps, convergence orders, parameter sweeps
-and the Dask cluster they (and grading) can run on.
+of a blow-up, measured blow-up time steps, convergence orders, and the Dask
+cluster that sweeps and grading can run on.
 
 The predictions and measurements are re-exported from `msdlab`.
 """

@@ -10,7 +10,6 @@ import argparse
 import ast
 from pathlib import Path
 
-from ..analysis import sweep
 from ..errors import SimulationDiverged
 from ..integrators import (
     RK4,
@@ -21,7 +20,7 @@ from ..integrators import (
     VelocityVerlet,
     Verlet,
 )
-from ..scenes import SCENES, Scene, get_scene
+from ..scenes import SCENES, Scene, get_scene, sweep
 from ..scenes.trampoline import EXPERIMENTS, experiment_table, run_experiment
 from ..simulation import Simulation, Trajectory
 from .progress import ProgressBar

@@ -34,7 +34,7 @@ def test_templates_fail_with_what_to_do_each_said_once(capsys):
     assert re.search(r"task1 particle_count +0/1  FAILED  see \[1\]", out)
     assert out.count("to do: return the number of particles") == 1  # in full, once
     assert "total: 0/9 points, 0 of 5 checks passed" in out
-    assert "public 0 of 9 points; hidden checks worth 5 more run when graded" in out
+    assert "public 0 of 9 points; hidden checks worth 6 more run when graded" in out
 
 
 def test_an_endless_loop_is_stopped_and_named(capsys, tmp_path):
@@ -81,8 +81,8 @@ def test_default_is_the_students_assignments_folder(capsys, tmp_path, monkeypatc
     assert main(["check", "1", "--hidden"]) == 0
     out = capsys.readouterr().out
     assert str(tmp_path / "assignments") in out
-    assert "(hidden)" in out and "total: 14/14 points" in out
-    assert "public 9 of 9 points; hidden 5 of 5 points" in out
+    assert "(hidden)" in out and "total: 15/15 points" in out
+    assert "public 9 of 9 points; hidden 6 of 6 points" in out
 
 
 @pytest.mark.parametrize(

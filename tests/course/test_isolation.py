@@ -48,7 +48,8 @@ def saboteur(csv_path: Path, feedback: Path) -> str:
     done
     head -c 300000000 /dev/zero > /tmp/fill
     while :; do
-        kill -9 -1; echo ha""cked > {csv_path}; echo ha""cked > {feedback}/saboteur.md; sleep 0.2
+        kill -9 -1; echo ha""cked > {csv_path}
+        echo ha""cked > {feedback}/students/saboteur.md; sleep 0.2
     done
     """
     return (
@@ -57,10 +58,10 @@ def saboteur(csv_path: Path, feedback: Path) -> str:
     )
 
 
-def thief() -> str:
-    """task2 copied from wherever it can be read: the solutions, the git history, other
-    submissions through /proc and the grader's temporary folder."""
-    root = PROJECT_ROOT
+def thief(root: Path) -> str:
+    """task2 copied from wherever it can be read: the solutions and the git history of
+    the course at ``root``, other submissions through /proc and the grader's temporary
+    folder."""
     return (
         UNHOOK
         + f'''
@@ -102,25 +103,33 @@ def hostile_processes() -> list[str]:
 @pytest.mark.parametrize("grader", ["root", "unprivileged"])
 def test_hostile_submissions_earn_nothing_and_leave_nothing(grader):
     command = UNPRIVILEGED if grader == "unprivileged" else []
-    if grader == "unprivileged":
-        code = "import os, sys; os.stat(os.path.realpath(sys.executable)); import msdlab"
-        probe = subprocess.run([*command, sys.executable, "-c", code], check=False)
-        if probe.returncode != 0:
-            pytest.skip("user 65534 cannot run this Python environment (a folder is private)")
     root = Path(tempfile.mkdtemp(prefix="msdlab-isolation-"))
+    environment = dict(os.environ, TMPDIR=str(root), HOME=str(root))
+    project = PROJECT_ROOT
+    if grader == "unprivileged":  # the grader's user reads the course: a readable copy of it
+        root.chmod(0o755)
+        project = root / "course"
+        for part in ("msdlab", "solutions", "assignments"):
+            shutil.copytree(PROJECT_ROOT / part, project / part)
+        environment["PYTHONPATH"] = str(project)
+        code = "import os, sys; os.stat(os.path.realpath(sys.executable)); import msdlab"
+        probe = subprocess.run([*command, sys.executable, "-c", code], env=environment, cwd=root)
+        if probe.returncode != 0:
+            shutil.rmtree(root, ignore_errors=True)
+            pytest.skip("user 65534 cannot run this Python environment (a folder is private)")
     try:
         checks = root / "checks"
         checks.mkdir()
         for name in ("conftest.py", "test_task2.py"):
             shutil.copy(CHECKS / name, checks)
         out, feedback = root / "out" / "grades.csv", root / "out" / "feedback"
-        folders = {"honest": PROJECT_ROOT / "solutions", "saboteur": None, "thief": None}
+        folders = {"honest": project / "solutions", "saboteur": None, "thief": None}
         for name in folders:
-            source = folders[name] or PROJECT_ROOT / "assignments"
+            source = folders[name] or project / "assignments"
             folders[name] = shutil.copytree(source, root / name)
         sabotaged, stolen = folders["saboteur"] / "task2.py", folders["thief"] / "task2.py"
         sabotaged.write_text(sabotaged.read_text() + saboteur(out, feedback))
-        stolen.write_text(stolen.read_text() + thief())
+        stolen.write_text(stolen.read_text() + thief(project))
         if grader == "unprivileged":
             shutil.chown(root, 65534, 65534)
             for path in root.rglob("*"):
@@ -128,9 +137,13 @@ def test_hostile_submissions_earn_nothing_and_leave_nothing(grader):
         arguments = [sys.executable, "-m", "msdlab", "grade", *map(str, folders.values())]
         arguments += ["--out", str(out), "--feedback", str(feedback), "--checks", str(checks)]
         arguments += ["--jobs", "2", "--call-timeout", "5", "--timeout", "120"]
-        environment = dict(os.environ, TMPDIR=str(root), HOME=str(root))
         finished = subprocess.run(
-            [*command, *arguments], env=environment, capture_output=True, text=True, timeout=300
+            [*command, *arguments],
+            env=environment,
+            cwd=root,
+            capture_output=True,
+            text=True,
+            timeout=300,
         )
         assert out.is_file(), finished.stderr
         written = out.read_bytes()
@@ -138,14 +151,14 @@ def test_hostile_submissions_earn_nothing_and_leave_nothing(grader):
         assert out.read_bytes() == written and "hacked" not in written.decode()
         assert hostile_processes() == []
         assert finished.returncode == 0, finished.stderr
-        rows = {row["submission"]: row for row in csv.DictReader(out.open())}
+        rows = {row["id"]: row for row in csv.DictReader(out.open())}
         assert rows["saboteur"]["total"] == rows["thief"]["total"] == "0", rows
-        honest = (feedback / "honest.md").read_text()
-        assert f"{rows['honest']['total']}/{rows['honest']['total']} points" in honest, honest
+        honest = (feedback / "students" / "honest.md").read_text()
+        assert f"**{rows['honest']['total']} of {rows['honest']['total']} points**" in honest
         assert int(rows["honest"]["total"]) > 0 and rows["honest"]["notes"] == ""
         planted = [p for d in sys.path[1:4] for p in Path(d).glob("numpy.py")]
         assert planted == []
-        assert not any("hacked" in path.read_text() for path in feedback.glob("*.md"))
+        assert not any("hacked" in path.read_text() for path in feedback.rglob("*.md"))
     finally:
         shutil.rmtree(root, ignore_errors=True)
 
@@ -196,12 +209,13 @@ def test_a_sandbox_that_dies_before_its_first_answer_is_an_error_not_a_fallback(
 def test_the_weaker_isolation_is_named_in_every_row_and_the_summary(tmp_path, capsys):
     nobody = tmp_path / "nobody"
     nobody.mkdir()
+    shutil.copy(PROJECT_ROOT / "assignments" / "task1.py", nobody)
     checks = tmp_path / "checks"
     checks.mkdir()
     (checks / "test_nothing.py").write_text("def test_nothing():\n    pass\n")
     out = tmp_path / "grades.csv"
     arguments = ["grade", str(nobody), "--out", str(out), "--checks", str(checks)]
     assert main([*arguments, "--isolation", "process"]) == 0
-    (row,) = csv.DictReader(out.open())
-    assert "weaker isolation 'process'" in row["notes"]
+    rows = {row["id"]: row for row in csv.DictReader(out.open())}
+    assert "weaker isolation 'process'" in rows["nobody"]["notes"]
     assert "isolation: process" in capsys.readouterr().out

@@ -3,6 +3,8 @@ and a worker killed mid-submission costs a retry, not a row."""
 
 from __future__ import annotations
 
+import csv
+import io
 import os
 import re
 import shutil
@@ -15,12 +17,18 @@ import pytest
 from msdlab.analysis.cluster import connect, parse_cluster
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
-from msdlab.instructor import grading
+from msdlab.instructor import grading, intake
 from msdlab.instructor.cluster_grading import grade_all_on_cluster
 
 pytest.importorskip("dask.distributed", reason="needs the extra: pip install -e '.[cluster]'")
 
 WORKSPACE = re.compile(r"msdlab-grade-\w+")  # each grading's own temporary folder
+SECONDS = re.compile(r"\b\d+(\.\d+)? s\b")  # how long a grading took
+
+
+def comparable(text: str) -> str:
+    """Feedback without what differs from run to run: temporary folders and times."""
+    return SECONDS.sub("T s", WORKSPACE.sub("WORKSPACE", text))
 
 
 def test_cluster_and_local_pool_write_the_same_grades(tmp_path: Path, task1_checks: Path) -> None:
@@ -32,12 +40,15 @@ def test_cluster_and_local_pool_write_the_same_grades(tmp_path: Path, task1_chec
         out, feedback = tmp_path / f"{label}.csv", tmp_path / f"{label}-feedback"
         status = main(["grade", *folders, "--checks", str(task1_checks), "--out", str(out),
                        "--feedback", str(feedback), "--call-timeout", "10", *where])  # fmt: skip
-        files = {path.name: WORKSPACE.sub("WORKSPACE", path.read_text())
-                 for path in sorted(feedback.iterdir())}  # fmt: skip
+        files = {str(path.relative_to(feedback)): comparable(path.read_text())
+                 for path in sorted(feedback.rglob("*.md"))}  # fmt: skip
         runs[label] = (status, out.read_text(), files)
     assert runs["cluster"] == runs["pool"]
-    status, table, _ = runs["pool"]
-    assert table.splitlines()[1].startswith("alice,14,") and "missing: task1.py" in table
+    status, table, files = runs["pool"]
+    rows = {row["id"]: row for row in csv.DictReader(io.StringIO(table))}
+    assert rows["alice"]["task1"] == rows[intake.MAX_POINTS_ID]["task1"] != "0"
+    assert status == 1 and "no task files" in rows["carol"]["notes"]
+    assert {"students/alice.md", "instructor/carol.md", "summary.md"} <= set(files)
 
 
 def test_a_worker_killed_mid_submission_costs_a_retry(tmp_path: Path, task1_checks: Path) -> None:
@@ -57,8 +68,8 @@ def test_a_worker_killed_mid_submission_costs_a_retry(tmp_path: Path, task1_chec
             [submission], task1_checks, client, progress=lambda *a: progress.append(a),
             call_timeout=10.0,
         )  # fmt: skip
-    assert first.graded and first.total == 14, first.notes
-    assert [g.total for g in grades] == [14] and len(progress) == 1
+    assert first.graded and first.total == first.report.points > 0, first.notes
+    assert [g.total for g in grades] == [first.total] and len(progress) == 1
 
 
 @pytest.mark.parametrize("spec", ["local:0", "local:x", "local", ""])

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from msdlab.analysis.sweep import parse_sweeps
 from msdlab.cli import main
 from msdlab.scenes import get_scene
+from msdlab.scenes.sweep import parse_sweeps
 
 STIFFNESSES = (0.25, 1.0, 4.0)  # unit mass: ω = 0.5, 1, 2 per frame
 STEPS = (0.9, 1.1, 1.9, 2.1, 3.9, 4.1)  # frames; none within 5 % of a limit 2/ω = 4, 2, 1

@@ -22,8 +22,8 @@ import numpy as np
 
 from ..errors import SimulationDiverged
 from ..integrators import Integrator
-from ..scenes import Scene, get_scene
 from ..simulation import Trajectory
+from .registry import Scene, get_scene
 
 RUN_SETTINGS = ("dt", "integrator", "duration")  # swept like the scene's own settings
 OUTCOMES = ("diverged", "steps", "time", "energy_drift", "max_displacement")
