@@ -7,7 +7,16 @@ sim = msd.Simulation(body, msd.Verlet(damping=0.01), dt=1e-3,
 trajectory = sim.run(duration=1.0, record_every=10)
 """
 
-from .analysis import Convergence, bisect_blowup, convergence_order, measure_blowup_dt
+from .analysis import (
+    Convergence,
+    Mode,
+    bisect_blowup,
+    convergence_order,
+    max_stable_dt,
+    measure_blowup_dt,
+    stability_limit,
+    stiffest_mode,
+)
 from .body import Body, rotation_matrix
 from .constraint import Constraint, StepState
 from .dynamics import Dynamics
@@ -34,49 +43,17 @@ from .interaction import Drag, Grab, Ground, Prescribed, SphereContact, Walls
 from .particle import Particle
 from .simulation import Simulation, Trajectory
 from .spring import Spring
-from .stability import Mode, max_stable_dt, stability_limit, stiffest_mode
 
 __version__ = "0.1.0"
 
+# fmt: off
 __all__ = [
-    "RK4",
-    "Body",
-    "Constraint",
-    "Convergence",
-    "Drag",
-    "Dynamics",
-    "EnergyLedger",
-    "ExplicitEuler",
-    "Force",
-    "Grab",
-    "Gravity",
-    "Ground",
-    "ImplicitEuler",
-    "Integrator",
-    "Mode",
-    "Particle",
-    "Prescribed",
-    "Simulation",
-    "SimulationDiverged",
-    "SphereContact",
-    "Spring",
-    "StepState",
-    "SymplecticEuler",
-    "Trajectory",
-    "VelocityVerlet",
-    "Verlet",
-    "ViscousDamping",
-    "Walls",
-    "angular_momentum",
-    "bisect_blowup",
-    "convergence_order",
-    "elastic_energy",
-    "gravitational_energy",
-    "kinetic_energy",
-    "max_stable_dt",
-    "measure_blowup_dt",
-    "momentum",
-    "rotation_matrix",
-    "stability_limit",
-    "stiffest_mode",
+    "RK4", "Body", "Constraint", "Convergence", "Drag", "Dynamics", "EnergyLedger",
+    "ExplicitEuler", "Force", "Grab", "Gravity", "Ground", "ImplicitEuler", "Integrator", "Mode",
+    "Particle", "Prescribed", "Simulation", "SimulationDiverged", "SphereContact", "Spring",
+    "StepState", "SymplecticEuler", "Trajectory", "VelocityVerlet", "Verlet", "ViscousDamping",
+    "Walls", "angular_momentum", "bisect_blowup", "convergence_order", "elastic_energy",
+    "gravitational_energy", "kinetic_energy", "max_stable_dt", "measure_blowup_dt", "momentum",
+    "rotation_matrix", "stability_limit", "stiffest_mode",
 ]
+# fmt: on

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import math
 import operator
-from collections.abc import Iterator, Sequence
-from typing import Generic, TypeVar
+from collections.abc import Callable, Iterator, Sequence
+from typing import Any, Generic, TypeVar
 
 import numpy as np
 
@@ -15,134 +15,145 @@ from .particle import Particle
 from .spring import Spring
 
 Item = TypeVar("Item", Particle, Spring)
+MASS_HINT = "To pin a particle use fixed=True instead of a zero mass."
+FIELDS = {  # the arrays of a body and their types: one row per particle / per spring
+    "particles": {"positions": float, "velocities": float, "masses": float, "fixed": bool},
+    "springs": {
+        "spring_a": np.int64,
+        "spring_b": np.int64,
+        "stiffness": float,
+        "rest_lengths": float,
+        "spring_damping": float,
+    },
+}
+
+
+def _per_row(name: str, values: object, count: int, hint: str, zero: bool = True) -> np.ndarray:
+    """``values`` checked finite and >= 0 (> 0 unless ``zero``): one value or ``count``."""
+    array = check_non_negative(name, values, hint, zero=zero)
+    if array.ndim and array.shape != (count,):
+        raise ValueError(f"{name} needs one value or one per row ({count}), got {array.shape}")
+    return array
+
+
+def _pin(body: Body, fixed: object, count: int) -> np.ndarray:
+    """The fixed mask (N,) to store; pinned particles stop (their velocity becomes zero)."""
+    mask = np.broadcast_to(np.asarray(fixed, dtype=bool), (count,))
+    body.velocities[mask] = 0.0
+    return mask
+
+
+class _Rows:
+    """A body array as an attribute: a view of the used rows of a buffer that grows.
+
+    The view is valid until the body grows. Assigning the whole array goes through
+    ``check(body, value, rows)``; without a check the array is read-only.
+    """
+
+    def __init__(self, doc: str, check: Callable[[Body, Any, int], Any] | None = None) -> None:
+        self.__doc__, self.check = doc, check
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+        self.kind = "particles" if name in FIELDS["particles"] else "springs"
+
+    def __get__(self, body: Body | None, owner: type | None = None) -> Any:
+        if body is None:
+            return self
+        view = body._buffers[self.name][: body._size[self.kind]]
+        if self.check is None:
+            view.flags.writeable = False
+        return view
+
+    def __set__(self, body: Body, value: object) -> None:
+        if self.check is None:
+            raise AttributeError(f"body.{self.name} is read-only; add springs to change it")
+        rows = self.__get__(body)
+        rows[...] = self.check(body, value, len(rows))
 
 
 class Body:
     """A mass-spring body in 2-D or 3-D (fixed by the first particle added).
 
-    The state lives in arrays, so the whole body is updated at once:
-    ``positions`` (N, d) m, ``velocities`` (N, d) m/s, ``masses`` (N,) kg,
-    ``fixed`` (N,) bool; springs in ``spring_a``, ``spring_b`` (E,) particle
-    indices, ``stiffness`` (E,) N/m, ``rest_lengths`` (E,) m, ``spring_damping``
-    (E,) N·s/m. These are writeable views, valid until the body grows.
-    ``particles[i]`` and ``springs[k]`` are objects reading/writing the same rows.
+    The state lives in arrays, so the whole body is updated at once (writeable
+    views, valid until the body grows). ``particles[i]`` and ``springs[k]`` are
+    objects reading and writing the same rows.
     """
+
+    positions = _Rows(
+        "Positions (N, d) in m.", lambda body, x, n: as_vectors("positions", x, body.dim or 3, n)
+    )
+    velocities = _Rows(
+        "Velocities (N, d) in m/s; zero for fixed particles.",
+        lambda body, v, n: np.where(
+            body.fixed[:, None], 0.0, as_vectors("velocities", v, body.dim or 3, n)
+        ),
+    )
+    masses = _Rows(
+        "Masses (N,) in kg.", lambda body, m, n: _per_row("mass", m, n, MASS_HINT, zero=False)
+    )
+    fixed = _Rows("True for pinned particles (N,); pinning zeroes their velocity.", _pin)
+    spring_a = _Rows("First particle of each spring (E,), read-only.")
+    spring_b = _Rows("Second particle of each spring (E,), read-only.")
+    stiffness = _Rows(
+        "Spring stiffness k (E,) in N/m.",
+        lambda body, k, n: _per_row("stiffness", k, n, "Use k >= 0 (N/m)."),
+    )
+    rest_lengths = _Rows(
+        "Spring rest lengths l (E,) in m.",
+        lambda body, rest, n: _per_row("rest length", rest, n, "It is in m.", zero=False),
+    )
+    spring_damping = _Rows(
+        "Dashpot coefficient c along each spring (E,) in N·s/m.",
+        lambda body, c, n: _per_row("damping", c, n, "Use a dashpot coefficient c >= 0 (N·s/m)."),
+    )
 
     def __init__(self, dim: int | None = None) -> None:
         if dim not in (None, 2, 3):
             raise ValueError(f"a body is 2-D or 3-D, got dim = {dim!r}")
         self.dim = dim
         self.grid_shape: tuple[int, ...] | None = None
-        self.topology_version = 0
-        self._n = self._e = 0
-        self._x = self._v = np.zeros((0, dim or 3))
-        self._m = np.zeros(0)
-        self._fixed = np.zeros(0, dtype=bool)
-        self._a = self._b = np.zeros(0, dtype=np.int64)
-        self._k = self._rest = self._c = np.zeros(0)
+        self.topology_version = 0  # grows whenever particles or springs are added
+        self._size = {"particles": 0, "springs": 0}
+        self._buffers: dict[str, np.ndarray] = {}
+        self._capacity = {"particles": 0, "springs": 0}
+        self._reserve("particles", 0)
+        self._reserve("springs", 0)
+        self._incidence: tuple[int, np.ndarray, np.ndarray] | None = None
 
-    # ----------------------------------------------------------------- state views
     @property
     def n_particles(self) -> int:
-        return self._n
+        return self._size["particles"]
 
     @property
     def n_springs(self) -> int:
-        return self._e
+        return self._size["springs"]
 
     def __len__(self) -> int:
-        return self._n
-
-    @property
-    def positions(self) -> np.ndarray:
-        """Positions (N, d) in m."""
-        return self._x[: self._n]
-
-    @positions.setter
-    def positions(self, value: object) -> None:
-        self._x[: self._n] = as_vectors("positions", value, self._dim_or_3(), self._n)
-
-    @property
-    def velocities(self) -> np.ndarray:
-        """Velocities (N, d) in m/s."""
-        return self._v[: self._n]
-
-    @velocities.setter
-    def velocities(self, value: object) -> None:
-        value = as_vectors("velocities", value, self._dim_or_3(), self._n)
-        value[self.fixed] = 0.0
-        self._v[: self._n] = value
-
-    @property
-    def masses(self) -> np.ndarray:
-        """Masses (N,) in kg."""
-        return self._m[: self._n]
-
-    @masses.setter
-    def masses(self, value: object) -> None:
-        self._m[: self._n] = self._checked_masses(value, self._n)
-
-    @property
-    def fixed(self) -> np.ndarray:
-        """True for pinned particles (N,)."""
-        return self._fixed[: self._n]
-
-    @fixed.setter
-    def fixed(self, value: object) -> None:
-        mask = np.broadcast_to(np.asarray(value, dtype=bool), (self._n,))
-        self._fixed[: self._n] = mask
-        self.velocities[mask] = 0.0
-
-    @property
-    def spring_a(self) -> np.ndarray:
-        """First particle of each spring (E,), read-only."""
-        return _read_only(self._a[: self._e])
-
-    @property
-    def spring_b(self) -> np.ndarray:
-        """Second particle of each spring (E,), read-only."""
-        return _read_only(self._b[: self._e])
-
-    @property
-    def stiffness(self) -> np.ndarray:
-        """Spring stiffness k (E,) in N/m."""
-        return self._k[: self._e]
-
-    @property
-    def rest_lengths(self) -> np.ndarray:
-        """Spring rest lengths l (E,) in m."""
-        return self._rest[: self._e]
-
-    @property
-    def spring_damping(self) -> np.ndarray:
-        """Dashpot coefficient c along each spring (E,) in N·s/m."""
-        return self._c[: self._e]
+        return self.n_particles
 
     @property
     def particles(self) -> _Items[Particle]:
         """``particles[i]`` reads/writes particle i's rows of the arrays."""
-        return _Items(self, Particle, self._n)
+        return _Items(self, Particle, self.n_particles)
 
     @property
     def springs(self) -> _Items[Spring]:
         """``springs[k]`` reads/writes spring k's rows of the arrays."""
-        return _Items(self, Spring, self._e)
+        return _Items(self, Spring, self.n_springs)
 
     # ----------------------------------------------------------------- building
     def add_particle(self, particle: Particle) -> int:
         """Add ``particle`` and return its index; the object then reads/writes this body."""
         if not isinstance(particle, Particle):
             raise TypeError(f"add_particle takes a msdlab.Particle, got {type(particle).__name__}")
-        if particle.is_bound:
-            raise ValueError(
-                "this particle already belongs to a body; make a new Particle for each body"
-            )
-        own = particle.own_values
-        (index,) = self.add_particles(
-            own["position"][None], own["velocity"][None], own["mass"], own["fixed"]
+        if particle.body is not None:
+            raise ValueError("this particle already belongs to a body; make a new Particle")
+        new = self.add_particles(
+            [particle.position], [particle.velocity], particle.mass, particle.fixed
         )
-        particle.bind(self, int(index))
-        return int(index)
+        particle.bind(self, int(new[0]))
+        return int(new[0])
 
     def add_particles(
         self,
@@ -155,48 +166,36 @@ class Body:
         positions = np.array(positions, dtype=float)
         dim = positions.shape[-1] if positions.ndim == 2 else None
         if dim not in (2, 3):
-            raise ValueError(
-                f"positions must have shape (N, 2) or (N, 3), got shape {positions.shape}"
-            )
-        if self.dim is not None and dim != self.dim:
+            raise ValueError(f"positions must have shape (N, 2) or (N, 3), got {positions.shape}")
+        if self.dim not in (None, dim):
             raise ValueError(
                 f"this body is {self.dim}-D but the new particle has {dim} coordinates; "
                 "do not mix 2-D and 3-D particles in one body"
             )
         count = len(positions)
         positions = as_vectors("positions", positions, dim, count)
-        velocities = (
-            np.zeros_like(positions)
-            if velocities is None
-            else as_vectors("velocities", velocities, dim, count)
-        )
-        masses = self._checked_masses(masses, count)
+        velocities = 0.0 if velocities is None else as_vectors("velocities", velocities, dim, count)
         fixed = np.broadcast_to(np.asarray(fixed, dtype=bool), (count,))
         if self.dim is None:
             self.dim = dim
-            self._x = self._v = np.zeros((0, dim))
-        start = self._n
-        self._reserve_particles(start + count)
-        self._x[start : start + count] = positions
-        self._v[start : start + count] = np.where(fixed[:, None], 0.0, velocities)
-        self._m[start : start + count] = masses
-        self._fixed[start : start + count] = fixed
-        self._n += count
-        self.topology_version += 1
-        return np.arange(start, start + count)
+            self._reserve("particles", 0)  # the empty buffers, now with d columns
+        return self._append(
+            "particles",
+            count,
+            positions=positions,
+            velocities=np.where(fixed[:, None], 0.0, velocities),
+            masses=_per_row("mass", masses, count, MASS_HINT, zero=False),
+            fixed=fixed,
+        )
 
     def add_spring(self, spring: Spring) -> int:
         """Add ``spring`` and return its index; the object then reads/writes this body."""
         if not isinstance(spring, Spring):
             raise TypeError(f"add_spring takes a msdlab.Spring, got {type(spring).__name__}")
-        if spring.is_bound:
+        if spring.body is not None:
             raise ValueError("this spring already belongs to a body; make a new Spring")
-        own = spring.own_values
         (index,) = self.add_springs(
-            [[own["a"], own["b"]]],
-            own["stiffness"],
-            None if own["rest_length"] is None else [own["rest_length"]],
-            own["damping"],
+            [[spring.a, spring.b]], spring.stiffness, spring.rest_length, spring.damping
         )
         spring.bind(self, int(index))
         return int(index)
@@ -208,7 +207,10 @@ class Body:
         rest_lengths: object = None,
         damping: object = 0.0,
     ) -> np.ndarray:
-        """Add springs between index pairs (E, 2); rest lengths default to current distances."""
+        """Add springs between index pairs (E, 2); rest lengths default to current distances.
+
+        Values are one per spring or one for all (checked once, not per spring).
+        """
         pairs = np.asarray(pairs)
         if pairs.size == 0:  # also () and [], which numpy makes float
             pairs = pairs.reshape(0, 2).astype(np.int64)
@@ -216,53 +218,60 @@ class Body:
             raise ValueError(f"spring pairs must have shape (E, 2), got shape {pairs.shape}")
         if not np.issubdtype(pairs.dtype, np.integer):
             raise TypeError(f"spring ends must be integer particle indices, got {pairs.dtype}")
-        pairs = pairs.astype(np.int64, copy=False)
-        bad = np.flatnonzero(np.any((pairs < 0) | (pairs >= self._n), axis=1))
-        if len(bad):
-            a, b = pairs[bad[0]]
+        count, n = len(pairs), self.n_particles
+        if count and (pairs.min() < 0 or pairs.max() >= n):
+            bad = np.flatnonzero(((pairs < 0) | (pairs >= n)).any(axis=1))[0]
             raise ValueError(
-                f"spring {bad[0]} joins particles {a} and {b}, but the body has {self._n} "
-                f"particles (indices 0 to {self._n - 1}); add the particles first"
+                f"spring {bad} joins particles {pairs[bad, 0]} and {pairs[bad, 1]}, but the body "
+                f"has {n} particles (indices 0 to {n - 1}); add the particles first"
             )
-        same = np.flatnonzero(pairs[:, 0] == pairs[:, 1])
-        if len(same):
+        a, b = pairs[:, 0], pairs[:, 1]
+        if (a == b).any():
+            same = np.flatnonzero(a == b)[0]
             raise ValueError(
-                f"spring {same[0]} joins particle {pairs[same[0], 0]} to itself; "
+                f"spring {same} joins particle {a[same]} to itself; "
                 "a spring needs two different particles"
             )
-        count = len(pairs)
-        stiffness = np.broadcast_to(np.asarray(stiffness, dtype=float), (count,))
-        damping = np.broadcast_to(np.asarray(damping, dtype=float), (count,))
-        check_non_negative("stiffness", stiffness, "Use k >= 0 (N/m).")
-        check_non_negative("damping", damping, "Use a dashpot coefficient c >= 0 (N·s/m).")
         if rest_lengths is None:
-            rest_lengths = np.linalg.norm(
-                self.positions[pairs[:, 0]] - self.positions[pairs[:, 1]], axis=1
-            )
-            zero = np.flatnonzero(rest_lengths == 0)
-            if len(zero):
-                a, b = pairs[zero[0]]
+            rest_lengths = np.linalg.norm(self.positions[a] - self.positions[b], axis=1)
+            if count and rest_lengths.min() == 0:
+                zero = np.flatnonzero(rest_lengths == 0)[0]
                 raise ValueError(
-                    f"zero-length spring: particles {a} and {b} are at the same position "
-                    f"{self.positions[a].tolist()}; move them apart or give rest_length > 0"
+                    f"zero-length spring: particles {a[zero]} and {b[zero]} are at the same "
+                    f"position {self.positions[a[zero]].tolist()}; "
+                    "move them apart or give rest_length > 0"
                 )
-        rest_lengths = np.broadcast_to(np.asarray(rest_lengths, dtype=float), (count,))
-        bad = np.flatnonzero(~np.isfinite(rest_lengths) | (rest_lengths <= 0))
-        if len(bad):
-            raise ValueError(
-                f"spring {bad[0]} has rest length {rest_lengths[bad[0]]!r}; "
-                "rest lengths must be > 0 (m)"
-            )
-        start = self._e
-        self._reserve_springs(start + count)
-        self._a[start : start + count] = pairs[:, 0]
-        self._b[start : start + count] = pairs[:, 1]
-        self._k[start : start + count] = stiffness
-        self._rest[start : start + count] = rest_lengths
-        self._c[start : start + count] = damping
-        self._e += count
+        return self._append(
+            "springs",
+            count,
+            spring_a=a,
+            spring_b=b,
+            stiffness=Body.stiffness.check(self, stiffness, count),
+            rest_lengths=Body.rest_lengths.check(self, rest_lengths, count),
+            spring_damping=Body.spring_damping.check(self, damping, count),
+        )
+
+    def _append(self, kind: str, count: int, **columns: object) -> np.ndarray:
+        """Write ``columns`` into the next ``count`` rows of ``kind``; return their indices."""
+        start = self._size[kind]
+        if start + count > self._capacity[kind]:
+            self._reserve(kind, max(start + count, 2 * start, 8))
+        for name, values in columns.items():
+            self._buffers[name][start : start + count] = values
+        self._size[kind] += count
         self.topology_version += 1
         return np.arange(start, start + count)
+
+    def _reserve(self, kind: str, capacity: int) -> None:
+        """Grow the buffers of ``kind`` to hold ``capacity`` rows (their used rows kept)."""
+        used = self._size[kind]
+        for name, dtype in FIELDS[kind].items():
+            columns = (self.dim or 3,) if name in ("positions", "velocities") else ()
+            grown = np.empty((capacity, *columns), dtype)  # rows past `used` are never read
+            if used:
+                grown[:used] = self._buffers[name][:used]
+            self._buffers[name] = grown
+        self._capacity[kind] = capacity
 
     @classmethod
     def from_arrays(
@@ -310,30 +319,21 @@ class Body:
         offsets = neighbour_offsets(len(shape), neighbours)
         body = cls()
         body.add_particles(grid_positions(shape, spacing, origin), masses=mass)
-        body._reserve_springs(grid_pair_count(shape, offsets))  # exactly: no regrowth
-        for offset, pairs in zip(offsets, grid_pair_blocks(shape, offsets)):
-            rest = spacing * math.sqrt(float(offset @ offset))
-            body.add_springs(pairs, stiffness, rest, damping)
+        k, c = Body.stiffness.check(body, stiffness, 1), Body.spring_damping.check(body, damping, 1)
+        body._reserve("springs", grid_pair_count(shape, offsets))  # exactly: no regrowth
+        for offset, pairs in zip(offsets, grid_pair_blocks(shape, offsets)):  # valid by design
+            rest = spacing * math.sqrt(offset @ offset)
+            columns = {"spring_a": pairs[:, 0], "spring_b": pairs[:, 1], "rest_lengths": rest}
+            body._append("springs", len(pairs), stiffness=k, spring_damping=c, **columns)
         body.grid_shape = shape
         return body
 
     # ----------------------------------------------------------------- helpers
     def copy(self) -> Body:
         """An independent copy of the body (state and springs)."""
-        body = (
-            Body.from_arrays(
-                self.positions,
-                np.stack([self.spring_a, self.spring_b], axis=1),
-                velocities=self.velocities,
-                masses=self.masses,
-                fixed=self.fixed,
-                stiffness=self.stiffness,
-                rest_lengths=self.rest_lengths,
-                damping=self.spring_damping,
-            )
-            if self._n
-            else Body(self.dim)
-        )
+        body = Body(self.dim)
+        for kind, names in FIELDS.items():
+            body._append(kind, self._size[kind], **{name: getattr(self, name) for name in names})
         body.grid_shape = self.grid_shape
         return body
 
@@ -342,10 +342,8 @@ class Body:
         return self.masses @ self.positions / self.masses.sum()
 
     def rotate(self, rotation: np.ndarray, about: Sequence[float] | None = None) -> None:
-        """Rotate positions and velocities by a (d, d) rotation matrix about a point.
-
-        ``about`` defaults to the centre of mass. See `rotation_matrix`.
-        """
+        """Rotate positions and velocities by a (d, d) rotation matrix about a point
+        (default: the centre of mass). See `rotation_matrix`."""
         rotation = np.asarray(rotation, dtype=float)
         if rotation.shape != (self.dim, self.dim) or not np.allclose(
             rotation @ rotation.T, np.eye(self.dim), atol=1e-9
@@ -357,58 +355,25 @@ class Body:
 
     def incident_springs(self) -> tuple[np.ndarray, np.ndarray]:
         """CSR lists of the springs touching each particle: ``springs[start[i]:start[i+1]]``."""
-        cached = getattr(self, "_incidence", None)
-        if cached is not None and cached[0] == self.topology_version:
-            return cached[1], cached[2]
-        ends = np.concatenate([self.spring_a, self.spring_b])
-        order = np.argsort(ends, kind="stable")
-        start = np.zeros(self._n + 1, dtype=np.int64)
-        np.cumsum(np.bincount(ends, minlength=self._n), out=start[1:])
-        springs = order % max(self._e, 1)
-        self._incidence = (self.topology_version, start, springs)
-        return start, springs
+        if self._incidence is None or self._incidence[0] != self.topology_version:
+            ends = np.concatenate([self.spring_a, self.spring_b])
+            start = np.zeros(self.n_particles + 1, dtype=np.int64)
+            np.cumsum(np.bincount(ends, minlength=self.n_particles), out=start[1:])
+            springs = np.argsort(ends, kind="stable") % max(self.n_springs, 1)
+            self._incidence = (self.topology_version, start, springs)
+        return self._incidence[1], self._incidence[2]
 
     def springs_touching(self, particles: np.ndarray) -> np.ndarray:
         """Indices of the springs with an end in ``particles`` (sorted, unique)."""
         start, springs = self.incident_springs()
         counts = start[particles + 1] - start[particles]
         first = np.repeat(start[particles] - (np.cumsum(counts) - counts), counts)
-        found = np.sort(springs[first + np.arange(counts.sum())])
-        return found[np.concatenate(([True], found[1:] != found[:-1]))] if len(found) else found
-
-    def _dim_or_3(self) -> int:
-        return self.dim or 3
-
-    @staticmethod
-    def _checked_masses(value: object, count: int) -> np.ndarray:
-        masses = np.broadcast_to(np.asarray(value, dtype=float), (count,))
-        bad = np.flatnonzero(~np.isfinite(masses) | (masses <= 0))
-        if len(bad):
-            raise ValueError(
-                f"mass of particle {bad[0]} is {masses[bad[0]]!r}; every mass must be > 0 (kg). "
-                "To pin a particle use fixed=True instead of a zero mass"
-            )
-        return masses
-
-    def _reserve_particles(self, needed: int) -> None:
-        if needed > len(self._m):
-            capacity = max(needed, 2 * len(self._m), 8)
-            self._x = _grown(self._x, capacity)
-            self._v = _grown(self._v, capacity)
-            self._m = _grown(self._m, capacity)
-            self._fixed = _grown(self._fixed, capacity)
-
-    def _reserve_springs(self, needed: int) -> None:
-        if needed > len(self._k):
-            capacity = max(needed, 2 * len(self._k), 8)
-            self._a, self._b = _grown(self._a, capacity), _grown(self._b, capacity)
-            self._k, self._rest = _grown(self._k, capacity), _grown(self._rest, capacity)
-            self._c = _grown(self._c, capacity)
+        return np.unique(springs[first + np.arange(counts.sum())])
 
     def __repr__(self) -> str:
         kind = f"{self.dim}-D" if self.dim else "empty"
         grid = f", grid {self.grid_shape}" if self.grid_shape else ""
-        return f"<Body {kind}: {self._n} particles, {self._e} springs{grid}>"
+        return f"<Body {kind}: {self.n_particles} particles, {self.n_springs} springs{grid}>"
 
 
 def rotation_matrix(angle_degrees: float, axis: Sequence[float] | None = None) -> np.ndarray:
@@ -448,14 +413,3 @@ class _Items(Sequence, Generic[Item]):
 
     def __iter__(self) -> Iterator[Item]:
         return (self[i] for i in range(self._count))
-
-
-def _grown(array: np.ndarray, capacity: int) -> np.ndarray:
-    grown = np.zeros((capacity, *array.shape[1:]), dtype=array.dtype)
-    grown[: len(array)] = array
-    return grown
-
-
-def _read_only(view: np.ndarray) -> np.ndarray:
-    view.flags.writeable = False
-    return view

@@ -1,70 +1,76 @@
-"""How a `Particle` or `Spring` object is bound to a row of a body's arrays.
+"""How a `Particle` or `Spring` object binds to a row of a body's arrays.
 
-Made on its own, such an object keeps its values in a dictionary. Added to a
-body (``body.add_particle``), it is bound to the row the body gave it and from
-then on reads and writes the body's arrays; ``body.particles[i]`` makes an
-object bound to row i directly. The body only calls `bind` and `row`.
+Made on its own, the object keeps its values in a dictionary. Added to a body
+(``body.add_particle``) or read back as ``body.particles[i]``, it is bound to
+that row and its `Field` attributes read and write the body's arrays.
 """
 
 from __future__ import annotations
 
-from typing import Any, Protocol, TypeVar
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:
+    from .body import Body
 
-Self = TypeVar("Self", bound="Bound")
 
+class Field:
+    """An attribute of a particle or spring: its own value, or row ``index`` of a body array.
 
-class BodyArrays(Protocol):
-    """The arrays of a body that particles and springs read and write (see `Body`)."""
+    ``check`` validates and converts a value before it is stored; ``kind`` converts
+    the value read (None: return the array row itself, a writeable view).
+    """
 
-    positions: np.ndarray
-    velocities: np.ndarray
-    masses: np.ndarray
-    fixed: np.ndarray
-    spring_a: np.ndarray
-    spring_b: np.ndarray
-    stiffness: np.ndarray
-    rest_lengths: np.ndarray
-    spring_damping: np.ndarray
+    def __init__(
+        self,
+        array: str,
+        doc: str,
+        check: Callable[[Any], Any] | None = None,
+        kind: type | None = float,
+    ) -> None:
+        self.array, self.__doc__, self.check, self.kind = array, doc, check, kind
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    def __get__(self, item: Bound | None, owner: type | None = None) -> Any:
+        if item is None:
+            return self
+        body = item.body
+        value = item._own[self.name] if body is None else getattr(body, self.array)[item.index]
+        return value if self.kind is None or value is None else self.kind(value)
+
+    def __set__(self, item: Bound, value: Any) -> None:
+        if self.check is None:
+            raise AttributeError(f"{self.name} cannot be changed; make a new {type(item).__name__}")
+        value = self.check(value)
+        if item.body is None:
+            item._own[self.name] = value
+        else:
+            getattr(item.body, self.array)[item.index] = value
 
 
 class Bound:
-    """Base of objects that hold their own values until bound to row ``index`` of a body."""
+    """Base of the objects whose `Field` attributes are bound to row ``index`` of ``body``."""
 
-    def __init__(self, **own: Any) -> None:
-        self._body: BodyArrays | None = None
-        self._index = -1
-        self._own = own
+    def __init__(self) -> None:
+        self.body: Body | None = None
+        self.index = -1  # row in the body; -1 while not in one
+        self._own: dict[str, Any] = {}
 
     @classmethod
-    def row(cls: type[Self], body: BodyArrays, index: int) -> Self:
+    def row(cls, body: Body, index: int) -> Any:
         """An object of this class reading and writing row ``index`` of ``body``."""
         item = cls.__new__(cls)
         Bound.__init__(item)
         item.bind(body, index)
         return item
 
-    def bind(self, body: BodyArrays, index: int) -> None:
-        """Read and write row ``index`` of ``body`` from now on (its own values are dropped)."""
-        if self._body is not None:
+    def bind(self, body: Body, index: int) -> None:
+        """Read and write row ``index`` of ``body`` from now on (own values are dropped)."""
+        if self.body is not None:
             kind = type(self).__name__
             raise ValueError(
                 f"this {kind.lower()} already belongs to a body; make a new {kind} for each body"
             )
-        self._body, self._index, self._own = body, int(index), {}
-
-    @property
-    def own_values(self) -> dict[str, Any]:
-        """The values given at creation, while not bound to a body."""
-        return dict(self._own)
-
-    @property
-    def is_bound(self) -> bool:
-        """True once the object reads and writes a body's arrays."""
-        return self._body is not None
-
-    @property
-    def index(self) -> int:
-        """Index in its body (-1 while not in a body)."""
-        return self._index
+        self.body, self.index, self._own = body, int(index), {}

@@ -13,8 +13,7 @@ from .commands import COMMANDS
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every sub-command registered."""
     parser = argparse.ArgumentParser(
-        prog="msdlab",
-        description="Mass-spring-damper simulation for teaching.",
+        prog="msdlab", description="Mass-spring-damper simulation for teaching."
     )
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     for command in COMMANDS:
@@ -23,12 +22,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def configure_process() -> None:
-    """Settings for the whole process, made by the command line, never by importing msdlab.
+    """Process-wide settings, made by the command line, never by importing msdlab.
 
-    Threads waiting for work sleep instead of spinning (``OMP_WAIT_POLICY=PASSIVE``):
-    spinning costs little on an idle machine, but when another program holds a
-    core the spinning thread keeps the waiting work off the CPU (a 0.5 ms step
-    took 30 ms). Set the variable yourself to choose otherwise.
+    Waiting threads sleep instead of spinning (``OMP_WAIT_POLICY=PASSIVE``): a
+    spinning thread keeps waiting work off a shared core (a 0.5 ms step took 30 ms).
+    A value the user set is kept.
     """
     os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
@@ -46,7 +44,3 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ValueError, TypeError, OSError, RuntimeError) as error:
         print(f"msdlab {args.command}: error: {error}", file=sys.stderr)
         return 2
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -15,10 +15,9 @@ from .errors import check_non_negative
 class Force(ABC):
     """A force field acting on the particles of a body.
 
-    `add_to` adds the force (N) to ``out``; conservative forces also give their
-    potential energy, dissipative ones the power they take out (booked in the
-    energy ledger under ``ledger_name``), and forces that depend on x or v may
-    give their Jacobians (used by `ImplicitEuler`).
+    Conservative forces also give their potential energy, dissipative ones the
+    power they take out (booked in the energy ledger under ``ledger_name``), and
+    forces that depend on x or v may give their Jacobians (for `ImplicitEuler`).
     """
 
     ledger_name = "other"
@@ -28,7 +27,7 @@ class Force(ABC):
 
     @abstractmethod
     def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-        """Add this force on each particle (N, d) in N to ``out``."""
+        """Add this force on each particle (N, d), in N, to ``out``."""
 
     def potential_energy(
         self, body: Body, x: np.ndarray, particles: np.ndarray | None = None
@@ -56,10 +55,14 @@ class Gravity(Force):
             raise ValueError(f"gravity must be a finite 2- or 3-vector in m/s², got {g!r}")
 
     def check(self, body: Body) -> None:
-        _check_dim("Gravity g", self.g, body)
+        if len(self.g) != body.dim:
+            raise ValueError(
+                f"Gravity g has {len(self.g)} components but the body is {body.dim}-D; "
+                f"give {body.dim} components"
+            )
 
     def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-        for axis, g in enumerate(self.g):  # per axis: much faster than broadcasting m[:, None] * g
+        for axis, g in enumerate(self.g):  # per axis: much faster than m[:, None] * g
             if g != 0.0:
                 out[:, axis] += g * body.masses
 
@@ -77,15 +80,13 @@ class Gravity(Force):
 class ViscousDamping(Force):
     """Linear drag F = -c v on every particle, c in N·s/m (the cloth seed's λ).
 
-    Under explicit integrators it is stable only for c·dt/m < 2; `Drag` is the
-    version that is stable at any dt.
+    Under explicit integrators it is stable only for c·dt/m < 2; `Drag` is stable at any dt.
     """
 
     ledger_name = "viscous"
 
     def __init__(self, coefficient: float) -> None:
-        check_non_negative("viscous damping coefficient", coefficient)
-        self.coefficient = float(coefficient)
+        self.coefficient = float(check_non_negative("viscous damping coefficient", coefficient))
 
     def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
         out -= self.coefficient * v
@@ -100,11 +101,3 @@ class ViscousDamping(Force):
 
     def __repr__(self) -> str:
         return f"ViscousDamping({self.coefficient:g})"
-
-
-def _check_dim(name: str, vector: np.ndarray, body: Body) -> None:
-    if len(vector) != body.dim:
-        raise ValueError(
-            f"{name} has {len(vector)} components but the body is {body.dim}-D; "
-            f"give {body.dim} components"
-        )

@@ -14,10 +14,9 @@ from .body import Body
 from .constraint import Constraint, StepState
 from .dynamics import Dynamics
 from .energy import EnergyLedger, kinetic_energy
-from .errors import SimulationDiverged, check_finite_array, check_positive
+from .errors import SimulationDiverged, check_finite_array, check_positive, diagnose_divergence
 from .forces import Force
 from .integrators import Integrator, Verlet
-from .stability import diagnose_divergence
 
 
 @dataclass

@@ -8,8 +8,20 @@ import operator
 import numpy as np
 
 from . import equations
-from .bound import Bound
+from .bound import Bound, Field
 from .errors import check_non_negative, check_positive
+
+
+def _stiffness(value: float) -> float:
+    return float(check_non_negative("stiffness", value, "Use k >= 0 (N/m)."))
+
+
+def _rest_length(value: float) -> float:
+    return check_positive("rest_length", value, "A spring needs a rest length > 0 (m).")
+
+
+def _damping(value: float) -> float:
+    return float(check_non_negative("damping", value, "Use a dashpot coefficient c >= 0 (N·s/m)."))
 
 
 class Spring(Bound):
@@ -22,9 +34,15 @@ class Spring(Bound):
         f_a = k (l - |x_a - x_b|) n  -  c ((v_a - v_b) · n) n,     f_b = -f_a
 
     ``rest_length=None`` takes the distance between the particles when the spring
-    is added to a body. This class is the readable one-spring version; it and the
-    spring kernels (`msdlab.kernels`) all apply `equations.spring_force`.
+    is added to a body. `Spring.force` and the spring kernels (`msdlab.kernels`)
+    all apply `equations.spring_force`.
     """
+
+    a = Field("spring_a", "Index of the first particle.", kind=int)
+    b = Field("spring_b", "Index of the second particle.", kind=int)
+    stiffness = Field("stiffness", "Stiffness k (N/m).", _stiffness)
+    rest_length = Field("rest_lengths", "Rest length l (m); None until in a body.", _rest_length)
+    damping = Field("spring_damping", "Dashpot coefficient c (N·s/m).", _damping)
 
     def __init__(
         self,
@@ -34,8 +52,9 @@ class Spring(Bound):
         rest_length: float | None = None,
         damping: float = 0.0,
     ) -> None:
+        super().__init__()
         try:
-            a, b = operator.index(a), operator.index(b)
+            self._own.update(a=operator.index(a), b=operator.index(b))
         except TypeError:
             raise TypeError(
                 f"a spring joins two particle indices (int), got {a!r} and {b!r}; "
@@ -43,69 +62,13 @@ class Spring(Bound):
             ) from None
         if a == b:
             raise ValueError(f"a spring cannot join particle {a} to itself; pick two particles")
-        check_non_negative("stiffness", stiffness, "Use k >= 0 (N/m); a negative k pushes apart.")
-        check_non_negative("damping", damping, "Use a dashpot coefficient c >= 0 (N·s/m).")
-        if rest_length is not None:
-            rest_length = check_positive(
-                "rest_length", rest_length, "A spring needs a rest length > 0 (m)."
-            )
-        super().__init__(
-            a=a, b=b, stiffness=float(stiffness), rest_length=rest_length, damping=float(damping)
-        )
-
-    def _get(self, name: str, array: str) -> float:
-        return self._own[name] if self._body is None else getattr(self._body, array)[self._index]
-
-    @property
-    def a(self) -> int:
-        """Index of the first particle."""
-        return int(self._get("a", "spring_a"))
-
-    @property
-    def b(self) -> int:
-        """Index of the second particle."""
-        return int(self._get("b", "spring_b"))
-
-    @property
-    def stiffness(self) -> float:
-        """Stiffness k (N/m)."""
-        return float(self._get("stiffness", "stiffness"))
-
-    @stiffness.setter
-    def stiffness(self, value: float) -> None:
-        check_non_negative("stiffness", value)
-        self._set("stiffness", "stiffness", value)
-
-    @property
-    def rest_length(self) -> float | None:
-        """Rest length l (m); None until added to a body when it was not given."""
-        value = self._get("rest_length", "rest_lengths")
-        return None if value is None else float(value)
-
-    @rest_length.setter
-    def rest_length(self, value: float) -> None:
-        self._set("rest_length", "rest_lengths", check_positive("rest_length", value))
-
-    @property
-    def damping(self) -> float:
-        """Dashpot coefficient c (N·s/m)."""
-        return float(self._get("damping", "spring_damping"))
-
-    @damping.setter
-    def damping(self, value: float) -> None:
-        check_non_negative("damping", value)
-        self._set("damping", "spring_damping", value)
-
-    def _set(self, name: str, array: str, value: float) -> None:
-        if self._body is None:
-            self._own[name] = float(value)
-        else:
-            getattr(self._body, array)[self._index] = value
+        self.stiffness, self.damping = stiffness, damping
+        self._own["rest_length"] = None if rest_length is None else _rest_length(rest_length)
 
     def _ends(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        if self._body is None:
+        if self.body is None:
             raise RuntimeError("add the spring to a body first: body.add_spring(spring)")
-        x, v = self._body.positions, self._body.velocities
+        x, v = self.body.positions, self.body.velocities
         return x[self.a], x[self.b], v[self.a], v[self.b]
 
     def length(self) -> float:
@@ -130,7 +93,7 @@ class Spring(Bound):
         return equations.spring_energy(self.stiffness, self.rest_length, self.length())
 
     def __repr__(self) -> str:
-        where = f"index={self._index}, " if self._body is not None else ""
+        where = f"index={self.index}, " if self.body is not None else ""
         return (
             f"Spring({where}a={self.a}, b={self.b}, stiffness={self.stiffness:g}, "
             f"rest_length={self.rest_length}, damping={self.damping:g})"

@@ -1,9 +1,20 @@
-"""Analysis on top of the engine: measured blow-up time steps, convergence
-orders, and the Dask cluster that sweeps and grading can run on.
+"""Analysis on top of the engine: the predicted stable time step and the diagnosis
+of a blow-up, measured blow-up time steps, convergence orders, and the Dask
+cluster that sweeps and grading can run on.
 
-The measurements are re-exported from `msdlab`.
+The predictions and measurements are re-exported from `msdlab`.
 """
 
 from .measure import Convergence, bisect_blowup, convergence_order, measure_blowup_dt
+from .stability import Mode, max_stable_dt, stability_limit, stiffest_mode
 
-__all__ = ["Convergence", "bisect_blowup", "convergence_order", "measure_blowup_dt"]
+__all__ = [
+    "Convergence",
+    "Mode",
+    "bisect_blowup",
+    "convergence_order",
+    "max_stable_dt",
+    "measure_blowup_dt",
+    "stability_limit",
+    "stiffest_mode",
+]

@@ -15,7 +15,7 @@ from ..errors import SimulationDiverged
 from ..forces import Force
 from ..integrators import Integrator
 from ..simulation import Simulation
-from ..stability import max_stable_dt
+from .stability import max_stable_dt
 
 
 def bisect_blowup(

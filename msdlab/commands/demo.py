@@ -7,8 +7,8 @@ import argparse
 import time
 from pathlib import Path
 
+from ..analysis import max_stable_dt
 from ..scenes import get_scene
-from ..stability import max_stable_dt
 from .progress import ProgressBar
 
 

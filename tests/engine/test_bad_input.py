@@ -125,3 +125,18 @@ def test_bad_grid_arguments():
         msd.Body.grid((3, 3), spacing=-1)
     with pytest.raises(ValueError, match="origin must have 2"):
         msd.Body.grid((3, 3), origin=(0, 0, 0))
+
+
+def test_whole_array_assignments_and_spring_values_are_checked():
+    body = body_2d()
+    body.stiffness = 5.0
+    assert body.stiffness[0] == 5.0
+    with pytest.raises(ValueError, match=r"stiffness must be finite and >= 0"):
+        body.stiffness = -1.0
+    with pytest.raises(ValueError, match=r"rest length must be finite and > 0"):
+        body.rest_lengths = [0.0]
+    with pytest.raises(ValueError, match=r"damping needs one value or one per row \(1\)"):
+        body.add_springs([[0, 1]], damping=[0.1, 0.2])
+    with pytest.raises(AttributeError, match="read-only"):
+        body.spring_a = [1]
+    assert body.stiffness[0] == 5.0 and body.n_springs == 1  # nothing changed by the failures

@@ -5,7 +5,8 @@ is stable for a mode when its one-step map on (x, v) has spectral radius <= 1;
 `stability_limit` finds the largest such dt by running the integrator's own
 `step` on that one mode, so it works for any `Integrator`, a student's included.
 `max_stable_dt` applies it to the stiffest mode of a body: the largest
-eigenvalue ω² of M⁻¹K (K = -∂F/∂x of the springs).
+eigenvalue ω² of M⁻¹K (K = -∂F/∂x of the springs). `describe_blowup` is what
+`Simulation` reports when a step blows up (registered with `msdlab.errors`).
 """
 
 from __future__ import annotations
@@ -19,10 +20,11 @@ import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from . import kernels
-from .body import Body
-from .forces import Force
-from .integrators import Integrator
+from .. import kernels
+from ..body import Body
+from ..errors import register_diagnosis
+from ..forces import Force
+from ..integrators import Integrator
 
 
 @dataclass(frozen=True)
@@ -137,7 +139,7 @@ def max_stable_dt(
     return stability_limit(integrator, stiffest_mode(body, forces, x))
 
 
-def diagnose_divergence(
+def describe_blowup(
     body: Body,
     integrator: Integrator,
     dt: float,
@@ -192,3 +194,6 @@ def diagnose_divergence(
             "reduce dt or the stiffness, or add damping"
         )
     return "; ".join(lines)
+
+
+register_diagnosis(describe_blowup)
