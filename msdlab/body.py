@@ -34,6 +34,7 @@ class Body:
         self.dim = dim
         self.grid_shape: tuple[int, ...] | None = None
         self.topology_version = 0
+        self.parameters_version = 0  # counts accesses that may edit spring values
         self._n = self._e = 0
         self._x = self._v = np.zeros((0, dim or 3))
         self._m = np.zeros(0)
@@ -106,17 +107,28 @@ class Body:
     @property
     def stiffness(self) -> np.ndarray:
         """Spring stiffness k (E,) in N/m."""
+        self.parameters_version += 1  # the caller may write to it
         return self._k[: self._e]
 
     @property
     def rest_lengths(self) -> np.ndarray:
         """Spring rest lengths l (E,) in m."""
+        self.parameters_version += 1  # the caller may write to it
         return self._rest[: self._e]
 
     @property
     def spring_damping(self) -> np.ndarray:
         """Dashpot coefficient c along each spring (E,) in N·s/m."""
+        self.parameters_version += 1  # the caller may write to it
         return self._c[: self._e]
+
+    def spring_values(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Stiffness (N/m), rest lengths (m) and dashpots (N·s/m) (E,) to read only.
+
+        Unlike `stiffness`, `rest_lengths` and `spring_damping` this does not
+        count as a possible edit in ``parameters_version``.
+        """
+        return self._k[: self._e], self._rest[: self._e], self._c[: self._e]
 
     @property
     def particles(self) -> _Items[Particle]:

@@ -12,9 +12,11 @@ for all springs at once, what `Spring.force` computes for one.
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
@@ -62,7 +64,7 @@ def _spring_forces_and_power(
     """`spring_forces`, and the power (W) the dashpots take at (x, v)."""
     pick = slice(None) if springs is None else springs
     a, b = body.spring_a[pick], body.spring_b[pick]
-    rest, damping = body.rest_lengths[pick], body.spring_damping[pick]
+    stiffness, rest, damping = (values[pick] for values in body.spring_values())
     d = x[a] - x[b]
     length = np.sqrt(np.einsum("ij,ij->i", d, d))
     safe = np.where(length > 0, length, np.inf)  # coincident ends: no direction, no force
@@ -72,7 +74,7 @@ def _spring_forces_and_power(
         closing = np.einsum("ij,ij->i", v[a] - v[b], d)
         power = float(np.sum(equations.dashpot_power(damping, closing / safe)))
     with np.errstate(divide="ignore", invalid="ignore"):  # coincident ends, masked below
-        magnitude = equations.spring_force(body.stiffness[pick], rest, length, damping, closing)
+        magnitude = equations.spring_force(stiffness, rest, length, damping, closing)
     f = np.where(length > 0, magnitude / safe, 0.0)[:, None] * d
     if out is None:
         out = np.zeros_like(x)
@@ -88,14 +90,13 @@ def elastic_energy(body: Body, x: np.ndarray, springs: np.ndarray | None = None)
     pick = slice(None) if springs is None else springs
     d = x[body.spring_a[pick]] - x[body.spring_b[pick]]
     length = np.sqrt(np.einsum("ij,ij->i", d, d))
-    return float(
-        np.sum(equations.spring_energy(body.stiffness[pick], body.rest_lengths[pick], length))
-    )
+    stiffness, rest, _ = (values[pick] for values in body.spring_values())
+    return float(np.sum(equations.spring_energy(stiffness, rest, length)))
 
 
 def dashpot_power(body: Body, x: np.ndarray, v: np.ndarray) -> float:
     """Power the dashpots take out of the body, Σ c ((v_a - v_b)·n)² (W), always >= 0."""
-    if not np.any(body.spring_damping):
+    if not np.any(body.spring_values()[2]):
         return 0.0
     return _spring_forces_and_power(body, x, v)[2]
 
@@ -157,10 +158,11 @@ def spring_jacobians(
     safe = np.where(length > 0, length, np.inf)
     n = d / safe[:, None]
     outer = n[:, :, None] * n[:, None, :]
-    transverse = np.maximum(0.0, 1.0 - body.rest_lengths / safe)
+    stiffness, rest, damping = body.spring_values()
+    transverse = np.maximum(0.0, 1.0 - rest / safe)
     eye = np.eye(dim)[None]
-    stiff = body.stiffness[:, None, None] * (outer + transverse[:, None, None] * (eye - outer))
-    damp = body.spring_damping[:, None, None] * outer
+    stiff = stiffness[:, None, None] * (outer + transverse[:, None, None] * (eye - outer))
+    damp = damping[:, None, None] * outer
     jx, jv = pattern.matrices(stiff, damp)
     return jx, jv
 
@@ -173,6 +175,56 @@ def _block_indices(a: np.ndarray, b: np.ndarray, dim: int) -> tuple[np.ndarray, 
     rows = np.broadcast_to(firsts, (4, len(a), dim, dim)).ravel()
     cols = np.broadcast_to(seconds, (4, len(a), dim, dim)).ravel()
     return rows, cols
+
+
+@dataclass(frozen=True)
+class GridStencil:
+    """Springs that form a regular grid stencil, as `Body.grid` builds them.
+
+    The particles fill a grid of ``shape`` (3,) in C order (2-D grids as
+    (1, n0, n1)); spring block m, ``starts[m]`` to ``starts[m + 1] - 1``, joins
+    every particle p to the particle at p's grid coordinates plus ``offsets[m]``
+    (3,), in the order of `lattice.grid_pair_blocks`. With the same stiffness,
+    rest length and dashpot in each block, the forces on a particle can be
+    gathered from its neighbours by offset, with no list of springs.
+    """
+
+    shape: np.ndarray
+    offsets: np.ndarray
+    starts: np.ndarray
+
+
+def grid_stencil(body: Body) -> GridStencil | None:
+    """The grid stencil the springs of ``body`` form, or None if they form none.
+
+    Needs ``body.grid_shape`` and springs in blocks of one offset each, every
+    block holding all the pairs of its offset in grid order (checked block by
+    block, not assumed). Whether the spring values are uniform per block is
+    for the caller to check, as they may change at any step.
+    """
+    shape = body.grid_shape
+    if shape is None or math.prod(shape) != body.n_particles or body.n_springs == 0:
+        return None
+    padded = (1,) * (3 - len(shape)) + tuple(shape)
+    index = np.arange(body.n_particles, dtype=np.int64).reshape(padded)
+    a, b = body.spring_a, body.spring_b
+    offsets, starts = [], [0]
+    while starts[-1] < body.n_springs:
+        first = starts[-1]
+        offset = np.subtract(np.unravel_index(b[first], padded), np.unravel_index(a[first], padded))
+        source = tuple(slice(max(0, -o), n - max(0, o)) for o, n in zip(offset, padded))
+        expected = index[source].ravel()
+        stop = first + len(expected)
+        shift = int(offset @ np.array([padded[1] * padded[2], padded[2], 1]))
+        if (
+            stop > body.n_springs
+            or not np.array_equal(a[first:stop], expected)
+            or not np.array_equal(b[first:stop], expected + shift)
+        ):
+            return None
+        offsets.append(offset)
+        starts.append(stop)
+    return GridStencil(np.array(padded), np.array(offsets, dtype=np.int64), np.array(starts))
 
 
 class SpringKernel(Protocol):
