@@ -174,8 +174,9 @@ def _gather_row(scratch, shape, offsets, k, rest, c, row, out):
     n1, n2 = shape[1], shape[2]
     i0, i1 = row // n1, row % n1
     row_start = row * n2
-    for f in fs:
-        f[row_start : row_start + n2] = 0.0
+    f0, f1, f2 = fs
+    for p in range(row_start, row_start + n2):
+        f0[p] = f1[p] = f2[p] = 0.0
     stretch = 0.0
     power = 0.0
     for m in range(len(offsets)):

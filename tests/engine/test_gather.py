@@ -36,6 +36,7 @@ def forces_by(kernel: kernels.SpringKernel, body: msd.Body) -> tuple[np.ndarray,
 
 def assert_agree(body: msd.Body, numba_kernel: NumbaKernel) -> None:
     expected, stretch, power = forces_by(kernels.NumpyKernel(), body)
+    forces_by(numba_kernel, body)  # a second call must not see the first one's forces
     actual, actual_stretch, actual_power = forces_by(numba_kernel, body)
     scale = np.abs(expected).max()
     np.testing.assert_allclose(actual, expected, rtol=RTOL, atol=RTOL * scale)
@@ -113,8 +114,13 @@ def test_edited_spring_values_switch_to_the_edge_loop(how: str) -> None:
     assert_agree(body, kernel)
 
 
-def test_simulation_on_the_gather_follows_the_edge_loop(monkeypatch: pytest.MonkeyPatch) -> None:
+@pytest.mark.parametrize("threaded", [False, True])
+def test_simulation_on_the_gather_follows_the_edge_loop(
+    threaded: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """200 steps of a grid falling onto the ground, SymplecticEuler and damped Verlet."""
+    if threaded:
+        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
     runs = []
     for gathered in (True, False):
         if not gathered:
