@@ -136,3 +136,34 @@ def test_simulation_on_the_gather_follows_the_edge_loop(
         np.testing.assert_allclose(x_gather, x_edge, rtol=0, atol=1e-11)
         for name, energy in booked_edge.items():
             assert booked_gather[name] == pytest.approx(energy, rel=1e-9, abs=1e-12)
+
+
+@pytest.mark.parametrize("threaded", [False, True])
+def test_shuffled_springs_sorted_for_the_edge_loop(
+    threaded: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Springs in a random order with random values: the sorted edge loop sees every edit."""
+    if threaded:
+        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
+    grid = shaken_grid((4, 3, 5), (1, 2, 3), 0.0)
+    order = np.random.default_rng(2).permutation(grid.n_springs)
+    pairs = np.stack([grid.spring_a[order], grid.spring_b[order]], axis=1)
+    body = msd.Body.from_arrays(
+        grid.positions, pairs, velocities=grid.velocities, stiffness=grid.stiffness[order]
+    )
+    body.spring_damping[::3] = 0.4
+    kernel = NumbaKernel()
+    assert kernel.grid_stencil(body) is None
+    assert_agree(body, kernel)
+    held = body.stiffness
+    held[5] = 123.0  # through a kept view
+    assert_agree(body, kernel)
+    body.rest_lengths[7] *= 1.5
+    assert_agree(body, kernel)
+    touching = body.springs_touching(np.array([3, 8]))
+    assert kernel.elastic_energy(body, body.positions, touching) == pytest.approx(
+        kernels.elastic_energy(body, body.positions, touching), rel=RTOL
+    )
+    assert kernel.dashpot_power(body, body.positions, body.velocities) == pytest.approx(
+        kernels.dashpot_power(body, body.positions, body.velocities), rel=RTOL
+    )
