@@ -32,8 +32,9 @@ import numpy as np
 from . import equations, kernels
 from .body import Body
 
-# Below this many springs one thread is faster than waking the others.
+# Below this many springs (particles for the update) one thread is faster than waking the others.
 PARALLEL_MIN_SPRINGS = 50_000
+PARALLEL_MIN_PARTICLES = 20_000
 
 _spring_force = numba.njit(cache=True, inline="always")(equations.spring_force)
 _spring_energy = numba.njit(cache=True, inline="always")(equations.spring_energy)
@@ -319,16 +320,18 @@ def _divide_by_masses(forces, masses, fixed):
             forces[i, q] = _acceleration(forces[i, q], inverse)
 
 
-def _compile_advance(update: Callable) -> Callable:
+def _compile_advance(update: Callable, threads: bool) -> Callable:
     """A loop over the particles doing a = F/m then ``update`` per coordinate.
 
-    numba compiles it at its first call, which raises a numba error if it cannot.
+    With ``threads`` the particles are split between the threads (each writes
+    only its own rows). numba compiles it at its first call, which raises a
+    numba error if it cannot.
     """
     scalar = numba.njit(update)
 
-    @numba.njit
+    @numba.njit(parallel=threads)
     def advance(x, v, forces, masses, fixed, dt, coefficients, x_new, v_new):
-        for i in range(len(masses)):
+        for i in numba.prange(len(masses)):
             inverse = _inverse_mass(masses[i], not fixed[i])
             for q in range(x.shape[1]):
                 a = _acceleration(forces[i, q], inverse)
@@ -359,8 +362,9 @@ def _shared(views: tuple[np.ndarray, ...]) -> bool:
     return any(sys.getrefcount(view.base) > _PRIVATE for view in views)
 
 
-# One compiled loop per update function, for the whole process.
-_ADVANCES: dict[Callable, Callable | None] = {}
+# One compiled loop per update function (threaded or not), for the whole process.
+_ADVANCES: dict[tuple[Callable, bool], Callable] = {}
+_FAILED: set[Callable] = set()  # updates numba cannot compile: they run on arrays
 
 
 class NumbaKernel:
@@ -452,17 +456,16 @@ class NumbaKernel:
 
     def dashpot_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
         """Power (W) the dashpots take out of the body at (x, v), always >= 0."""
-        a, b, _, _, damping = self._edge_list(body)
+        a, b, damping = body.spring_a, body.spring_b, body.spring_values()[2]
         if not self._parallel(body):
             return _dashpot_power_serial(x, v, a, b, damping)
         return _dashpot_power_parallel(x, v, a, b, damping, self._threads)
 
     def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
         """Energy (J) stored in the springs (or in the given ones) at positions x."""
+        arrays = (body.spring_a, body.spring_b, *body.spring_values()[:2])
         if springs is not None:
-            arrays = (body.spring_a, body.spring_b, *body.spring_values()[:2])
             return _elastic_energy_serial(x, *(array[springs] for array in arrays))
-        arrays = self._edge_list(body)[:4]
         if not self._parallel(body):
             return _elastic_energy_serial(x, *arrays)
         return _elastic_energy_parallel(x, *arrays, self._threads)
@@ -487,16 +490,20 @@ class NumbaKernel:
 
         An update numba cannot compile warns once and runs on whole arrays.
         """
-        if update not in _ADVANCES:
-            _ADVANCES[update] = _compile_advance(update)
-        compiled = _ADVANCES[update]
+        threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
+        if update in _FAILED:
+            compiled = None
+        elif (update, threads) not in _ADVANCES:
+            compiled = _ADVANCES[update, threads] = _compile_advance(update, threads)
+        else:
+            compiled = _ADVANCES[update, threads]
         if compiled is not None:
             x_new, v_new = np.empty_like(x), np.empty_like(v)
             try:
                 compiled(x, v, forces, body.masses, body.fixed, dt, coefficients, x_new, v_new)
                 return x_new, v_new
             except numba.core.errors.NumbaError as error:
-                _ADVANCES[update] = None
+                _FAILED.add(update)
                 warnings.warn(
                     f"numba cannot compile {update.__qualname__} ({type(error).__name__}); "
                     "it runs on whole numpy arrays instead, with the same result, more slowly",

@@ -118,9 +118,11 @@ def test_edited_spring_values_switch_to_the_edge_loop(how: str) -> None:
 def test_simulation_on_the_gather_follows_the_edge_loop(
     threaded: bool, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """200 steps of a grid falling onto the ground, SymplecticEuler and damped Verlet."""
+    """200 steps of a grid falling onto the ground, SymplecticEuler and damped Verlet
+    (threaded: the spring forces and the update, on the gather and on the edge loop)."""
     if threaded:
         monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_PARTICLES", 0)
     runs = []
     for gathered in (True, False):
         if not gathered:
