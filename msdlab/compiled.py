@@ -8,7 +8,16 @@ particle a and its opposite to particle b (eq. 1.1), and keeps the largest
 stretch |d|/l and the dashpot power on the way, with no temporary arrays.
 Large bodies split the springs between the threads, each summing into its own
 force buffer (no two threads write the same memory; the first one writes the
-result), and the buffers are then added per particle.
+result), and the buffers are then added per particle. The springs are visited
+sorted by their ends, so memory is read in order whatever order they were
+added in.
+
+Grid bodies (`msdlab.stencil`) whose springs share their values per offset
+are gathered instead: each particle sums the forces of its neighbours by grid
+offset, on positions copied by coordinate so that the inner loop walks
+contiguous rows on vector registers; the threads split the rows and write
+only their own particles. Each spring is then computed from both ends, with
+the same `equations.spring_force`; the two ways agree to rounding.
 
 `NumbaKernel.advance` compiles an integrator's update function (for example
 `integrators.verlet_update`) into one loop over the particles that computes
@@ -29,8 +38,9 @@ from collections.abc import Callable
 import numba
 import numpy as np
 
-from . import equations, kernels
+from . import equations
 from .body import Body
+from .stencil import GridStencil, grid_stencil
 
 # Below this many springs (particles for the update) one thread is faster than waking the others.
 PARALLEL_MIN_SPRINGS = 50_000
@@ -386,7 +396,7 @@ class NumbaKernel:
         self._partial: np.ndarray | None = None
         self._threads = 1
         self._stencil_version = -1
-        self._stencil: kernels.GridStencil | None = None
+        self._stencil: GridStencil | None = None
         self._stencil_values = np.zeros((3, 0))
         self._scratch = np.zeros((10, 0))  # x, v, forces by coordinate and squared lengths
         self._values_version = -1
@@ -427,7 +437,7 @@ class NumbaKernel:
             self._partial = np.empty((self._threads - 1, *x.shape))
         return _spring_forces_parallel(x, v, *arrays, self._partial, out)
 
-    def grid_stencil(self, body: Body) -> kernels.GridStencil | None:
+    def grid_stencil(self, body: Body) -> GridStencil | None:
         """The body's grid stencil if its forces can be gathered by offset now, else None.
 
         The stencil is found once per topology (``body.topology_version``); that
@@ -436,7 +446,7 @@ class NumbaKernel:
         difference), so edits of single springs switch to the edge loop at once.
         """
         if self._stencil_version != body.topology_version:
-            self._stencil = kernels.grid_stencil(body)
+            self._stencil = grid_stencil(body)
             blocks = 0 if self._stencil is None else len(self._stencil.offsets)
             self._stencil_values = np.zeros((3, blocks))
             self._stencil_version = body.topology_version

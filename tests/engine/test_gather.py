@@ -8,6 +8,7 @@ import pytest
 import msdlab as msd
 from msdlab import kernels
 from msdlab.compiled import NumbaKernel
+from msdlab.stencil import grid_stencil
 
 RTOL = 1e-12
 
@@ -78,19 +79,19 @@ def test_coincident_ends_exert_no_force() -> None:
 
 def test_stencil_found_only_for_grid_springs() -> None:
     grid = msd.Body.grid((4, 3, 5), neighbours=(1, 2, 3))
-    stencil = kernels.grid_stencil(grid)
+    stencil = grid_stencil(grid)
     assert stencil is not None and len(stencil.offsets) == 13
     assert stencil.starts[-1] == grid.n_springs
 
     pairs = np.stack([grid.spring_a, grid.spring_b], axis=1)
     shuffled = msd.Body.from_arrays(grid.positions, pairs[::-1], rest_lengths=grid.rest_lengths)
     shuffled.grid_shape = grid.grid_shape  # same shape, springs in another order
-    assert kernels.grid_stencil(shuffled) is None
+    assert grid_stencil(shuffled) is None
 
     extra = grid.copy()
     extra.add_springs([[0, 7]])
-    assert kernels.grid_stencil(extra) is None
-    assert kernels.grid_stencil(msd.Body.from_arrays(grid.positions, pairs)) is None  # no shape
+    assert grid_stencil(extra) is None
+    assert grid_stencil(msd.Body.from_arrays(grid.positions, pairs)) is None  # no shape
 
 
 @pytest.mark.parametrize("how", ["array", "held view", "spring object"])
