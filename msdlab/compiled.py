@@ -199,8 +199,9 @@ def _gather_row(scratch, shape, offsets, k, rest, c, row, out):
                 power += 0.5 * _gather_offset(
                     xs, vs, fs, squared, k[m], rest[m], c[m], first, stop, shift
                 )
-                longest = squared[first:stop].max()
-                stretch = max(stretch, math.sqrt(longest) / rest[m])
+                if sign == 1:  # -o meets the same springs from their other end
+                    longest = squared[first:stop].max()
+                    stretch = max(stretch, math.sqrt(longest) / rest[m])
     for p in range(row_start, row_start + n2):
         for q in range(out.shape[1]):
             out[p, q] += fs[q][p]
