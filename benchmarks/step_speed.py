@@ -1,34 +1,32 @@
-"""How fast does msdlab step a big body? Prints a table comparing implementations.
+"""How fast does msdlab step a big body, next to a hand-written numba edge loop?
 
-Workload: an n×n×n grid with neighbours (1, 2, 3) (13 springs per particle),
-spacing 2/n, origin (-1, 1.5, -1), k = 50 N/m, m = 1 kg, gravity, ground at
-y = 0 (not reached during the measured steps), dt = 1 ms, one step at a time.
+The yardstick is ``../shared/bench``'s peer, ``NumbaParallel(Problem(n))``: a
+parallel numba loop over the springs with per-thread force buffers, on an n³
+grid with 13 springs per particle (rest 1, √2, √3), k = 100 N/m, m = 1 kg,
+gravity, a ground clamp at y = 0, symplectic Euler, dt = 1 ms, float64.
+msdlab runs the same body (same positions) as a full `Simulation.step`:
+forces, integrator, fixed particles, ground, energy ledger, divergence check,
+with `SymplecticEuler` and with `Verlet(0.01)`, on two layouts of the springs:
 
-Implementations, each run in its own process (so its peak memory is its own):
+- grid: `Body.grid(..., neighbours=(1, 2, 3))`, which the numba kernel gathers
+  per particle by grid offset;
+- shuffled: the same springs in a random order, added with `add_springs` to a
+  body that is not a grid, which the kernel sums with its edge loop.
 
-- engine: `msdlab.Simulation.step` with the compiled kernel, Verlet(λ = 0.01)
-  and SymplecticEuler: the full step (forces, integrator, fixed particles,
-  ground, energy ledger, divergence check);
-- engine, numpy kernel: the same step with ``kernel="numpy"``;
-- numpy edge list: a plain numpy Verlet step over the spring list (gravity,
-  ground clamp, nothing else), what one writes without an engine;
-- Spring.force loop: a Python loop over ``body.springs`` calling
-  `Spring.force`, timed on a sample of springs and scaled to all of them.
-
-Columns: ms/step is the median of the timed steps after warm-up; M upd/s is
-million spring updates per second (springs / time per step); step MiB is the
-peak of memory allocated during one step (tracemalloc, i.e. temporaries and
-new arrays, not the body already built); peak RSS is the process's maximum
-resident memory (getrusage: Python, libraries, the body and the steps);
-build s is the time of `Body.grid`.
+The machine is shared and noisy, so the peer runs in the same process,
+interleaved with msdlab: batch of the peer, batch of each msdlab integrator,
+repeated; a ratio is msdlab's batch over the peer's batch next to it. The
+table shows the median ratio and its range over the repeats, and the medians
+of the times. Each (n, layout) runs in its own process; its peak RSS is taken
+before the peer is built, so it is msdlab's (the body, the kernels, Python).
 
     python benchmarks/step_speed.py                 # n = 20, 40, 60, 100
-    python benchmarks/step_speed.py --n 20 40 --repeats 5
-    python benchmarks/step_speed.py --skip-100      # without the 1 M particle grid
+    python benchmarks/step_speed.py --n 20 60 --repeats 15
+    python benchmarks/step_speed.py --skip-100 --no-extras
 
-It ends with the ImplicitEuler step on a 20³ grid and 10 000 steps of a small
-2-D body, in the air and resting on the ground (where the ground's energy
-bookkeeping runs every step).
+It ends with the compile time, the ImplicitEuler step on a 20³ grid and 10 000
+steps of a small 2-D body in the air and resting on the ground (``--no-extras``
+leaves them out).
 """
 
 from __future__ import annotations
@@ -42,7 +40,7 @@ import subprocess
 import sys
 import tempfile
 import time
-import tracemalloc
+from pathlib import Path
 
 import numpy as np
 
@@ -51,143 +49,89 @@ from msdlab.cli import configure_process
 
 configure_process()  # the thread wait policy the command line uses
 
-IMPLEMENTATIONS = {
-    "engine-verlet": "engine, numba, Verlet",
-    "engine-symplectic": "engine, numba, SymplecticEuler",
-    "engine-numpy": "engine, numpy kernel, Verlet",
-    "user-arrays": "engine, numba, a user's Verlet on arrays",
-    "user-advance": "engine, numba, a user's Verlet via advance",
-    "numpy-edge-list": "numpy edge list, Verlet",
-    "spring-loop": "Spring.force loop, Verlet",
-}
+PEER = Path(__file__).resolve().parents[1].parent / "shared" / "bench"
 DT = 1e-3
 GRAVITY = (0.0, -9.81, 0.0)
-LOOP_SAMPLE = 20_000  # springs timed for the Spring.force loop
+INTEGRATORS = {"symplectic": msd.SymplecticEuler, "verlet": lambda: msd.Verlet(0.01)}
+
+
+def peer_problem(n: int) -> tuple:
+    """The peer stepper and its `Problem` (imported from ../shared/bench)."""
+    sys.path.insert(0, str(PEER))
+    from common import Problem  # found at run time
+    from impl_numba import NumbaParallel
+
+    problem = Problem(n)
+    return NumbaParallel(problem), problem
 
 
 def make_grid(n: int) -> tuple[msd.Body, float]:
-    """The benchmark body and the seconds `Body.grid` took."""
+    """The peer's grid as a msdlab body (same spacing, k, masses), and seconds to build it."""
     start = time.perf_counter()
-    body = msd.Body.grid(
-        (n, n, n), spacing=2.0 / n, stiffness=50.0, neighbours=(1, 2, 3), origin=(-1, 1.5, -1)
-    )
+    body = msd.Body.grid((n, n, n), spacing=1.0, stiffness=100.0, neighbours=(1, 2, 3))
     return body, time.perf_counter() - start
 
 
-def damped_verlet_update(
-    x: np.ndarray, v: np.ndarray, a: np.ndarray, dt: float, lam: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Eq. (1.4) as a user writes it (like task 5), for numbers or arrays."""
-    old = x - v * dt
-    new = (2.0 - lam) * x - (1.0 - lam) * old + a * dt**2
-    return new, (new - x) / dt
+def shuffled(grid: msd.Body, seed: int = 0) -> msd.Body:
+    """The same particles and springs, the springs in a random order, not a grid."""
+    order = np.random.default_rng(seed).permutation(grid.n_springs)
+    body = msd.Body.from_arrays(grid.positions, masses=grid.masses)
+    pairs = np.stack([grid.spring_a[order], grid.spring_b[order]], axis=1)
+    body.add_springs(pairs, grid.stiffness[order], grid.rest_lengths[order])
+    return body
 
 
-class UserArrayVerlet(msd.Integrator):
-    """A user's damped Verlet written like task 5: ``dynamics.acceleration`` and arrays."""
-
-    def __init__(self, damping: float) -> None:
-        self.damping = damping
-
-    def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: msd.Dynamics) -> tuple:
-        return damped_verlet_update(x, v, dynamics.acceleration(x, v), dt, self.damping)
-
-
-class UserAdvanceVerlet(UserArrayVerlet):
-    """The same update handed to ``dynamics.advance``, which the numba kernel compiles."""
-
-    def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: msd.Dynamics) -> tuple:
-        return dynamics.advance(damped_verlet_update, x, v, dt, self.damping)
+def simulations(n: int, layout: str, x0: np.ndarray) -> tuple[dict, float]:
+    """One `Simulation` per integrator on its own copy of the body, and the build seconds."""
+    sims = {}
+    build = 0.0
+    for name, integrator in INTEGRATORS.items():
+        body, build = make_grid(n)
+        if layout == "shuffled":
+            body = shuffled(body)
+        body.positions[:] = x0
+        forces = [msd.Gravity(GRAVITY), msd.Ground(height=0.0)]
+        sims[name] = msd.Simulation(body, integrator(), dt=DT, forces=forces)
+    return sims, build
 
 
-def engine_stepper(body: msd.Body, implementation: str) -> tuple:
-    integrator = {
-        "engine-symplectic": msd.SymplecticEuler(),
-        "user-arrays": UserArrayVerlet(0.01),
-        "user-advance": UserAdvanceVerlet(0.01),
-    }.get(implementation, msd.Verlet(0.01))
-    kernel = "numpy" if implementation == "engine-numpy" else "numba"
-    forces = [msd.Gravity(GRAVITY), msd.Ground(height=0.0)]
-    sim = msd.Simulation(body, integrator, dt=DT, forces=forces, kernel=kernel)
-    return sim.step, body.n_springs
+def compare(n: int, layout: str, repeats: int) -> dict:
+    """Interleaved batches of the peer and of msdlab; the ratios and times of one (n, layout)."""
+    sys.path.insert(0, str(PEER))
+    from common import Problem  # found at run time
 
-
-def numpy_edge_list_stepper(body: msd.Body) -> tuple:
-    """Position Verlet with damping λ over the spring list in plain numpy."""
-    a, b = body.spring_a, body.spring_b
-    k, rest, m = body.stiffness, body.rest_lengths, body.masses
-    g, lam = np.array(GRAVITY), 0.01
-    state = {"x": body.positions.copy(), "old": body.positions.copy()}
-
-    def step() -> None:
-        x = state["x"]
-        d = x[a] - x[b]
-        length = np.sqrt((d * d).sum(axis=1))
-        f = (k * (rest - length) / length)[:, None] * d
-        force = np.empty_like(x)
-        for axis in range(3):
-            force[:, axis] = np.bincount(a, f[:, axis], len(x)) - np.bincount(b, f[:, axis], len(x))
-        acceleration = force / m[:, None] + g
-        x_new = (2 - lam) * x - (1 - lam) * state["old"] + acceleration * DT * DT
-        np.maximum(x_new[:, 1], 0.0, out=x_new[:, 1])  # the ground
-        state["old"], state["x"] = x, x_new
-
-    return step, body.n_springs
-
-
-def spring_loop_stepper(body: msd.Body) -> tuple:
-    """Forces of a sample of springs by `Spring.force`, then a numpy Verlet update."""
-    springs = body.springs[: min(LOOP_SAMPLE, body.n_springs)]
-    m, g = body.masses, np.array(GRAVITY)
-
-    def step() -> None:
-        force = np.zeros_like(body.positions)
-        for spring in springs:
-            f = spring.force()
-            force[spring.a] += f
-            force[spring.b] -= f
-        x = body.positions
-        x_new = 2 * x - (x - body.velocities * DT) + (force / m[:, None] + g) * DT * DT
-        body.velocities[:] = (x_new - x) / DT
-        x[:] = x_new
-
-    return step, len(springs)
-
-
-def measure(implementation: str, n: int, repeats: int, warmup: int) -> dict:
-    """Run one implementation on one grid (in this process) and return its row."""
-    body, build = make_grid(n)
-    if implementation.startswith(("engine", "user")):
-        step, timed_springs = engine_stepper(body, implementation)
-    elif implementation == "numpy-edge-list":
-        step, timed_springs = numpy_edge_list_stepper(body)
-    else:
-        step, timed_springs = spring_loop_stepper(body)
-        repeats, warmup = min(repeats, 3), 1
-    for _ in range(warmup):
-        step()
-    times = []
+    sims, build = simulations(n, layout, Problem(n).x0)
+    for sim in sims.values():
+        sim.run(steps=2)  # compile or load the kernels
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    peer, _ = peer_problem(n)
+    peer.step(2)
+    start = time.perf_counter()
+    peer.step(2)
+    steps = max(1, round(0.15 / ((time.perf_counter() - start) / 2)))  # ~0.15 s per batch
+    times: dict[str, list[float]] = {"peer": [], **{name: [] for name in sims}}
+    ratios: dict[str, list[float]] = {name: [] for name in sims}
     for _ in range(repeats):
-        start = time.perf_counter()
-        step()
-        times.append(time.perf_counter() - start)
-    tracemalloc.start()
-    before = tracemalloc.get_traced_memory()[0]
-    step()
-    step_bytes = tracemalloc.get_traced_memory()[1] - before
-    tracemalloc.stop()
-    seconds = float(np.median(times)) * body.n_springs / timed_springs
+        for name, sim in sims.items():
+            start = time.perf_counter()
+            peer.step(steps)
+            peer_seconds = (time.perf_counter() - start) / steps
+            start = time.perf_counter()
+            for _ in range(steps):
+                sim.step()
+            seconds = (time.perf_counter() - start) / steps
+            times["peer"].append(peer_seconds)
+            times[name].append(seconds)
+            ratios[name].append(seconds / peer_seconds)
     return {
-        "implementation": implementation,
         "n": n,
-        "particles": len(body),
-        "springs": body.n_springs,
-        "ms": 1e3 * seconds,
-        "extrapolated": timed_springs < body.n_springs,
-        "mups": body.n_springs / seconds / 1e6,
-        "step_mib": step_bytes / 2**20,
-        "rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+        "layout": layout,
+        "springs": next(iter(sims.values())).body.n_springs,
+        "ms": {name: 1e3 * float(np.median(t)) for name, t in times.items()},
+        "ratio": {name: [float(np.median(r)), min(r), max(r)] for name, r in ratios.items()},
+        "rss_mib": rss,
         "build_s": build,
+        "batch": steps,
     }
 
 
@@ -221,6 +165,7 @@ def small_body_seconds(kernel: str, resting: bool, steps: int = 10_000) -> float
 def implicit_ms(n: int = 20, repeats: int = 5) -> float:
     """Median ms per `ImplicitEuler` step on an n³ grid with (1, 2, 3) (dt = 10 ms)."""
     body = make_grid(n)[0]
+    body.positions[:, 1] += 1.05  # in the air, like the peer's grid
     forces = [msd.Gravity(GRAVITY), msd.Ground()]
     sim = msd.Simulation(body, msd.ImplicitEuler(), dt=1e-2, forces=forces)
     sim.step()
@@ -258,16 +203,17 @@ def machine() -> str:
 
 
 def table(rows: list[dict]) -> str:
-    columns = ["implementation", "n", "particles", "springs", "ms/step", "M upd/s"]
-    columns += ["step MiB", "peak RSS MiB", "build s"]
+    columns = ["n", "springs", "springs laid out", "peer ms"]
+    columns += ["SymplecticEuler ms", "÷ peer (range)", "Verlet(0.01) ms", "÷ peer (range)"]
+    columns += ["peak RSS MiB", "build s"]
     lines = ["| " + " | ".join(columns) + " |", "|" + " --- |" * len(columns)]
     for r in rows:
-        approx = "~" if r["extrapolated"] else ""
-        lines.append(
-            f"| {IMPLEMENTATIONS[r['implementation']]} | {r['n']} | {r['particles']:,} | "
-            f"{r['springs']:,} | {approx}{r['ms']:.3g} | {approx}{r['mups']:.3g} | "
-            f"{r['step_mib']:.1f} | {r['rss_mib']:.0f} | {r['build_s']:.2f} |"
-        )
+        cells = [str(r["n"]), f"{r['springs']:,}", r["layout"], f"{r['ms']['peer']:.3g}"]
+        for name in INTEGRATORS:
+            median, low, high = r["ratio"][name]
+            cells += [f"{r['ms'][name]:.3g}", f"{median:.2f} ({low:.2f}–{high:.2f})"]
+        cells += [f"{r['rss_mib']:.0f}", f"{r['build_s']:.2f}"]
+        lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
@@ -275,16 +221,14 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--n", type=int, nargs="+", default=[20, 40, 60, 100], help="grid sizes")
     parser.add_argument("--skip-100", action="store_true", help="leave out n = 100")
-    parser.add_argument("--repeats", type=int, default=9, help="timed steps per row")
-    parser.add_argument("--warmup", type=int, default=2, help="steps before timing")
-    parser.add_argument(
-        "--only", nargs="+", choices=list(IMPLEMENTATIONS), default=list(IMPLEMENTATIONS)
-    )
+    parser.add_argument("--repeats", type=int, default=7, help="interleaved batches per row")
+    parser.add_argument("--layouts", nargs="+", choices=["grid", "shuffled"])
+    parser.add_argument("--no-extras", action="store_true", help="only the table")
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
-    parser.add_argument("--implementation", help=argparse.SUPPRESS)
     parser.add_argument("--compile", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--small", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    layouts = args.layouts or ["grid", "shuffled"]
     if args.child:
         if args.compile:
             print(json.dumps({"seconds": compile_seconds()}))
@@ -297,10 +241,21 @@ def main() -> None:
             rows["implicit"] = implicit_ms()
             print(json.dumps(rows))
         else:
-            print(json.dumps(measure(args.implementation, args.n[0], args.repeats, args.warmup)))
+            print(json.dumps(compare(args.n[0], layouts[0], args.repeats)))
         return
 
+    if not (PEER / "common.py").exists():
+        sys.exit(f"the peer is not at {PEER}; this benchmark needs ../shared/bench beside the repo")
     print(machine())
+    rows = []
+    for n in [n for n in args.n if not (args.skip_100 and n == 100)]:
+        for layout in layouts:
+            rows.append(child(["--n", str(n), "--layouts", layout, "--repeats", str(args.repeats)]))
+            print(f"  measured n={n} {layout}", file=sys.stderr)
+    print(table(rows))
+    print(f"load average at the end: {os.getloadavg()[0]:.2f}")
+    if args.no_extras:
+        return
     with tempfile.TemporaryDirectory() as cache:
         env = dict(os.environ, NUMBA_CACHE_DIR=cache)
         cold = child(["--compile"], env)["seconds"]
@@ -309,17 +264,6 @@ def main() -> None:
         f"numba kernels: {cold:.2f} s to compile (empty cache), {warm:.2f} s to load from "
         "the cache (first steps of a small 2-D and a 17³ body, including their set-up)"
     )
-    sizes = [n for n in args.n if not (args.skip_100 and n == 100)]
-    rows = []
-    for n in sizes:
-        for implementation in args.only:
-            arguments = ["--implementation", implementation, "--n", str(n)]
-            arguments += ["--repeats", str(args.repeats), "--warmup", str(args.warmup)]
-            rows.append(child(arguments))
-            print(f"  measured {implementation} n={n}", file=sys.stderr)
-    print(table(rows))
-    print(f"load average at the end: {os.getloadavg()[0]:.2f}")
-    print("~: Spring.force loop timed on a sample of springs and scaled to all of them.")
     small = child(["--small"])
     print(f"ImplicitEuler, 20³ grid with (1, 2, 3): {small.pop('implicit'):.0f} ms per step")
     print("10 000 steps of a 2-D body (300 particles, 1 097 springs with dashpots, 3 fixed,")

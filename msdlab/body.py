@@ -63,6 +63,8 @@ class _Rows:
         view = body._buffers[self.name][: body._size[self.kind]]
         if self.check is None:
             view.flags.writeable = False
+        elif self.kind == "springs":
+            body.parameters_version += 1  # the caller may write to the spring values
         return view
 
     def __set__(self, body: Body, value: object) -> None:
@@ -114,6 +116,7 @@ class Body:
         self.dim = dim
         self.grid_shape: tuple[int, ...] | None = None
         self.topology_version = 0  # grows whenever particles or springs are added
+        self.parameters_version = 0  # grows whenever the spring values may have been edited
         self._size = {"particles": 0, "springs": 0}
         self._buffers: dict[str, np.ndarray] = {}
         self._capacity = {"particles": 0, "springs": 0}
@@ -131,6 +134,17 @@ class Body:
 
     def __len__(self) -> int:
         return self.n_particles
+
+    def spring_values(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Stiffness (N/m), rest lengths (m) and dashpots (N·s/m) (E,) to read only.
+
+        Unlike `stiffness`, `rest_lengths` and `spring_damping` this does not
+        count as a possible edit in ``parameters_version``.
+        """
+        used = self.n_springs
+        return tuple(  # type: ignore[return-value]
+            self._buffers[name][:used] for name in ("stiffness", "rest_lengths", "spring_damping")
+        )
 
     @property
     def particles(self) -> _Items[Particle]:

@@ -8,7 +8,16 @@ particle a and its opposite to particle b (eq. 1.1), and keeps the largest
 stretch |d|/l and the dashpot power on the way, with no temporary arrays.
 Large bodies split the springs between the threads, each summing into its own
 force buffer (no two threads write the same memory; the first one writes the
-result), and the buffers are then added per particle.
+result), and the buffers are then added per particle. The springs are visited
+sorted by their ends, so memory is read in order whatever order they were
+added in.
+
+Grid bodies (`msdlab.stencil`) whose springs share their values per offset
+are gathered instead: each particle sums the forces of its neighbours by grid
+offset, on positions copied by coordinate so that the inner loop walks
+contiguous rows on vector registers; the threads split the rows and write
+only their own particles. Each spring is then computed from both ends, with
+the same `equations.spring_force`; the two ways agree to rounding.
 
 `NumbaKernel.advance` compiles an integrator's update function (for example
 `integrators.verlet_update`) into one loop over the particles that computes
@@ -22,6 +31,7 @@ threads with ``NUMBA_NUM_THREADS`` or `numba.set_num_threads`.
 from __future__ import annotations
 
 import math
+import sys
 import warnings
 from collections.abc import Callable
 
@@ -30,9 +40,11 @@ import numpy as np
 
 from . import equations
 from .body import Body
+from .stencil import GridStencil, grid_stencil
 
-# Below this many springs one thread is faster than waking the others.
+# Below this many springs (particles for the update) one thread is faster than waking the others.
 PARALLEL_MIN_SPRINGS = 50_000
+PARALLEL_MIN_PARTICLES = 20_000
 
 _spring_force = numba.njit(cache=True, inline="always")(equations.spring_force)
 _spring_energy = numba.njit(cache=True, inline="always")(equations.spring_energy)
@@ -111,6 +123,140 @@ def _spring_forces_parallel(x, v, a, b, k, rest, c, partial, out):
     return stretches.max(), powers.sum()
 
 
+@numba.njit(cache=True, inline="always", error_model="numpy")
+def _gather_offset(xs, vs, fs, squared, k, rest, c, first, stop, shift):
+    """Add to particles ``first`` to ``stop - 1`` the force of their spring to p + ``shift``.
+
+    ``xs``, ``vs``, ``fs`` are positions, velocities and forces by coordinate,
+    3 contiguous arrays each, so the loop runs on vector registers: d = x_p - x_q
+    and p gets f(|d|)·d/|d|, f of eq. (1.2) plus the dashpot, whichever end of
+    the spring p is (the spring computes the same f for both ends). Each |d|²
+    goes to ``squared`` (a running maximum would keep the loop scalar); returns
+    the dashpot power of these springs. Indices are unsigned: numba then needs
+    no negative-index test, which would also keep the loop scalar.
+    """
+    x0, x1, x2 = xs
+    f0, f1, f2 = fs
+    power = 0.0
+    if c == 0.0:  # two loops, so that the one without dashpots has no sum across springs
+        for i in range(first, stop):
+            p, q = numba.uint64(i), numba.uint64(i + shift)
+            d0, d1, d2 = x0[p] - x0[q], x1[p] - x1[q], x2[p] - x2[q]
+            squared[p] = d0 * d0 + d1 * d1 + d2 * d2
+            length = math.sqrt(squared[p])
+            safe = length if length > 0.0 else 1.0  # coincident ends: no direction, no force
+            scale = _spring_force(k, rest, safe, 0.0, 0.0) / safe
+            scale = scale if length > 0.0 else 0.0
+            f0[p] += scale * d0
+            f1[p] += scale * d1
+            f2[p] += scale * d2
+        return power
+    v0, v1, v2 = vs
+    for i in range(first, stop):
+        p, q = numba.uint64(i), numba.uint64(i + shift)
+        d0, d1, d2 = x0[p] - x0[q], x1[p] - x1[q], x2[p] - x2[q]
+        squared[p] = d0 * d0 + d1 * d1 + d2 * d2
+        length = math.sqrt(squared[p])
+        safe = length if length > 0.0 else 1.0
+        closing = (v0[p] - v0[q]) * d0 + (v1[p] - v1[q]) * d1 + (v2[p] - v2[q]) * d2
+        power += _dashpot_power_of(c, closing / safe)
+        scale = _spring_force(k, rest, safe, c, closing) / safe
+        scale = scale if length > 0.0 else 0.0
+        f0[p] += scale * d0
+        f1[p] += scale * d1
+        f2[p] += scale * d2
+    return power
+
+
+@numba.njit(cache=True, inline="always", error_model="numpy")
+def _gather_row(scratch, shape, offsets, k, rest, c, row, out):
+    """Add to ``out`` (N, d) the spring forces on the particles of grid row ``row``.
+
+    ``scratch`` (10, N) holds the positions, velocities and forces by
+    coordinate and the squared lengths. For each stencil offset ±o the
+    particles p of the row and their neighbours p ± o are both contiguous.
+    Returns the largest stretch |d|/l and half the dashpot power of the
+    springs met (each spring is met from both ends).
+    """
+    xs = (scratch[0], scratch[1], scratch[2])
+    vs = (scratch[3], scratch[4], scratch[5])
+    fs = (scratch[6], scratch[7], scratch[8])
+    squared = scratch[9]
+    n1, n2 = shape[1], shape[2]
+    i0, i1 = row // n1, row % n1
+    row_start = row * n2
+    f0, f1, f2 = fs
+    for p in range(row_start, row_start + n2):
+        f0[p] = f1[p] = f2[p] = 0.0
+    stretch = 0.0
+    power = 0.0
+    for m in range(len(offsets)):
+        for sign in (1, -1):
+            o0, o1, o2 = sign * offsets[m, 0], sign * offsets[m, 1], sign * offsets[m, 2]
+            if 0 <= i0 + o0 < shape[0] and 0 <= i1 + o1 < n1:
+                first, stop = row_start + max(0, -o2), row_start + n2 - max(0, o2)
+                shift = (o0 * n1 + o1) * n2 + o2
+                power += 0.5 * _gather_offset(
+                    xs, vs, fs, squared, k[m], rest[m], c[m], first, stop, shift
+                )
+                if sign == 1:  # -o meets the same springs from their other end
+                    longest = squared[first:stop].max()
+                    stretch = max(stretch, math.sqrt(longest) / rest[m])
+    for p in range(row_start, row_start + n2):
+        for q in range(out.shape[1]):
+            out[p, q] += fs[q][p]
+    return stretch, power
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _gather_serial(x, v, shape, offsets, k, rest, c, scratch, out):
+    """One thread: `_gather_row` for every row; return (largest stretch, dashpot power)."""
+    damped = np.any(c != 0.0)
+    for q in range(x.shape[1]):
+        scratch[q] = x[:, q]
+        if damped:
+            scratch[3 + q] = v[:, q]
+    stretch = 0.0
+    power = 0.0
+    for row in range(shape[0] * shape[1]):
+        row_stretch, row_power = _gather_row(scratch, shape, offsets, k, rest, c, row, out)
+        stretch = max(stretch, row_stretch)
+        power += row_power
+    return stretch, power
+
+
+@numba.njit(cache=True, parallel=True, error_model="numpy")
+def _gather_parallel(x, v, shape, offsets, k, rest, c, scratch, out):
+    """Threads: rows split between them, each writing only its own particles' forces."""
+    damped = np.any(c != 0.0)
+    for p in numba.prange(len(x)):
+        for q in range(x.shape[1]):
+            scratch[q, p] = x[p, q]
+            if damped:
+                scratch[3 + q, p] = v[p, q]
+    rows = shape[0] * shape[1]
+    stretches = np.zeros(rows)
+    powers = np.zeros(rows)
+    for row in numba.prange(rows):
+        stretches[row], powers[row] = _gather_row(scratch, shape, offsets, k, rest, c, row, out)
+    return stretches.max(), powers.sum()
+
+
+@numba.njit(cache=True)
+def _uniform_blocks(k, rest, c, starts, values):
+    """True if every spring block has one stiffness, rest length and dashpot; they go to
+    ``values`` (3, M). Stops at the first spring that differs from its block's first."""
+    for m in range(len(starts) - 1):
+        first = starts[m]
+        values[0, m], values[1, m], values[2, m] = k[first], rest[first], c[first]
+        same = True
+        for s in range(first, starts[m + 1]):
+            same &= (k[s] == k[first]) & (rest[s] == rest[first]) & (c[s] == c[first])
+        if not same:
+            return False
+    return True
+
+
 @numba.njit(cache=True, inline="always")
 def _dashpot_power(x, v, a, b, c, first, stop):
     """Power (W) taken by the dashpots of springs ``first`` to ``stop - 1``."""
@@ -185,16 +331,18 @@ def _divide_by_masses(forces, masses, fixed):
             forces[i, q] = _acceleration(forces[i, q], inverse)
 
 
-def _compile_advance(update: Callable) -> Callable:
+def _compile_advance(update: Callable, threads: bool) -> Callable:
     """A loop over the particles doing a = F/m then ``update`` per coordinate.
 
-    numba compiles it at its first call, which raises a numba error if it cannot.
+    With ``threads`` the particles are split between the threads (each writes
+    only its own rows). numba compiles it at its first call, which raises a
+    numba error if it cannot.
     """
     scalar = numba.njit(update)
 
-    @numba.njit
+    @numba.njit(parallel=threads)
     def advance(x, v, forces, masses, fixed, dt, coefficients, x_new, v_new):
-        for i in range(len(masses)):
+        for i in numba.prange(len(masses)):
             inverse = _inverse_mass(masses[i], not fixed[i])
             for q in range(x.shape[1]):
                 a = _acceleration(forces[i, q], inverse)
@@ -203,24 +351,60 @@ def _compile_advance(update: Callable) -> Callable:
     return advance
 
 
-# One compiled loop per update function, for the whole process.
-_ADVANCES: dict[Callable, Callable | None] = {}
+def _references_of_a_private_array() -> int:
+    """How many references the memory of a body's spring array has when only the body
+    and one view of it refer to it (as in `_shared`)."""
+    owner = type("Owner", (), {})()
+    owner.array = np.zeros(2)
+    view = owner.array[:1]
+    return sys.getrefcount(view.base)
+
+
+_PRIVATE = _references_of_a_private_array()
+
+
+def _shared(views: tuple[np.ndarray, ...]) -> bool:
+    """True if anything besides the body and ``views`` refers to the memory of ``views``.
+
+    A view of ``body.stiffness`` kept by the user could be written at any time
+    without touching ``body.parameters_version``; while one exists, the spring
+    values are checked at every step.
+    """
+    return any(sys.getrefcount(view.base) > _PRIVATE for view in views)
+
+
+# One compiled loop per update function (threaded or not), for the whole process.
+_ADVANCES: dict[tuple[Callable, bool], Callable] = {}
+_FAILED: set[Callable] = set()  # updates numba cannot compile: they run on arrays
 
 
 class NumbaKernel:
     """The compiled spring kernel for one body, with what it needs kept between calls.
 
-    Keeps int32 copies of the spring ends (half the memory traffic of int64)
-    and one force buffer per extra thread, rebuilt when the springs change
-    (``body.topology_version``). Stiffness, rest lengths and dashpots are read
-    from the body at every call, so edits to them count at once. ``springs``
-    (indices) restricts a computation to some springs, on one thread.
+    Grid bodies whose springs share their values per offset are gathered by
+    offset (`grid_stencil`); other bodies go through the edge loop, over the
+    springs sorted by their ends (`_edge_list`), with one force buffer per
+    extra thread. What is kept is rebuilt when the springs change
+    (``body.topology_version``) and re-checked when their values may have
+    (``body.parameters_version``, or a view of them kept elsewhere), so edits
+    count at once. ``springs`` (indices) restricts a computation to some
+    springs, on one thread, in the body's order.
     """
 
     def __init__(self) -> None:
         self._version = -1
         self._a = self._b = np.zeros(0, dtype=np.int32)
         self._partial: np.ndarray | None = None
+        self._threads = 1
+        self._stencil_version = -1
+        self._stencil: GridStencil | None = None
+        self._stencil_values = np.zeros((3, 0))
+        self._scratch = np.zeros((10, 0))  # x, v, forces by coordinate and squared lengths
+        self._values_version = -1
+        self._uniform = False
+        self._order: np.ndarray | None = None
+        self._sorted_version = -1
+        self._sorted_values: tuple[np.ndarray, ...] = ()
 
     name = "numba"
 
@@ -236,30 +420,66 @@ class NumbaKernel:
 
         Returns the largest stretch |d|/l and the power (W) the dashpots take.
         """
-        a, b = self._ends(body)
-        arrays = (a, b, body.stiffness, body.rest_lengths, body.spring_damping)
+        if springs is None:
+            stencil = self.grid_stencil(body)
+            if stencil is not None:
+                gather = _gather_parallel if self._parallel(body) else _gather_serial
+                if self._scratch.shape != (10, len(x)):
+                    self._scratch = np.zeros((10, len(x)))  # 2-D bodies keep x2 = v2 = 0
+                k, rest, c = self._stencil_values
+                return gather(x, v, stencil.shape, stencil.offsets, k, rest, c, self._scratch, out)
         if springs is not None:
+            arrays = (body.spring_a, body.spring_b, *body.spring_values())
             return _spring_forces_serial(x, v, *(array[springs] for array in arrays), out)
-        if self._partial is None:
+        arrays = self._edge_list(body)
+        if not self._parallel(body):
             return _spring_forces_serial(x, v, *arrays, out)
+        if self._partial is None or self._partial.shape[1:] != x.shape:
+            self._partial = np.empty((self._threads - 1, *x.shape))
         return _spring_forces_parallel(x, v, *arrays, self._partial, out)
+
+    def grid_stencil(self, body: Body) -> GridStencil | None:
+        """The body's grid stencil if its forces can be gathered by offset now, else None.
+
+        The stencil is found once per topology (``body.topology_version``); that
+        each of its blocks has one stiffness, rest length and dashpot is checked
+        at every call (one read of the spring values, stopping at the first
+        difference), so edits of single springs switch to the edge loop at once.
+        """
+        if self._stencil_version != body.topology_version:
+            self._stencil = grid_stencil(body)
+            blocks = 0 if self._stencil is None else len(self._stencil.offsets)
+            self._stencil_values = np.zeros((3, blocks))
+            self._stencil_version = body.topology_version
+            self._values_version = -1
+        if self._stencil is None:
+            return None
+        values = body.spring_values()
+        if body.parameters_version != self._values_version or _shared(values):
+            self._uniform = _uniform_blocks(*values, self._stencil.starts, self._stencil_values)
+            self._values_version = body.parameters_version
+        return self._stencil if self._uniform else None
+
+    def _parallel(self, body: Body) -> bool:
+        """Whether the springs of ``body`` are worth splitting between threads."""
+        self._threads = numba.get_num_threads()
+        return body.n_springs >= PARALLEL_MIN_SPRINGS and self._threads > 1
 
     def dashpot_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
         """Power (W) the dashpots take out of the body at (x, v), always >= 0."""
-        a, b = self._ends(body)
-        if self._partial is None:
-            return _dashpot_power_serial(x, v, a, b, body.spring_damping)
-        return _dashpot_power_parallel(x, v, a, b, body.spring_damping, len(self._partial) + 1)
+        a, b, damping = body.spring_a, body.spring_b, body.spring_values()[2]
+        if not self._parallel(body):
+            return _dashpot_power_serial(x, v, a, b, damping)
+        return _dashpot_power_parallel(x, v, a, b, damping, self._threads)
 
     def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
         """Energy (J) stored in the springs (or in the given ones) at positions x."""
-        a, b = self._ends(body)
-        arrays = (a, b, body.stiffness, body.rest_lengths)
+        arrays = (body.spring_a, body.spring_b, *body.spring_values()[:2])
         if springs is not None:
             return _elastic_energy_serial(x, *(array[springs] for array in arrays))
-        if self._partial is None:
+        if not self._parallel(body):
             return _elastic_energy_serial(x, *arrays)
-        return _elastic_energy_parallel(x, *arrays, len(self._partial) + 1)
+        return _elastic_energy_parallel(x, *arrays, self._threads)
 
     @staticmethod
     def to_acceleration(body: Body, forces: np.ndarray) -> np.ndarray:
@@ -281,16 +501,20 @@ class NumbaKernel:
 
         An update numba cannot compile warns once and runs on whole arrays.
         """
-        if update not in _ADVANCES:
-            _ADVANCES[update] = _compile_advance(update)
-        compiled = _ADVANCES[update]
+        threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
+        if update in _FAILED:
+            compiled = None
+        elif (update, threads) not in _ADVANCES:
+            compiled = _ADVANCES[update, threads] = _compile_advance(update, threads)
+        else:
+            compiled = _ADVANCES[update, threads]
         if compiled is not None:
             x_new, v_new = np.empty_like(x), np.empty_like(v)
             try:
                 compiled(x, v, forces, body.masses, body.fixed, dt, coefficients, x_new, v_new)
                 return x_new, v_new
             except numba.core.errors.NumbaError as error:
-                _ADVANCES[update] = None
+                _FAILED.add(update)
                 warnings.warn(
                     f"numba cannot compile {update.__qualname__} ({type(error).__name__}); "
                     "it runs on whole numpy arrays instead, with the same result, more slowly",
@@ -300,15 +524,30 @@ class NumbaKernel:
         inverse = equations.inverse_mass(body.masses, ~body.fixed)
         return update(x, v, equations.acceleration(forces, inverse[:, None]), dt, *coefficients)
 
-    def _ends(self, body: Body) -> tuple[np.ndarray, np.ndarray]:
-        """The spring ends as compact integers, and the thread buffers, for this topology."""
+    def _edge_list(self, body: Body) -> tuple[np.ndarray, ...]:
+        """Ends a, b and stiffness, rest length, dashpot of all springs, sorted by (a, b).
+
+        In that order consecutive springs share or neighbour their particles,
+        so the edge loop reads and writes memory it has just used, whatever
+        order the springs were added in (a shuffled 60³ grid: several times
+        faster). The ends (int32: half the memory traffic of int64) and the
+        order are kept per topology; the sorted values are copied again when
+        they may have changed (see `grid_stencil`).
+        """
         if self._version != body.topology_version:
             index = np.int32 if body.n_particles < 2**31 else np.int64
-            self._a = body.spring_a.astype(index)
-            self._b = body.spring_b.astype(index)
-            threads = numba.get_num_threads()
-            parallel = body.n_springs >= PARALLEL_MIN_SPRINGS and threads > 1
-            shape = (threads - 1, *body.positions.shape)
-            self._partial = np.empty(shape) if parallel else None
+            order = np.lexsort((body.spring_b, body.spring_a))
+            self._order = None if np.array_equal(order, np.arange(len(order))) else order
+            ends = (body.spring_a, body.spring_b)
+            if self._order is not None:
+                ends = tuple(end[order] for end in ends)
+            self._a, self._b = (end.astype(index) for end in ends)
             self._version = body.topology_version
-        return self._a, self._b
+            self._sorted_version = -1
+        values = body.spring_values()
+        if self._order is None:
+            return self._a, self._b, *values
+        if body.parameters_version != self._sorted_version or _shared(values):
+            self._sorted_values = tuple(array[self._order] for array in values)
+            self._sorted_version = body.parameters_version
+        return self._a, self._b, *self._sorted_values

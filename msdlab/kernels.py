@@ -62,7 +62,7 @@ def _spring_forces_and_power(
     """`spring_forces`, and the power (W) the dashpots take at (x, v)."""
     pick = slice(None) if springs is None else springs
     a, b = body.spring_a[pick], body.spring_b[pick]
-    rest, damping = body.rest_lengths[pick], body.spring_damping[pick]
+    stiffness, rest, damping = (values[pick] for values in body.spring_values())
     d = x[a] - x[b]
     length = np.sqrt(np.einsum("ij,ij->i", d, d))
     safe = np.where(length > 0, length, np.inf)  # coincident ends: no direction, no force
@@ -72,7 +72,7 @@ def _spring_forces_and_power(
         closing = np.einsum("ij,ij->i", v[a] - v[b], d)
         power = float(np.sum(equations.dashpot_power(damping, closing / safe)))
     with np.errstate(divide="ignore", invalid="ignore"):  # coincident ends, masked below
-        magnitude = equations.spring_force(body.stiffness[pick], rest, length, damping, closing)
+        magnitude = equations.spring_force(stiffness, rest, length, damping, closing)
     f = np.where(length > 0, magnitude / safe, 0.0)[:, None] * d
     if out is None:
         out = np.zeros_like(x)
@@ -88,14 +88,13 @@ def elastic_energy(body: Body, x: np.ndarray, springs: np.ndarray | None = None)
     pick = slice(None) if springs is None else springs
     d = x[body.spring_a[pick]] - x[body.spring_b[pick]]
     length = np.sqrt(np.einsum("ij,ij->i", d, d))
-    return float(
-        np.sum(equations.spring_energy(body.stiffness[pick], body.rest_lengths[pick], length))
-    )
+    stiffness, rest, _ = (values[pick] for values in body.spring_values())
+    return float(np.sum(equations.spring_energy(stiffness, rest, length)))
 
 
 def dashpot_power(body: Body, x: np.ndarray, v: np.ndarray) -> float:
     """Power the dashpots take out of the body, Σ c ((v_a - v_b)·n)² (W), always >= 0."""
-    if not np.any(body.spring_damping):
+    if not np.any(body.spring_values()[2]):
         return 0.0
     return _spring_forces_and_power(body, x, v)[2]
 
@@ -157,10 +156,11 @@ def spring_jacobians(
     safe = np.where(length > 0, length, np.inf)
     n = d / safe[:, None]
     outer = n[:, :, None] * n[:, None, :]
-    transverse = np.maximum(0.0, 1.0 - body.rest_lengths / safe)
+    stiffness, rest, damping = body.spring_values()
+    transverse = np.maximum(0.0, 1.0 - rest / safe)
     eye = np.eye(dim)[None]
-    stiff = body.stiffness[:, None, None] * (outer + transverse[:, None, None] * (eye - outer))
-    damp = body.spring_damping[:, None, None] * outer
+    stiff = stiffness[:, None, None] * (outer + transverse[:, None, None] * (eye - outer))
+    damp = damping[:, None, None] * outer
     jx, jv = pattern.matrices(stiff, damp)
     return jx, jv
 

@@ -1,0 +1,172 @@
+"""The grid gather and the edge loop, the two backends of the numba kernel, agree to rounding."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import msdlab as msd
+from msdlab import kernels
+from msdlab.compiled import NumbaKernel
+from msdlab.stencil import grid_stencil
+
+RTOL = 1e-12
+
+
+@pytest.fixture(autouse=True)
+def _once(kernel: str) -> None:
+    """These tests compare both numba backends with the numpy reference themselves."""
+    if kernel != "numba":
+        pytest.skip("compares the numba backends with the numpy kernel directly")
+
+
+def shaken_grid(shape: tuple[int, ...], neighbours: tuple[int, ...], damping: float) -> msd.Body:
+    """A grid with uniform springs per offset, moved off rest and moving."""
+    rng = np.random.default_rng(1)
+    body = msd.Body.grid(shape, spacing=0.1, stiffness=40.0, neighbours=neighbours, damping=damping)
+    body.positions[:] += rng.normal(scale=0.02, size=body.positions.shape)
+    body.velocities[:] = rng.normal(size=body.positions.shape)
+    return body
+
+
+def forces_by(kernel: kernels.SpringKernel, body: msd.Body) -> tuple[np.ndarray, float, float]:
+    out = np.zeros_like(body.positions)
+    stretch, power = kernel.add_spring_forces(body, body.positions, body.velocities, out, None)
+    return out, stretch, power
+
+
+def assert_agree(body: msd.Body, numba_kernel: NumbaKernel) -> None:
+    expected, stretch, power = forces_by(kernels.NumpyKernel(), body)
+    forces_by(numba_kernel, body)  # a second call must not see the first one's forces
+    actual, actual_stretch, actual_power = forces_by(numba_kernel, body)
+    scale = np.abs(expected).max()
+    np.testing.assert_allclose(actual, expected, rtol=RTOL, atol=RTOL * scale)
+    assert actual_stretch == pytest.approx(stretch, rel=RTOL)
+    assert actual_power == pytest.approx(power, rel=RTOL, abs=RTOL * scale)
+
+
+@pytest.mark.parametrize(
+    ("shape", "neighbours"),
+    [((5, 4, 6), (1, 2, 3)), ((6, 5, 4), (1, 2, 3, 4)), ((7, 5), (1, 2)), ((1, 1, 5), (1,))],
+)
+@pytest.mark.parametrize("damping", [0.0, 0.3])
+@pytest.mark.parametrize("threaded", [False, True])
+def test_gather_matches_edge_loop_and_numpy(
+    shape: tuple[int, ...],
+    neighbours: tuple[int, ...],
+    damping: float,
+    threaded: bool,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    if threaded:
+        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
+    body = shaken_grid(shape, neighbours, damping)
+    gather = NumbaKernel()
+    assert gather.grid_stencil(body) is not None
+    assert_agree(body, gather)
+    edge_loop = NumbaKernel()
+    monkeypatch.setattr(edge_loop, "grid_stencil", lambda body: None)
+    assert_agree(body, edge_loop)
+
+
+def test_coincident_ends_exert_no_force() -> None:
+    body = shaken_grid((3, 3, 3), (1, 2, 3), 0.2)
+    body.positions[4] = body.positions[5]  # particles 4 and 5 share a spring
+    forces, _, power = forces_by(NumbaKernel(), body)
+    assert np.isfinite(forces).all() and np.isfinite(power)
+    assert_agree(body, NumbaKernel())
+
+
+def test_stencil_found_only_for_grid_springs() -> None:
+    grid = msd.Body.grid((4, 3, 5), neighbours=(1, 2, 3))
+    stencil = grid_stencil(grid)
+    assert stencil is not None and len(stencil.offsets) == 13
+    assert stencil.starts[-1] == grid.n_springs
+
+    pairs = np.stack([grid.spring_a, grid.spring_b], axis=1)
+    shuffled = msd.Body.from_arrays(grid.positions, pairs[::-1], rest_lengths=grid.rest_lengths)
+    shuffled.grid_shape = grid.grid_shape  # same shape, springs in another order
+    assert grid_stencil(shuffled) is None
+
+    extra = grid.copy()
+    extra.add_springs([[0, 7]])
+    assert grid_stencil(extra) is None
+    assert grid_stencil(msd.Body.from_arrays(grid.positions, pairs)) is None  # no shape
+
+
+@pytest.mark.parametrize("how", ["array", "held view", "spring object"])
+def test_edited_spring_values_switch_to_the_edge_loop(how: str) -> None:
+    body = shaken_grid((4, 4, 4), (1, 2, 3), 0.0)
+    kernel = NumbaKernel()
+    assert kernel.grid_stencil(body) is not None
+    held = body.stiffness
+    if how == "array":
+        body.stiffness[17] = 90.0
+    elif how == "held view":
+        held[17] = 90.0
+    else:
+        body.springs[17].stiffness = 90.0
+    assert kernel.grid_stencil(body) is None
+    assert_agree(body, kernel)  # the edit counts at once
+    held[17] = 40.0
+    assert kernel.grid_stencil(body) is not None
+    body.spring_damping[:] = 0.5  # uniform again: gathered, dashpots included
+    assert kernel.grid_stencil(body) is not None
+    assert_agree(body, kernel)
+
+
+@pytest.mark.parametrize("threaded", [False, True])
+def test_simulation_on_the_gather_follows_the_edge_loop(
+    threaded: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """200 steps of a grid falling onto the ground, SymplecticEuler and damped Verlet
+    (threaded: the spring forces and the update, on the gather and on the edge loop)."""
+    if threaded:
+        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_PARTICLES", 0)
+    runs = []
+    for gathered in (True, False):
+        if not gathered:
+            monkeypatch.setattr(NumbaKernel, "grid_stencil", lambda self, body: None)
+        for integrator in (msd.SymplecticEuler(), msd.Verlet(0.01)):
+            body = shaken_grid((4, 5, 3), (1, 2, 3), 0.1)
+            body.positions[:, 1] += 0.05
+            forces = [msd.Gravity((0, -9.81, 0)), msd.Ground()]
+            sim = msd.Simulation(body, integrator, dt=1e-3, forces=forces, kernel="numba")
+            sim.run(steps=200)
+            runs.append((body.positions.copy(), dict(sim.dissipated)))
+    for (x_gather, booked_gather), (x_edge, booked_edge) in zip(runs[:2], runs[2:]):
+        np.testing.assert_allclose(x_gather, x_edge, rtol=0, atol=1e-11)
+        for name, energy in booked_edge.items():
+            assert booked_gather[name] == pytest.approx(energy, rel=1e-9, abs=1e-12)
+
+
+@pytest.mark.parametrize("threaded", [False, True])
+def test_shuffled_springs_sorted_for_the_edge_loop(
+    threaded: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Springs in a random order with random values: the sorted edge loop sees every edit."""
+    if threaded:
+        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
+    grid = shaken_grid((4, 3, 5), (1, 2, 3), 0.0)
+    order = np.random.default_rng(2).permutation(grid.n_springs)
+    pairs = np.stack([grid.spring_a[order], grid.spring_b[order]], axis=1)
+    body = msd.Body.from_arrays(
+        grid.positions, pairs, velocities=grid.velocities, stiffness=grid.stiffness[order]
+    )
+    body.spring_damping[::3] = 0.4
+    kernel = NumbaKernel()
+    assert kernel.grid_stencil(body) is None
+    assert_agree(body, kernel)
+    held = body.stiffness
+    held[5] = 123.0  # through a kept view
+    assert_agree(body, kernel)
+    body.rest_lengths[7] *= 1.5
+    assert_agree(body, kernel)
+    touching = body.springs_touching(np.array([3, 8]))
+    assert kernel.elastic_energy(body, body.positions, touching) == pytest.approx(
+        kernels.elastic_energy(body, body.positions, touching), rel=RTOL
+    )
+    assert kernel.dashpot_power(body, body.positions, body.velocities) == pytest.approx(
+        kernels.dashpot_power(body, body.positions, body.velocities), rel=RTOL
+    )
