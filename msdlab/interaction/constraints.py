@@ -11,7 +11,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from .. import equations
+from .. import energy, equations
 from ..body import Body
 from ..constraint import Constraint, StepState
 from ..errors import check_non_negative
@@ -25,9 +25,20 @@ class Ground(Constraint):
     the brief's floor y = 0; use ``normal=(0, 0, 1)`` for z-up scenes). A clamped
     particle keeps its tangential velocity (times 1 - ``friction``) and its
     normal velocity becomes the displacement it really made over the step / dt,
-    which is what position Verlet implies: no bounce, no sticking. The clamp is
-    first order: under resting contact the ledger books a small residual to
-    "ground" (it may be negative) that vanishes as dt -> 0.
+    which is what position Verlet implies: no bounce, no sticking.
+
+    The ledger books the work of the contact force, not the energy difference
+    across the clamp (`msdlab.energy.contact_work`): the clamp gives each
+    particle a kick Δv along the normal, and the force m·Δv/dt works at the
+    particle's mean velocity over the step. A particle held at rest gets no
+    work; one that lands loses energy, and with Verlet the ground never puts
+    any in (the mean normal velocity is (x(t+dt) - x(t-dt))·n/2dt ≤ 0 when
+    x(t+dt) is on the plane and x(t-dt) was not below it). The clamp itself was
+    right; the earlier bookkeeping was not: it compared the energy before and
+    after the clamp with the velocity estimate v + ½a·dt, whose a leaves out
+    the ground's push, so a body at rest booked -¼ k (a·dt²)² per particle and
+    step ("ground" went negative and the drift grew for as long as it rested).
+    Friction books the kinetic energy it takes out of the tangential velocity.
     """
 
     ledger_name = "ground"
@@ -69,13 +80,18 @@ class Ground(Constraint):
         below = np.flatnonzero((depth > 0) & ~state.body.fixed)
         if len(below) == 0:
             return 0.0
-        before = state.energy_of(below)
         x, v = state.x, state.v
         x[below] += depth[below, None] * n
+        landing = v[below] @ n
         normal_speed = (x[below] - state.x_old[below]) @ n / state.dt
-        tangential = v[below] - (v[below] @ n)[:, None] * n
+        tangential = v[below] - landing[:, None] * n
         v[below] = (1.0 - self.friction) * tangential + normal_speed[:, None] * n
-        return before - state.energy_of(below)
+        masses = state.body.masses[below]
+        kick = (normal_speed - landing)[:, None] * n
+        normal_before = (state.v_old[below] @ n)[:, None] * n
+        work = energy.contact_work(masses, kick, normal_before, normal_speed[:, None] * n)
+        rubbed = energy.kinetic_energy_removed(masses, tangential, 1.0 - self.friction)
+        return rubbed - work
 
     def __repr__(self) -> str:
         return f"Ground(height={self.height:g}, normal={self.normal}, friction={self.friction:g})"

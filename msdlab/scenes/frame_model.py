@@ -58,7 +58,9 @@ class FrameEuler(Integrator):
         force, _ = kernels.spring_forces(body, x, v, springs=short)
         return force * np.where(body.fixed, 0.0, 1.0 / body.masses)[:, None]
 
-    def dissipated_energy(self, v: np.ndarray, masses: np.ndarray) -> float:
+    def dissipated_energy(
+        self, v: np.ndarray, masses: np.ndarray, v_new: np.ndarray | None = None
+    ) -> float:
         """Kinetic energy the per-frame factor removes: (1 - damping²)·½ Σ m v²."""
         kinetic = 0.5 * np.sum(masses * np.einsum("ij,ij->i", v, v))
         return float((1.0 - self.damping**2) * kinetic)
