@@ -8,8 +8,23 @@ so gravity is (0, -g). Rest lengths are the distances at creation, as on the pag
 Every scene takes ``model``: "physical" (default) steps Newton's law with
 `VelocityVerlet` and turns the page's velocity factor per frame into the
 exact drag v ← v·exp(-rate·dt) with rate = -ln(damping) per frame;
-"frame" is the page's own update (`FrameEuler`: v += F/m, v *= damping, speed
-cap, springs idle under 1 px). Both have the same equilibria.
+"frame" is the page's own ``draw()`` (`FrameEuler`), reproduced frame for frame:
+external forces, damping, speed cap, the page's wall rule, move, then the
+springs at the new positions. Where the physical model differs from the page:
+
+- no dead zone: the page's springs do nothing while their ends are within
+  1 px, so two particles 0.5 px apart on a long spring stay put there, while
+  the physical spring pushes them apart to its rest length;
+- no speed cap: past the stable step the physical model blows up and says so,
+  the page's model oscillates at 10 px/frame;
+- walls: the page tests the position before the move, turns the velocity
+  inward and never moves the particle back (it ends up to one frame's move
+  past the wall and keeps bouncing there); the physical walls put a particle
+  back on the wall after the move with a bounce that keeps its energy;
+- order: the page's springs act at the end of a frame and move the particles
+  in the next one (none in the first frame); the physical model is Newton's law.
+
+Without walls, speed cap and dead zone, both have the same equilibria.
 """
 
 from __future__ import annotations
@@ -56,15 +71,17 @@ def simulation(
     if not 0.0 < damping <= 1.0:
         raise ValueError(f"damping is a velocity factor per frame in (0, 1], got {damping}")
     forces: list[Force | Constraint] = [Gravity((0.0, -gravity))] if gravity else []
-    if model == "frame":
-        integrator = FrameEuler(damping, max_speed)
+    integrator: FrameEuler | VelocityVerlet
+    if model == "frame":  # the page's walls are part of its draw()
+        rule = None if walls == "none" else walls
+        integrator = FrameEuler(damping, max_speed, walls=rule, upper=(WIDTH, HEIGHT))
     else:
         integrator = VelocityVerlet()
         if damping < 1.0:
             forces.append(Drag(-math.log(damping)))
-    if walls != "none":
-        mode = "reflect" if walls == "hard" else "periodic"
-        forces.append(Walls((0.0, 0.0), (WIDTH, HEIGHT), mode))
+        if walls != "none":
+            mode = "reflect" if walls == "hard" else "periodic"
+            forces.append(Walls((0.0, 0.0), (WIDTH, HEIGHT), mode))
     return Simulation(body, integrator, dt, [*forces, *extra], ledger=model != "frame")
 
 
