@@ -77,11 +77,11 @@ def simulation(
         integrator = FrameEuler(damping, max_speed, walls=rule, upper=(WIDTH, HEIGHT))
     else:
         integrator = VelocityVerlet()
-        if damping < 1.0:
-            forces.append(Drag(-math.log(damping)))
-        if walls != "none":
+        if walls != "none":  # before the drag, which then acts on the bounced velocity
             mode = "reflect" if walls == "hard" else "periodic"
             forces.append(Walls((0.0, 0.0), (WIDTH, HEIGHT), mode))
+        if damping < 1.0:
+            forces.append(Drag(-math.log(damping)))
     return Simulation(body, integrator, dt, [*forces, *extra], ledger=model != "frame")
 
 
