@@ -124,14 +124,16 @@ def hanging_particle(
 def rope(
     *,
     count: int = 18,
-    spacing: float = 40.0,
+    spacing: float = 12.0,
     stiffness: float = 0.1,
     gravity: float = 0.1,
     damping: float = 0.96,
     model: str = "physical",
 ) -> Simulation:
-    """Springs 2: ``count`` particles in a horizontal line, the first one fixed; it swings down."""
-    x = 20.0 + spacing * np.arange(count)
+    """Springs 2: ``count`` particles in a horizontal line from a fixed one at the top
+    middle (300, 20) (page); it swings down and hangs inside the canvas: 17 links of
+    12 px plus Hooke's stretch Σ i·m g/K = 153 px put the end 357 px below the top one."""
+    x = WIDTH / 2 + spacing * np.arange(count)
     body = Body.from_arrays(
         np.column_stack([x, np.full(count, HEIGHT - 20.0)]),
         _chain(count),
@@ -229,7 +231,7 @@ def mesh(
 def driven_mesh(
     *,
     shape: Sequence[int] = (10, 10),
-    spacing: float = 30.0,
+    spacing: float = 20.0,
     amplitude: float = 40.0,
     period: float = 90.0,
     noise: float = 25.0,
@@ -241,6 +243,9 @@ def driven_mesh(
 ) -> Simulation:
     """Springs 5: the mesh hanging from its top-middle particle, which a driver moves.
 
+    The driver's home is 80 px below the top of the canvas; with the defaults the
+    mesh (20 px cells) hangs and swings inside the canvas.
+
     The driver is a vertical sine (``amplitude`` px, ``period`` frames) plus
     smooth random wandering of about ``noise`` px (a few sines with random
     frequencies and phases from ``seed``, standing in for the page's Perlin noise).
@@ -248,6 +253,7 @@ def driven_mesh(
     body = _mesh_body(shape, spacing, True, stiffness)
     rows, cols = (int(n) for n in shape)
     driven = (cols // 2) * rows + rows - 1  # top row, middle column
+    body.positions = body.positions + (0.0, HEIGHT - 80.0 - body.positions[driven, 1])
     home = body.positions[driven].copy()
     wander = _smooth_noise(np.random.default_rng(seed), noise, period)
 

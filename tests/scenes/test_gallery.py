@@ -8,7 +8,7 @@ import pytest
 from scipy.optimize import brentq, curve_fit
 
 import msdlab as msd
-from msdlab.scenes import gallery
+from msdlab.scenes import SCENES, gallery
 from msdlab.scenes.frame_model import FrameEuler
 
 MODELS = ["physical", "frame"]
@@ -57,8 +57,17 @@ def test_rope_hangs_straight_down_with_hookes_stretch(model):
     x = settle(gallery.rope(model=model), 4000)
     lengths = np.linalg.norm(np.diff(x, axis=0), axis=1)
     carried = np.arange(17, 0, -1)
-    np.testing.assert_allclose(lengths, 40.0 + carried * 0.1 / 0.1, atol=1e-3)
+    np.testing.assert_allclose(lengths, 12.0 + carried * 0.1 / 0.1, atol=1e-3)
     np.testing.assert_allclose(x[:, 0], x[0, 0], atol=1e-3)
+    assert x[-1, 1] == pytest.approx(380.0 - 17 * 12.0 - 153.0, abs=1e-3)  # as its docstring says
+
+
+@pytest.mark.parametrize("name", [n for n, s in SCENES.items() if s.unit == "frames"])
+def test_gallery_scenes_start_and_stay_inside_their_canvas(name):
+    sim = SCENES[name].build()
+    x = sim.run(steps=600, record_every=10).positions
+    assert np.all((x[0] >= 0.0) & (x[0] <= (gallery.WIDTH, gallery.HEIGHT))), "starts outside"
+    assert np.all((x >= -1.0) & (x <= (gallery.WIDTH + 1.0, gallery.HEIGHT + 1.0)))
 
 
 def discrete_catenary(count, rest, stiffness, weight, left, right):
@@ -178,8 +187,8 @@ def test_speed_cap_hides_the_instability_the_physical_model_reports():
     moves = np.linalg.norm(np.diff(trajectory.positions, axis=0), axis=2)
     assert moves.max() == pytest.approx(10.0)  # px per frame
     lengths = np.linalg.norm(np.diff(trajectory.positions[-100:], axis=1), axis=2)
-    # At rest the top link carries 17 particles: 17 · 0.1 / 1.5 = 1.1 px, 3 % of 40 px.
-    assert np.max(np.abs(lengths / 40.0 - 1.0)) > 0.2
+    # At rest the top link carries 17 particles: 17 · 0.1 / 1.5 = 1.1 px, 9 % of 12 px.
+    assert np.max(np.abs(lengths / 12.0 - 1.0)) > 0.2
 
 
 def test_springs_shorter_than_one_pixel_do_not_push_in_the_frame_model():
