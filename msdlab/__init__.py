@@ -1,7 +1,7 @@
 """msdlab: mass-spring-damper simulation for teaching.
 
 import msdlab as msd
-body = msd.Body.grid((10, 10, 10), spacing=0.1, stiffness=50.0, neighbours=(1, 2, 3))
+body = msd.Body.grid((10, 10, 10), spacing=0.1, stiffness=5000.0, neighbours=(1, 2, 3))
 sim = msd.Simulation(body, msd.Verlet(damping=0.01), dt=1e-3,
                      forces=[msd.Gravity((0, -9.81, 0)), msd.Ground(height=0.0)])
 trajectory = sim.run(duration=1.0, record_every=10)

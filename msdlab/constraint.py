@@ -23,6 +23,7 @@ class StepState:
 
     body: Body
     x_old: np.ndarray  # positions at the start of the step (m)
+    v_old: np.ndarray  # velocities at the start of the step (m/s)
     x: np.ndarray  # new positions (m)
     v: np.ndarray  # new velocities (m/s)
     time: float  # time at the end of the step (s)

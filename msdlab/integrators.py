@@ -23,6 +23,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .dynamics import Dynamics
+from .energy import damping_work
 from .equations import kinetic_energy
 
 State = tuple[np.ndarray, np.ndarray]
@@ -59,8 +60,11 @@ class Integrator(ABC):
     def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: Dynamics) -> State:
         """Return (x, v) one step of ``dt`` seconds later."""
 
-    def dissipated_energy(self, v: np.ndarray, masses: np.ndarray) -> float:
-        """Energy (J) the scheme removes on purpose in one step (see `Verlet`); 0 by default."""
+    def dissipated_energy(
+        self, v: np.ndarray, masses: np.ndarray, v_new: np.ndarray | None = None
+    ) -> float:
+        """Energy (J) the scheme removes on purpose in the step from velocities ``v`` to
+        ``v_new`` (see `Verlet`); 0 by default."""
         return 0.0
 
     def velocity_at_positions(self, v: np.ndarray, a: np.ndarray, dt: float) -> np.ndarray:
@@ -130,11 +134,16 @@ class Verlet(Integrator):
         """v(t) ≈ v(t - dt/2) + ½ a(t) dt: the stored velocity is half a step behind x."""
         return v + 0.5 * dt * a
 
-    def dissipated_energy(self, v: np.ndarray, masses: np.ndarray) -> float:
-        """Kinetic energy λ removes per step: (1 - (1 - λ)²)·½ Σ m v²."""
+    def dissipated_energy(
+        self, v: np.ndarray, masses: np.ndarray, v_new: np.ndarray | None = None
+    ) -> float:
+        """Energy λ removes per step: the work of the kick -λ·v (`energy.damping_work`),
+        or (1 - (1 - λ)²)·½ Σ m v² when the step's new velocity ``v_new`` is not given."""
         if self.damping == 0.0:
             return 0.0
-        return float((1.0 - (1.0 - self.damping) ** 2) * kinetic_energy(masses, v))
+        if v_new is None:
+            return float((1.0 - (1.0 - self.damping) ** 2) * kinetic_energy(masses, v))
+        return damping_work(masses, v, v_new, 1.0 - self.damping)
 
     def __repr__(self) -> str:
         return f"Verlet(damping={self.damping:g})"

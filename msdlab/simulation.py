@@ -128,17 +128,19 @@ class Simulation:
         self.dynamics.forget_last_state()
         x_new, v_new = self._checked(self.integrator.step(x, v, dt, self.dynamics), x)
         power = self.dynamics.dashpot_power(x, v) if self.ledger else 0.0
-        booked = self._dissipation(x, v, power) if self.ledger else {}
         fixed = body.fixed
         if fixed.any():
             x_new[fixed] = x[fixed]
             v_new[fixed] = 0.0
         energy_of = self._energy_of(x_new, v_new) if self.ledger else _unbooked
-        state = StepState(body, x, x_new, v_new, self.time + dt, dt, energy_of)
-        for constraint in self.constraints:
-            removed = constraint.apply(state)
-            if self.ledger:
-                booked[constraint.ledger_name] = booked.get(constraint.ledger_name, 0.0) + removed
+        state = StepState(body, x, v, x_new, v_new, self.time + dt, dt, energy_of)
+        removed = [(c.ledger_name, c.apply(state)) for c in self.constraints]
+        if self.ledger:  # after the constraints: the integrator's damping works at the final v
+            booked = self._dissipation(x, v, v_new, power)
+            for name, energy in removed:
+                booked[name] = booked.get(name, 0.0) + energy
+        else:
+            booked = {}
         self._check_divergence(x, x_new, v_new)
         x[...] = x_new
         v[...] = v_new
@@ -147,13 +149,15 @@ class Simulation:
         for name, energy in booked.items():
             self.dissipated[name] += energy
 
-    def _dissipation(self, x: np.ndarray, v: np.ndarray, dashpot_power: float) -> dict[str, float]:
+    def _dissipation(
+        self, x: np.ndarray, v: np.ndarray, v_new: np.ndarray, dashpot_power: float
+    ) -> dict[str, float]:
         """Energy (J) the dashpots, the integrator's damping and dissipative forces take out
-        in this step, by source."""
+        in the step from (x, v) to velocities ``v_new``, by source."""
         dt = self.dt
         booked = {
             "dashpot": dashpot_power * dt,
-            "integrator": self.integrator.dissipated_energy(v, self.body.masses),
+            "integrator": self.integrator.dissipated_energy(v, self.body.masses, v_new),
         }
         for force in self.forces:
             lost = force.dissipated_power(self.body, x, v)

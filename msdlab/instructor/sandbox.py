@@ -518,8 +518,10 @@ class RemoteIntegrator(RemoteObject, Integrator):
     def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: Any) -> Any:
         return self.__getattr__("step")(x, v, dt, dynamics)
 
-    def dissipated_energy(self, v: np.ndarray, masses: np.ndarray) -> float:
-        return self.__getattr__("dissipated_energy")(v, masses)
+    def dissipated_energy(
+        self, v: np.ndarray, masses: np.ndarray, v_new: np.ndarray | None = None
+    ) -> float:
+        return self.__getattr__("dissipated_energy")(v, masses, v_new)
 
     def velocity_at_positions(self, v: np.ndarray, a: np.ndarray, dt: float) -> np.ndarray:
         return self.__getattr__("velocity_at_positions")(v, a, dt)

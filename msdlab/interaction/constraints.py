@@ -11,7 +11,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from .. import equations
+from .. import energy, equations
 from ..body import Body
 from ..constraint import Constraint, StepState
 from ..errors import check_non_negative
@@ -25,9 +25,20 @@ class Ground(Constraint):
     the brief's floor y = 0; use ``normal=(0, 0, 1)`` for z-up scenes). A clamped
     particle keeps its tangential velocity (times 1 - ``friction``) and its
     normal velocity becomes the displacement it really made over the step / dt,
-    which is what position Verlet implies: no bounce, no sticking. The clamp is
-    first order: under resting contact the ledger books a small residual to
-    "ground" (it may be negative) that vanishes as dt -> 0.
+    which is what position Verlet implies: no bounce, no sticking.
+
+    The ledger books the work of the contact force, not the energy difference
+    across the clamp (`msdlab.energy.contact_work`): the clamp gives each
+    particle a kick Δv along the normal, and the force m·Δv/dt works at the
+    particle's mean velocity over the step. A particle held at rest gets no
+    work; one that lands loses energy, and with Verlet the ground never puts
+    any in (the mean normal velocity is (x(t+dt) - x(t-dt))·n/2dt ≤ 0 when
+    x(t+dt) is on the plane and x(t-dt) was not below it). The clamp itself was
+    right; the earlier bookkeeping was not: it compared the energy before and
+    after the clamp with the velocity estimate v + ½a·dt, whose a leaves out
+    the ground's push, so a body at rest booked -¼ k (a·dt²)² per particle and
+    step ("ground" went negative and the drift grew for as long as it rested).
+    Friction books the kinetic energy it takes out of the tangential velocity.
     """
 
     ledger_name = "ground"
@@ -69,13 +80,18 @@ class Ground(Constraint):
         below = np.flatnonzero((depth > 0) & ~state.body.fixed)
         if len(below) == 0:
             return 0.0
-        before = state.energy_of(below)
         x, v = state.x, state.v
         x[below] += depth[below, None] * n
+        landing = v[below] @ n
         normal_speed = (x[below] - state.x_old[below]) @ n / state.dt
-        tangential = v[below] - (v[below] @ n)[:, None] * n
+        tangential = v[below] - landing[:, None] * n
         v[below] = (1.0 - self.friction) * tangential + normal_speed[:, None] * n
-        return before - state.energy_of(below)
+        masses = state.body.masses[below]
+        kick = (normal_speed - landing)[:, None] * n
+        normal_before = (state.v_old[below] @ n)[:, None] * n
+        work = energy.contact_work(masses, kick, normal_before, normal_speed[:, None] * n)
+        rubbed = energy.kinetic_energy_removed(masses, tangential, 1.0 - self.friction)
+        return rubbed - work
 
     def __repr__(self) -> str:
         return f"Ground(height={self.height:g}, normal={self.normal}, friction={self.friction:g})"
@@ -107,10 +123,21 @@ class Drag(Constraint):
 class Walls(Constraint):
     """A box [lower, upper] per axis: ``"reflect"`` bounces particles back, ``"periodic"`` wraps.
 
-    A particle found outside is put back on the wall with its normal velocity
-    turned inward: a bounce that keeps the speed and can carry a load. Moving it
-    back to the wall does work against the forces on it, so the energy is kept
-    only to first order in dt (the ledger books the difference under "walls").
+    A particle found outside is put back on the wall and leaves it with the
+    inward normal speed that keeps its energy: moving it back does work against
+    the forces on it (lifting it against gravity, say), and that work comes out
+    of its normal kinetic energy, ½ m w'² = ½ m w² - ΔU. A free bounce keeps its
+    speed and the ledger books nothing. When the lift costs all the normal
+    kinetic energy (a particle resting on the wall), it stays on the wall
+    (w' = 0) and the ledger books the work of the wall's push at the particle's
+    mean normal velocity over the step (`msdlab.energy.contact_work`): zero for
+    a particle at rest, a loss for one that comes to rest. So walls never put
+    energy in, and a body resting on them keeps every ledger entry still.
+
+    The earlier rule (keep the speed, turn it inward) was a wrong contact
+    model, not a bookkeeping slip: a particle resting on a wall got back the
+    speed its weight gave it in the step, so resting bodies jittered, every
+    step put energy in (walls < 0 in the ledger) and the drag took it out again.
 
     Periodic wrapping moves a particle across the box but not its springs, which
     then stretch across the whole box (as on the p5.js page); use it for loose
@@ -135,20 +162,39 @@ class Walls(Constraint):
             raise ValueError(f"walls have {len(self.lower)} axes but the body is {body.dim}-D")
 
     def apply(self, state: StepState) -> float:
-        x, v = state.x, state.v
+        x = state.x
         outside = np.any((x < self.lower) | (x > self.upper), axis=1)
         outside = np.flatnonzero(outside & ~state.body.fixed)
         if len(outside) == 0:
             return 0.0
-        before = state.energy_of(outside)
         if self.mode == "periodic":
+            before = state.energy_of(outside)
             x[outside] = self.lower + np.mod(x[outside] - self.lower, self.upper - self.lower)
-        else:  # put it back on the wall and turn its normal velocity inward
-            speed = np.abs(v[outside])
-            low, high = x[outside] < self.lower, x[outside] > self.upper
-            x[outside] = np.clip(x[outside], self.lower, self.upper)
-            v[outside] = np.where(low, speed, np.where(high, -speed, v[outside]))
-        return before - state.energy_of(outside)
+            return before - state.energy_of(outside)
+        return sum(self._bounce(state, np.array([p])) for p in outside)
+
+    def _bounce(self, state: StepState, particle: np.ndarray) -> float:
+        """Put one particle back on the wall with the normal speed that keeps its energy;
+        return the energy removed (J)."""
+        x, v = state.x, state.v
+        before = state.energy_of(particle)
+        low, high = x[particle] < self.lower, x[particle] > self.upper
+        hit = low | high
+        incoming = np.where(hit, v[particle], 0.0)
+        x[particle] = np.clip(x[particle], self.lower, self.upper)
+        v[particle] = np.where(hit, 0.0, v[particle])
+        spare = before - state.energy_of(particle)
+        normal_kinetic = equations.kinetic_energy(state.body.masses[particle], incoming)
+        if spare > 0.0 and normal_kinetic > 0.0:  # a bounce: the energy is kept
+            speed = np.abs(incoming) * math.sqrt(spare / normal_kinetic)
+            v[particle] = np.where(low, speed, np.where(high, -speed, v[particle]))
+            return before - state.energy_of(particle)
+        # held on the wall: the work of its push at the particle's mean normal velocity
+        # (one that left the wall at the start of the step counts as held from rest)
+        start = state.v_old[particle]
+        start = np.where(low, np.minimum(start, 0.0), np.where(high, np.maximum(start, 0.0), 0.0))
+        masses = state.body.masses[particle]
+        return -energy.contact_work(masses, -incoming, start, np.zeros_like(start))
 
     def __repr__(self) -> str:
         return f"Walls({self.lower.tolist()}, {self.upper.tolist()}, mode={self.mode!r})"

@@ -8,8 +8,23 @@ so gravity is (0, -g). Rest lengths are the distances at creation, as on the pag
 Every scene takes ``model``: "physical" (default) steps Newton's law with
 `VelocityVerlet` and turns the page's velocity factor per frame into the
 exact drag v ← v·exp(-rate·dt) with rate = -ln(damping) per frame;
-"frame" is the page's own update (`FrameEuler`: v += F/m, v *= damping, speed
-cap, springs idle under 1 px). Both have the same equilibria.
+"frame" is the page's own ``draw()`` (`FrameEuler`), reproduced frame for frame:
+external forces, damping, speed cap, the page's wall rule, move, then the
+springs at the new positions. Where the physical model differs from the page:
+
+- no dead zone: the page's springs do nothing while their ends are within
+  1 px, so two particles 0.5 px apart on a long spring stay put there, while
+  the physical spring pushes them apart to its rest length;
+- no speed cap: past the stable step the physical model blows up and says so,
+  the page's model oscillates at 10 px/frame;
+- walls: the page tests the position before the move, turns the velocity
+  inward and never moves the particle back (it ends up to one frame's move
+  past the wall and keeps bouncing there); the physical walls put a particle
+  back on the wall after the move with a bounce that keeps its energy;
+- order: the page's springs act at the end of a frame and move the particles
+  in the next one (none in the first frame); the physical model is Newton's law.
+
+Without walls, speed cap and dead zone, both have the same equilibria.
 """
 
 from __future__ import annotations
@@ -56,15 +71,17 @@ def simulation(
     if not 0.0 < damping <= 1.0:
         raise ValueError(f"damping is a velocity factor per frame in (0, 1], got {damping}")
     forces: list[Force | Constraint] = [Gravity((0.0, -gravity))] if gravity else []
-    if model == "frame":
-        integrator = FrameEuler(damping, max_speed)
+    integrator: FrameEuler | VelocityVerlet
+    if model == "frame":  # the page's walls are part of its draw()
+        rule = None if walls == "none" else walls
+        integrator = FrameEuler(damping, max_speed, walls=rule, upper=(WIDTH, HEIGHT))
     else:
         integrator = VelocityVerlet()
+        if walls != "none":  # before the drag, which then acts on the bounced velocity
+            mode = "reflect" if walls == "hard" else "periodic"
+            forces.append(Walls((0.0, 0.0), (WIDTH, HEIGHT), mode))
         if damping < 1.0:
             forces.append(Drag(-math.log(damping)))
-    if walls != "none":
-        mode = "reflect" if walls == "hard" else "periodic"
-        forces.append(Walls((0.0, 0.0), (WIDTH, HEIGHT), mode))
     return Simulation(body, integrator, dt, [*forces, *extra], ledger=model != "frame")
 
 
@@ -107,14 +124,16 @@ def hanging_particle(
 def rope(
     *,
     count: int = 18,
-    spacing: float = 40.0,
+    spacing: float = 12.0,
     stiffness: float = 0.1,
     gravity: float = 0.1,
     damping: float = 0.96,
     model: str = "physical",
 ) -> Simulation:
-    """Springs 2: ``count`` particles in a horizontal line, the first one fixed; it swings down."""
-    x = 20.0 + spacing * np.arange(count)
+    """Springs 2: ``count`` particles in a horizontal line from a fixed one at the top
+    middle (300, 20) (page); it swings down and hangs inside the canvas: 17 links of
+    12 px plus Hooke's stretch Σ i·m g/K = 153 px put the end 357 px below the top one."""
+    x = WIDTH / 2 + spacing * np.arange(count)
     body = Body.from_arrays(
         np.column_stack([x, np.full(count, HEIGHT - 20.0)]),
         _chain(count),
@@ -212,7 +231,7 @@ def mesh(
 def driven_mesh(
     *,
     shape: Sequence[int] = (10, 10),
-    spacing: float = 30.0,
+    spacing: float = 20.0,
     amplitude: float = 40.0,
     period: float = 90.0,
     noise: float = 25.0,
@@ -224,6 +243,9 @@ def driven_mesh(
 ) -> Simulation:
     """Springs 5: the mesh hanging from its top-middle particle, which a driver moves.
 
+    The driver's home is 80 px below the top of the canvas; with the defaults the
+    mesh (20 px cells) hangs and swings inside the canvas.
+
     The driver is a vertical sine (``amplitude`` px, ``period`` frames) plus
     smooth random wandering of about ``noise`` px (a few sines with random
     frequencies and phases from ``seed``, standing in for the page's Perlin noise).
@@ -231,6 +253,7 @@ def driven_mesh(
     body = _mesh_body(shape, spacing, True, stiffness)
     rows, cols = (int(n) for n in shape)
     driven = (cols // 2) * rows + rows - 1  # top row, middle column
+    body.positions = body.positions + (0.0, HEIGHT - 80.0 - body.positions[driven, 1])
     home = body.positions[driven].copy()
     wander = _smooth_noise(np.random.default_rng(seed), noise, period)
 

@@ -68,8 +68,8 @@ def trampoline(
     - ``integrator`` `VelocityVerlet` (default): symplectic, so the energy
       stays bounded without damping; the predicted stable dt is ≈ 4 ms, four
       times the report's 1 ms. The report's forward Euler (`ExplicitEuler`)
-      gains energy every step on undamped springs (×150 over 10 s here); it
-      needs a dashpot c > k·dt on every mode, and the links' dashpots
+      gains energy every step on undamped springs (here the run diverges
+      after 6.2 s); it needs a dashpot c > k·dt on every mode, and the links' dashpots
       (``link_damping``, N·s/m) cannot damp the net's sideways waves.
     - ``drag`` 1/s: air and net losses lumped into v ← v·exp(-drag·dt) on
       every particle (exact, so stable at any dt, and booked in the energy

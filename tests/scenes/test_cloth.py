@@ -70,6 +70,16 @@ def test_explicit_euler_blows_up_at_the_notebook_settings_and_says_why():
     assert error.trajectory is not None and len(error.trajectory) > 1
 
 
+def test_the_numbers_of_the_cloth_notebook():
+    """Forward Euler at dt = 0.01 s is 85 times over its limit and blows up within 1 s."""
+    sim = cloth(integrator=msd.ExplicitEuler())
+    limit = msd.max_stable_dt(sim.body, msd.ExplicitEuler(), sim.forces)
+    assert round(sim.dt / limit) == 85
+    with pytest.raises(msd.SimulationDiverged) as caught:
+        sim.run(duration=10.0, record_every=10)
+    assert caught.value.time < 1.0 and caught.value.step < 100
+
+
 def test_explicit_euler_below_the_predicted_limit_is_stable():
     sim = cloth(integrator=msd.ExplicitEuler())
     sim.dt = 0.8 * msd.max_stable_dt(sim.body, msd.ExplicitEuler(), sim.forces)

@@ -145,6 +145,18 @@ def test_forward_euler_gains_energy_where_velocity_verlet_keeps_it():
     assert verlet.energies.relative_drift() < 1e-3
 
 
+def test_the_numbers_of_the_scene_docstring():
+    """Predicted stable dt ≈ 4 ms for velocity Verlet; forward Euler diverges after 6.2 s."""
+    sim = trampoline()
+    assert msd.max_stable_dt(sim.body, msd.VelocityVerlet(), sim.forces) == pytest.approx(
+        4e-3, rel=0.05
+    )
+    euler = trampoline(integrator=msd.ExplicitEuler())
+    with pytest.raises(msd.SimulationDiverged) as caught:
+        euler.run(duration=10.0, record_every=1000)
+    assert caught.value.time == pytest.approx(6.2, abs=0.05)
+
+
 def test_bad_net_size_is_refused():
     with pytest.raises(ValueError, match="size >= 3"):
         trampoline(size=2)
