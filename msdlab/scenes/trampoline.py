@@ -69,7 +69,7 @@ def trampoline(
       stays bounded without damping; the predicted stable dt is ≈ 4 ms, four
       times the report's 1 ms. The report's forward Euler (`ExplicitEuler`)
       gains energy every step on undamped springs (here the run diverges
-      after 6.2 s); it needs a dashpot c > k·dt on every mode, and the links' dashpots
+      after about 6 s); it needs a dashpot c > k·dt on every mode, and the links' dashpots
       (``link_damping``, N·s/m) cannot damp the net's sideways waves.
     - ``drag`` 1/s: air and net losses lumped into v ← v·exp(-drag·dt) on
       every particle (exact, so stable at any dt, and booked in the energy

@@ -146,7 +146,11 @@ def test_forward_euler_gains_energy_where_velocity_verlet_keeps_it():
 
 
 def test_the_numbers_of_the_scene_docstring():
-    """Predicted stable dt ≈ 4 ms for velocity Verlet; forward Euler diverges after 6.2 s."""
+    """Predicted stable dt ≈ 4 ms for velocity Verlet; forward Euler diverges after about 6 s.
+
+    The blow-up grows out of rounding, so its time depends on the order of the sums:
+    6.1 s with the numba kernel, 6.5 s with numpy.
+    """
     sim = trampoline()
     assert msd.max_stable_dt(sim.body, msd.VelocityVerlet(), sim.forces) == pytest.approx(
         4e-3, rel=0.05
@@ -154,7 +158,7 @@ def test_the_numbers_of_the_scene_docstring():
     euler = trampoline(integrator=msd.ExplicitEuler())
     with pytest.raises(msd.SimulationDiverged) as caught:
         euler.run(duration=10.0, record_every=1000)
-    assert caught.value.time == pytest.approx(6.2, abs=0.05)
+    assert 5.5 < caught.value.time < 7.0
 
 
 def test_bad_net_size_is_refused():
