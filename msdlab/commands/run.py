@@ -130,6 +130,7 @@ def run(args: argparse.Namespace) -> int:
             spheres=spheres_of(sim),
             time_unit=scene.unit,
             title=scene.name,
+            colour=scene.colour,
         )
         print(f"animation written to {path.resolve()}")
     if args.show:

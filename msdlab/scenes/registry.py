@@ -22,6 +22,7 @@ class Scene:
     view: tuple[float, float] = (45.0, 30.0)  # azimuth, elevation (degrees) of 3-D views
     up: str = "z"  # the vertical axis
     unit: str = "s"  # of time
+    colour: str = "strain"  # what the springs' colour shows in animations: strain or sag
 
     def settings(self) -> dict[str, object]:
         """The keyword arguments of ``build`` and their defaults."""
@@ -56,6 +57,7 @@ SCENES: dict[str, Scene] = {
             duration=5.0,
             frames=60,
             view=(15.0, 12.0),  # from the side, just above the rim: the sag shows
+            colour="sag",  # and its depth is coloured
         ),
         Scene(
             "cloth",

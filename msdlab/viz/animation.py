@@ -23,7 +23,7 @@ from matplotlib.figure import Figure
 from PIL import Image
 
 from ..simulation import Trajectory
-from .view import BodyView, new_axes, strains
+from .view import BodyView, check_colour, new_axes, rim_height, sags, strains
 
 FORMATS = (".gif", ".mp4", ".html")
 PALETTE_COLOURS = 64  # colours per frame image: plenty for coloured lines on white
@@ -51,6 +51,14 @@ def strain_scale(body, frames: np.ndarray, floor: float = 0.05) -> float:
         return floor
     sample = frames[:: max(1, len(frames) // 10)]
     return max(floor, float(max(np.percentile(np.abs(strains(body, f)), 99) for f in sample)))
+
+
+def sag_scale(body, frames: np.ndarray, up: str) -> float:
+    """The sag drawn at full colour for ``frames`` (F, N, 3): 15 % of the body's size, or the
+    deepest sag below the rim of the first frame if deeper, so runs of one scene share a scale."""
+    rim = rim_height(body, frames[0], up)
+    size = float(np.max(np.ptp(frames[0], axis=0)))
+    return max(0.15 * size, float(max(sags(body, f, up, rim).max(initial=0) for f in frames)))
 
 
 @dataclass
@@ -95,12 +103,16 @@ def animate(
     energy_unit: str = "J",
     title: str = "",
     spheres: Sequence[tuple[int, float]] = (),
+    colour: str = "strain",
 ) -> FuncAnimation:
     """A matplotlib animation of at most ``max_frames`` evenly spaced frames of ``trajectory``.
 
-    ``view`` (azimuth, elevation), ``up`` and ``spheres`` are as in `BodyView`.
+    ``view`` (azimuth, elevation), ``up``, ``spheres`` and ``colour`` ("strain" or
+    "sag") are as in `BodyView`.
     """
-    movie = _build(trajectory, max_frames, fps, view, up, time_unit, energy_unit, title, spheres)
+    movie = _build(
+        trajectory, max_frames, fps, view, up, time_unit, energy_unit, title, spheres, colour
+    )
     return FuncAnimation(movie.figure, movie.draw, frames=movie.count, interval=1000.0 / fps)
 
 
@@ -116,6 +128,7 @@ def to_html(
     title: str = "",
     spheres: Sequence[tuple[int, float]] = (),
     dpi: float = 80.0,
+    colour: str = "strain",
 ) -> str:
     """The animation of ``trajectory`` as a self-contained HTML player (works offline).
 
@@ -125,7 +138,9 @@ def to_html(
     """
     import matplotlib.pyplot as plt
 
-    movie = _build(trajectory, max_frames, fps, view, up, time_unit, energy_unit, title, spheres)
+    movie = _build(
+        trajectory, max_frames, fps, view, up, time_unit, energy_unit, title, spheres, colour
+    )
     try:
         return html_player([_png(image) for image in movie.images(dpi)], fps)
     finally:
@@ -145,6 +160,7 @@ def save_animation(
     energy_unit: str = "J",
     title: str = "",
     spheres: Sequence[tuple[int, float]] = (),
+    colour: str = "strain",
 ) -> Path:
     """Write an animation of ``trajectory`` to ``path`` (.gif, .mp4 or .html); return the path.
 
@@ -154,7 +170,9 @@ def save_animation(
     suffix = check_format(path)
     import matplotlib.pyplot as plt
 
-    movie = _build(trajectory, max_frames, fps, view, up, time_unit, energy_unit, title, spheres)
+    movie = _build(
+        trajectory, max_frames, fps, view, up, time_unit, energy_unit, title, spheres, colour
+    )
     path.parent.mkdir(parents=True, exist_ok=True)
     try:
         if suffix == ".html":
@@ -229,19 +247,23 @@ def _build(
     energy_unit: str,
     title: str,
     spheres: Sequence[tuple[int, float]],
+    colour: str,
 ) -> _Movie:
+    check_colour(colour, trajectory.body)
     picks = np.unique(np.linspace(0, len(trajectory) - 1, max(1, max_frames)).astype(int))
     frames = trajectory.positions[picks]
     body = trajectory.body
     ax = new_axes(body)
+    limit = sag_scale(body, frames, up) if colour == "sag" else strain_scale(body, frames)
     drawing = BodyView(
         ax,
         body,
         frames[0],
-        strain_limit=strain_scale(body, frames),
+        strain_limit=limit,
         view=view,
         up=up,
         spheres=spheres,
+        colour=colour,
     )
     drawing.fit(frames)
     ledger = trajectory.energies.as_arrays()

@@ -27,6 +27,7 @@ from ..interaction import SphereContact
 from ..simulation import Simulation
 
 UPS = ("x", "y", "z")
+COLOURINGS = ("strain", "sag")  # what the springs' colour shows
 BALL_COLOUR = "tab:green"  # not on the coolwarm scale of the springs
 _U, _V = np.meshgrid(np.linspace(0, 2 * np.pi, 13), np.linspace(0, np.pi, 7))
 _UNIT_SPHERE = np.stack([np.cos(_U) * np.sin(_V), np.sin(_U) * np.sin(_V), np.cos(_V)])
@@ -36,6 +37,27 @@ def strains(body: Body, positions: np.ndarray) -> np.ndarray:
     """Strain of each spring, |x_a - x_b| / rest length - 1 (> 0 stretched, < 0 squeezed)."""
     d = positions[body.spring_a] - positions[body.spring_b]
     return np.sqrt(np.einsum("ij,ij->i", d, d)) / body.rest_lengths - 1.0
+
+
+def sags(body: Body, positions: np.ndarray, up: str, rim: float) -> np.ndarray:
+    """Depth of each spring's middle below the height ``rim`` along the ``up`` axis (> 0 below)."""
+    axis = UPS.index(up)
+    middles = 0.5 * (positions[body.spring_a, axis] + positions[body.spring_b, axis])
+    return rim - middles
+
+
+def check_colour(colour: str, body: Body) -> None:
+    """Raise ValueError unless springs of ``body`` can be coloured by ``colour``."""
+    if colour not in COLOURINGS or (colour == "sag" and body.dim != 3):
+        raise ValueError(
+            f"cannot colour springs by {colour!r}; choose 'strain' (any body) or 'sag' (3-D)"
+        )
+
+
+def rim_height(body: Body, positions: np.ndarray, up: str) -> float:
+    """The height a net sags from: its highest pinned particle's (or highest particle's)."""
+    heights = positions[:, UPS.index(up)]
+    return float(heights[body.fixed].max() if body.fixed.any() else heights.max())
 
 
 def spheres_of(sim: Simulation) -> list[tuple[int, float]]:
@@ -57,8 +79,11 @@ def new_axes(
 class BodyView:
     """The artists drawing ``body`` on ``ax`` (2-D or 3-D axes), updated by `update`.
 
-    ``strain_limit`` is the strain drawn at full colour (blue squeezed, red
-    stretched); ``view`` = (azimuth, elevation) in degrees, report convention;
+    ``colour`` "strain" colours springs by strain, ``strain_limit`` drawn at full
+    colour (blue squeezed, red stretched); "sag" (3-D) by their depth below the rim
+    (the highest pinned particle), ``strain_limit`` then being the deepest colour, in
+    length units: a net's sag shows from any view. ``view`` = (azimuth, elevation) in
+    degrees, report convention;
     ``spheres`` are (particle, radius) pairs drawn as balls (see `spheres_of`).
     """
 
@@ -73,22 +98,24 @@ class BodyView:
         up: str = "z",
         spheres: Sequence[tuple[int, float]] = (),
         colorbar: bool = True,
+        colour: str = "strain",
     ) -> None:
         if up not in UPS:
             raise ValueError(f"unknown vertical axis {up!r}; choose one of {', '.join(UPS)}")
+        check_colour(colour, body)
         self.ax, self.body = ax, body
         self.is_3d = body.dim == 3
         if self.is_3d != hasattr(ax, "get_proj"):
             kind = "3-D" if self.is_3d else "2-D"
             raise ValueError(f"a {kind} body needs {kind} axes; use new_axes(body)")
         positions = body.positions if positions is None else positions
-        limit = strain_limit or max(
-            1e-3, float(np.max(np.abs(strains(body, positions)), initial=0))
-        )
+        self.colour, self.up = colour, up
+        self.rim = rim_height(body, positions, up) if colour == "sag" else 0.0
+        limit = strain_limit or max(1e-3, float(np.max(np.abs(self.values(positions)), initial=0)))
         thin = body.n_springs > 300  # a dense body: light springs, so the shape shows through
         style = {
-            "cmap": "coolwarm",
-            "norm": Normalize(-limit, limit),
+            "cmap": "coolwarm" if colour == "strain" else "cool",
+            "norm": Normalize(-limit, limit) if colour == "strain" else Normalize(0.0, limit),
             "linewidths": 0.6 if thin else 1.2,
             "alpha": 0.7 if thin else 1.0,
         }
@@ -106,7 +133,7 @@ class BodyView:
             self.springs = LineCollection(segments, **style)
             ax.add_collection(self.springs)
             ax.set_aspect("equal")
-        self.springs.set_array(strains(body, positions))
+        self.springs.set_array(self.values(positions))
         dot = 2.0 if body.n_particles > 500 else 3.5
         (self.free,) = ax.plot(*positions[~body.fixed].T, "o", ms=dot, color="0.15")
         (self.pinned,) = ax.plot(*positions[body.fixed].T, "s", ms=5, color="k")
@@ -121,13 +148,19 @@ class BodyView:
                 aspect=25,
                 fraction=0.03,
                 pad=0.08 if self.is_3d else 0.02,
-                label="strain",
+                label="strain" if colour == "strain" else "sag below the rim",
             )
+
+    def values(self, positions: np.ndarray) -> np.ndarray:
+        """What the springs' colour shows at ``positions``: strain or sag."""
+        if self.colour == "sag":
+            return sags(self.body, positions, self.up, self.rim)
+        return strains(self.body, positions)
 
     def update(self, positions: np.ndarray) -> list:
         """Redraw for ``positions`` (N, d); return the changed artists."""
         self.springs.set_segments(self._segments(positions))
-        self.springs.set_array(strains(self.body, positions))
+        self.springs.set_array(self.values(positions))
         for artist, mask in ((self.free, ~self.body.fixed), (self.pinned, self.body.fixed)):
             if self.is_3d:
                 artist.set_data_3d(*positions[mask].T)
@@ -178,11 +211,22 @@ def plot_body(
     strain_limit: float | None = None,
     title: str | None = None,
     save: str | Path | None = None,
+    colour: str = "strain",
 ) -> Figure:
-    """Plot ``body`` (at ``positions``, default its own) with springs coloured by strain;
-    return the figure, also written to ``save`` (.png, .pdf, .svg) if given."""
+    """Plot ``body`` (at ``positions``, default its own) with springs coloured by strain
+    (or ``colour="sag"``, see `BodyView`); return the figure, also written to ``save``
+    (.png, .pdf, .svg) if given."""
     ax = ax or new_axes(body)
-    BodyView(ax, body, positions, strain_limit=strain_limit, view=view, up=up, spheres=spheres)
+    BodyView(
+        ax,
+        body,
+        positions,
+        strain_limit=strain_limit,
+        view=view,
+        up=up,
+        spheres=spheres,
+        colour=colour,
+    )
     if title:
         ax.set_title(title)
     return save_figure(ax.figure, save)

@@ -8,7 +8,7 @@ from PIL import Image
 
 import msdlab as msd
 from msdlab import viz
-from msdlab.scenes import gallery, jelly
+from msdlab.scenes import gallery, jelly, trampoline
 
 
 @pytest.fixture(scope="module")
@@ -76,3 +76,13 @@ def test_mp4_with_ffmpeg(rope_run, tmp_path):
 def test_unknown_file_type_names_the_formats(rope_run, tmp_path):
     with pytest.raises(ValueError, match=r"\.gif, \.mp4, \.html"):
         viz.save_animation(rope_run, tmp_path / "rope.avi")
+
+
+def test_a_net_animated_with_its_sag_shares_a_scale_between_runs(tmp_path):
+    """Coloured by sag, the colour bar spans 15 % of the net's size (0.9 m for its 6 m)
+    however deep this run sags, so a heavier ball's deeper sag shows as a deeper colour."""
+    run = trampoline.trampoline(ball_mass=5.0).run(steps=100, record_every=10)
+    figure = viz.animate(run, max_frames=5, colour="sag")._fig
+    (colour_bar,) = [ax for ax in figure.axes if ax.get_ylabel() == "sag below the rim"]
+    assert colour_bar.get_ylim() == pytest.approx((0.0, 0.9))
+    assert viz.save_animation(run, tmp_path / "net.gif", max_frames=5, colour="sag").exists()

@@ -75,6 +75,26 @@ def test_wrong_axes_or_vertical_axis_are_refused():
         viz.plot_body(sim.body, up="w")
 
 
+def test_a_net_can_be_coloured_by_its_sag_below_the_rim():
+    body = trampoline.trampoline().body  # a flat net at the rim's height, z = 0
+    positions = body.positions.copy()
+    middle = 24  # the net's centre particle
+    positions[middle, 2] -= 0.5
+    figure = viz.plot_body(body, positions, colour="sag", strain_limit=1.0)
+    (springs,) = figure.axes[0].collections[:1]
+    touching = (body.spring_a == middle) | (body.spring_b == middle)
+    np.testing.assert_allclose(springs.get_array()[touching], 0.25)  # their middles sag 0.25
+    np.testing.assert_allclose(springs.get_array()[~touching], 0.0)
+    assert figure.axes[1].get_ylabel() == "sag below the rim"
+
+
+def test_sag_colouring_needs_a_3d_body():
+    with pytest.raises(ValueError, match="'sag' \\(3-D\\)"):
+        viz.plot_body(gallery.rope().body, colour="sag")
+    with pytest.raises(ValueError, match="cannot colour springs by 'height'"):
+        viz.plot_body(cloth.cloth().body, colour="height")
+
+
 def test_energy_plot_shows_the_ledger(tmp_path):
     trajectory = gallery.triangle().run(steps=200, record_every=10)
     ax = viz.plot_energy(trajectory.energies, time_unit="frames").axes[0]

@@ -1,0 +1,228 @@
+"""The gallery's live view driven as a person would in Jupyter: JupyterLab with ipympl in
+headless Chromium runs the gallery notebook's dragging cell, the mouse presses on a particle,
+drags it and holds still; the particle follows the mouse.
+
+The notebook made for the test holds the gallery's import cell, its dragging cell and a
+cell that writes, ten times a second, where the particles are on the figure (pixels) and
+which one is held to ``state.json`` beside it.
+"""
+
+import importlib.util
+import json
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import nbformat
+import numpy as np
+import pytest
+
+GALLERY = Path(__file__).resolve().parents[2] / "notebooks" / "scene_gallery.ipynb"
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+PACKAGES = [
+    name for name in ("jupyterlab", "ipympl", "playwright") if not importlib.util.find_spec(name)
+]
+
+pytestmark = [
+    pytest.mark.skipif(
+        CHROMIUM is None, reason="needs Chromium for the page (apt-get install chromium)"
+    ),
+    pytest.mark.skipif(
+        bool(PACKAGES), reason=f"needs {', '.join(PACKAGES)} (pip install -e '.[test]')"
+    ),
+    pytest.mark.timeout(120),
+]
+
+REPORTER = """\
+import json
+from pathlib import Path
+
+def report_state() -> None:
+    \"\"\"Where the particles are on the figure (px, y up) and which one is held.\"\"\"
+    figure = dragger.ax.figure
+    state = {
+        "held": dragger.grab.particle,
+        "pixels": dragger.ax.transData.transform(dragger.sim.body.positions).tolist(),
+        "figure": [figure.bbox.width, figure.bbox.height],
+    }
+    Path("state.json.part").write_text(json.dumps(state))
+    Path("state.json.part").replace("state.json")
+
+reporter = dragger.ax.figure.canvas.new_timer(interval=100)
+reporter.add_callback(report_state)
+reporter.start()
+"""
+
+
+def drag_notebook(folder: Path) -> Path:
+    """The gallery's import and dragging cells plus the reporter, as ``folder/drag.ipynb``."""
+    gallery = nbformat.read(GALLERY, as_version=4)
+    code = [cell.source for cell in gallery.cells if cell.cell_type == "code"]
+    imports = next(source for source in code if "import msdlab as msd" in source)
+    dragging = next(source for source in code if "viz.show(" in source)
+    notebook = nbformat.v4.new_notebook(metadata=gallery.metadata)
+    notebook.cells = [nbformat.v4.new_code_cell(s) for s in (imports, dragging, REPORTER)]
+    path = folder / "drag.ipynb"
+    nbformat.write(notebook, path)
+    return path
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def wait_until(condition, seconds: float, what: str):
+    """Poll ``condition()`` until it returns something true; its value."""
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        value = condition()
+        if value:
+            return value
+        time.sleep(0.1)
+    raise TimeoutError(f"{what} did not happen in {seconds} s")
+
+
+@pytest.fixture
+def jupyterlab(tmp_path):
+    """A JupyterLab server of this Python on a free local port, serving ``tmp_path``."""
+    port, token = free_port(), "msdlab-test"
+    env = {
+        **os.environ,
+        "JUPYTER_CONFIG_DIR": str(tmp_path / "config"),
+        "JUPYTER_RUNTIME_DIR": str(tmp_path / "runtime"),
+        "IPYTHONDIR": str(tmp_path / "ipython"),
+    }
+    env.pop("MPLBACKEND", None)  # the kernel picks ipympl itself
+    page_config = tmp_path / "config" / "labconfig" / "page_config.json"
+    page_config.parent.mkdir(parents=True)
+    no_news = {"@jupyterlab/apputils-extension:announcements": True}  # no pop-up over the page
+    page_config.write_text(json.dumps({"disabledExtensions": no_news}))
+    log = (tmp_path / "jupyterlab.log").open("w")
+    server = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "jupyterlab",
+            "--no-browser",
+            "--ip=127.0.0.1",
+            f"--port={port}",
+            f"--IdentityProvider.token={token}",
+            f"--ServerApp.root_dir={tmp_path}",
+            "--LabApp.expose_app_in_browser=True",  # window.jupyterapp runs the cells
+            "--allow-root",  # CI runs as root
+        ],
+        env=env,
+        stdout=log,
+        stderr=subprocess.STDOUT,
+    )
+    url = f"http://127.0.0.1:{port}"
+
+    def started() -> bool:
+        if server.poll() is not None:
+            log.flush()
+            output = (tmp_path / "jupyterlab.log").read_text()
+            raise RuntimeError(f"JupyterLab stopped:\n{output}")
+        return answers(f"{url}/api/status?token={token}")
+
+    try:
+        wait_until(started, 60, "JupyterLab starting")
+        yield url, token
+    finally:
+        server.terminate()
+        try:
+            server.wait(timeout=15)
+        except subprocess.TimeoutExpired:
+            server.kill()
+        log.close()
+
+
+def answers(url: str) -> bool:
+    try:
+        with urllib.request.urlopen(url, timeout=2) as response:
+            return response.status == 200
+    except OSError:
+        return False
+
+
+def read_state(path: Path) -> dict | None:
+    try:
+        return json.loads(path.read_text())
+    except (FileNotFoundError, json.JSONDecodeError):
+        return None
+
+
+def test_a_dragged_particle_follows_the_mouse_in_jupyterlab(jupyterlab, tmp_path):
+    from playwright.sync_api import sync_playwright
+
+    url, token = jupyterlab
+    drag_notebook(tmp_path)
+    state_file = tmp_path / "state.json"
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(
+            executable_path=CHROMIUM, args=["--no-sandbox", "--disable-gpu"], timeout=30_000
+        )
+        try:
+            page = browser.new_page(viewport={"width": 1400, "height": 1200})
+            page.set_default_timeout(40_000)
+            page.goto(f"{url}/lab/tree/drag.ipynb?token={token}")
+            page.wait_for_function("window.jupyterapp && document.querySelector('.jp-Notebook')")
+            page.get_by_text("Python 3 (ipykernel) | Idle").wait_for()  # the kernel is ready
+            page.evaluate("() => { window.jupyterapp.commands.execute('notebook:run-all-cells'); }")
+            canvas = page.locator(".jupyter-matplotlib-canvas-div canvas").last
+            canvas.wait_for(state="visible")
+            canvas.scroll_into_view_if_needed()
+            # the mesh falls onto the floor and settles: aim once it is still
+            last: list[np.ndarray] = []
+
+            def settled():
+                state = read_state(state_file)
+                if state is None:
+                    return None
+                last.append(np.array(state["pixels"]))
+                if len(last) > 5 and np.abs(last[-1] - last[-6]).max() < 0.5:
+                    return state
+                return None
+
+            state = wait_until(settled, 40, "the mesh settling in the live view")
+            box = canvas.bounding_box()
+            width, height = state["figure"]
+            scale = np.array([box["width"] / width, box["height"] / height])
+
+            def on_page(pixel) -> np.ndarray:
+                """Page coordinates (y down) of a figure pixel (y up)."""
+                return np.array([box["x"], box["y"] + box["height"]]) + scale * (1, -1) * pixel
+
+            pixels = np.array(state["pixels"])
+            particle = int(np.argmax(pixels.sum(axis=1)))  # the top-right corner
+            press = on_page(pixels[particle])
+            release = press + (-120.0, -60.0)  # to the left and up on the page
+            page.mouse.move(*press)
+            page.mouse.down()
+            for fraction in np.linspace(0.1, 1.0, 10):  # a hand moves in small steps
+                page.mouse.move(*(press + fraction * (release - press)))
+                time.sleep(0.05)
+            time.sleep(1.0)  # held still: the particle sits under the mouse
+            held = wait_until(
+                lambda: (s := read_state(state_file)) and s["held"] is not None and s,
+                10,
+                "a particle being held",
+            )
+            time.sleep(0.5)
+            held = read_state(state_file) or held
+            page.mouse.up()
+        except Exception:
+            page.screenshot(path=tmp_path / "page.png")
+            raise
+        finally:
+            browser.close()
+    assert held["held"] == particle  # the particle under the mouse was taken
+    on_screen = on_page(np.array(held["pixels"][particle]))
+    assert np.linalg.norm(on_screen - press) > 100.0  # it came along
+    np.testing.assert_allclose(on_screen, release, atol=3.0)  # and sits under the mouse
