@@ -194,7 +194,6 @@ else:
 
 
 # %%
-# NBVAL_CHECK_OUTPUT
 def inverted_cells(sim: msd.Simulation, shape: tuple[int, int] = (10, 10)) -> int:
     """Cells of the mesh whose signed area (shoelace formula) is negative: turned over."""
     grid = sim.body.positions.reshape(shape[0], shape[1], 2)
@@ -226,6 +225,16 @@ def pull_and_let_go(pull: float, frames: int) -> msd.Simulation:
     return sim
 
 
+turned_over = {}
 for pull, frames in ((60.0, 60), (400.0, 10)):
-    inverted = inverted_cells(pull_and_let_go(pull, frames))
-    print(f"corner moved {pull:.0f} px in {frames} frames: {inverted} of 81 cells turned over")
+    turned_over[frames] = inverted_cells(pull_and_let_go(pull, frames))
+    count = turned_over[frames]
+    print(f"corner moved {pull:.0f} px in {frames} frames: {count} of 81 cells turned over")
+
+# %%
+# NBVAL_CHECK_OUTPUT
+# How many cells stay turned over depends on rounding (a thrown mesh moves chaotically);
+# whether it folds at all does not.
+print(
+    f"gently dragged mesh folded: {turned_over[60] > 0}; thrown mesh folded: {turned_over[10] > 0}"
+)

@@ -1,0 +1,108 @@
+"""How fast is a user's integrator next to `msd.Verlet`, on a 30³ grid?
+
+Three integrators step the same body (30³ grid, neighbours 1, 2, 3, k = 100 N/m,
+gravity, ground, ledger on) with the default kernel:
+
+- ``msd.Verlet(0.01)``, the engine's;
+- ``advance``: a user's subclass of `msd.Integrator` whose update is a plain
+  function handed to ``dynamics.advance`` (the documented way; compiled);
+- ``arrays``: task 5's reference `DampedVerlet`, written with
+  ``dynamics.acceleration`` and numpy array operations (runs as written).
+
+The machine is shared, so the three run interleaved in batches of about
+0.15 s; a ratio is a user's batch over the engine's batch next to it, median
+and range over the repeats.
+
+    python benchmarks/user_integrator.py [--n 30] [--repeats 9]
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+import msdlab as msd
+from msdlab.cli import configure_process
+
+configure_process()  # the thread wait policy the command line uses
+
+SOLUTION = Path(__file__).resolve().parents[1] / "solutions" / "task5.py"
+
+
+def damped_verlet_update(
+    x: float, v: float, a: float, dt: float, damping: float
+) -> tuple[float, float]:
+    """Eq. (1.4) as a user writes it: x(t + dt) = x + (1 - λ)(x - x(t - dt)) + a dt²."""
+    x_new = x + (1.0 - damping) * v * dt + a * dt * dt
+    return x_new, (x_new - x) / dt
+
+
+class UserVerlet(msd.Integrator):
+    """A user's damped Verlet through ``dynamics.advance`` (compiled by the kernel)."""
+
+    def __init__(self, damping: float) -> None:
+        self.damping = damping
+
+    def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: msd.Dynamics):
+        return dynamics.advance(damped_verlet_update, x, v, dt, self.damping)
+
+
+def task5_damped_verlet() -> type[msd.Integrator]:
+    """The reference solution of task 5 (array operations)."""
+    spec = importlib.util.spec_from_file_location("task5_solution", SOLUTION)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.DampedVerlet
+
+
+def simulation(n: int, integrator: msd.Integrator) -> msd.Simulation:
+    body = msd.Body.grid((n, n, n), spacing=1.0, stiffness=100.0, neighbours=(1, 2, 3))
+    body.positions[:, 1] += 0.5  # just above the ground
+    forces = [msd.Gravity((0.0, -9.81, 0.0)), msd.Ground(height=0.0)]
+    return msd.Simulation(body, integrator, dt=1e-3, forces=forces)
+
+
+def batch_time(step: Callable[[], None], steps: int) -> float:
+    """Seconds per step over ``steps`` steps."""
+    start = time.perf_counter()
+    for _ in range(steps):
+        step()
+    return (time.perf_counter() - start) / steps
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--n", type=int, default=30)
+    parser.add_argument("--repeats", type=int, default=9)
+    args = parser.parse_args()
+    contenders = {
+        "msd.Verlet(0.01)": simulation(args.n, msd.Verlet(0.01)),
+        "advance (user)": simulation(args.n, UserVerlet(0.01)),
+        "arrays (task 5)": simulation(args.n, task5_damped_verlet()(0.01)),
+    }
+    for sim in contenders.values():  # compile and warm up
+        sim.step()
+    engine = contenders["msd.Verlet(0.01)"]
+    steps = max(3, round(0.15 / batch_time(engine.step, 3)))
+    times: dict[str, list[float]] = {name: [] for name in contenders}
+    for _ in range(args.repeats):
+        for name, sim in contenders.items():
+            times[name].append(batch_time(sim.step, steps))
+    engine_times = np.array(times["msd.Verlet(0.01)"])
+    print(f"{args.n}³ grid, {engine.body.n_springs:,} springs, {steps} steps per batch")
+    print(f"{'integrator':<18} {'ms/step':>8} {'÷ Verlet':>9}  range")
+    for name, values in times.items():
+        ratio = np.array(values) / engine_times
+        print(
+            f"{name:<18} {1e3 * np.median(values):8.2f} {np.median(ratio):9.2f}  "
+            f"{ratio.min():.2f}–{ratio.max():.2f}"
+        )
+
+
+if __name__ == "__main__":
+    main()
