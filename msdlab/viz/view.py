@@ -19,7 +19,8 @@ from matplotlib.collections import LineCollection
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
-from matplotlib.ticker import MaxNLocator
+from matplotlib.ticker import MaxNLocator, NullLocator
+from mpl_toolkits.mplot3d import proj3d
 from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
 from ..body import Body
@@ -147,7 +148,9 @@ class BodyView:
                 shrink=0.5,
                 aspect=25,
                 fraction=0.03,
-                pad=0.08 if self.is_3d else 0.02,
+                # 3-D: below the box, clear of the z axis's label and ticks at its right
+                location="bottom" if self.is_3d else "right",
+                pad=0.06 if self.is_3d else 0.02,
                 label="strain" if colour == "strain" else "sag below the rim",
             )
 
@@ -189,6 +192,25 @@ class BodyView:
         if self.is_3d:
             self.ax.set(zlim=(low[2], high[2]), zlabel="z")
             self.ax.set_box_aspect(tuple(high - low), zoom=1.25)  # less white around the box
+            self._thin_out_foreshortened_axes()
+
+    def _thin_out_foreshortened_axes(self) -> None:
+        """Fewer ticks on an axis the view shortens, none on one seen end-on: no overlaps."""
+        limits = np.array([self.ax.get_xlim(), self.ax.get_ylim(), self.ax.get_zlim()])
+        centre = limits.mean(axis=1)
+        ends = np.repeat(centre[None], 6, axis=0)
+        for axis in range(3):
+            ends[2 * axis : 2 * axis + 2, axis] = limits[axis]
+        x, y, _ = proj3d.proj_transform(*ends.T, self.ax.get_proj())
+        screen = np.hypot(np.diff(x)[::2], np.diff(y)[::2])
+        for length, axis in zip(
+            screen / screen.max(), (self.ax.xaxis, self.ax.yaxis, self.ax.zaxis)
+        ):
+            if length < 0.1:  # seen end-on
+                axis.set_major_locator(NullLocator())
+                axis.label.set_visible(False)
+            elif length < 0.35:
+                axis.set_major_locator(MaxNLocator(2))
 
     def _segments(self, positions: np.ndarray) -> np.ndarray:
         return np.stack([positions[self.body.spring_a], positions[self.body.spring_b]], axis=1)

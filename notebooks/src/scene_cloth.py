@@ -64,7 +64,7 @@ for name in ("corners", "row"):
     print(f"pinned ({name}): lowest point z = {variants[name].body.positions[:, 2].min():.2f} m")
 
 # %%
-fig = plt.figure(figsize=(13, 4))
+fig = plt.figure(figsize=(15, 4.5), layout="constrained")
 for place, (name, sim) in enumerate(variants.items(), 1):
     ax = fig.add_subplot(1, 3, place, projection="3d")
     viz.plot_body(sim.body, ax=ax, view=(-30, 20), title=name)

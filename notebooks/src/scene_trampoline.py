@@ -39,13 +39,16 @@ from msdlab.scenes.trampoline import BALL, EXPERIMENTS, experiment_table, run_ex
 sim = trampoline()
 control = sim.run(duration=5.0, record_every=10)
 spheres = viz.spheres_of(sim)
-HTML(viz.to_html(control, max_frames=30, view=(45, 45), spheres=spheres))
+# from the side, just above the rim, with the net coloured by its sag (m)
+HTML(viz.to_html(control, max_frames=30, view=(15, 12), spheres=spheres, colour="sag"))
 
 # %%
-fig = plt.figure(figsize=(11, 4))
+fig = plt.figure(figsize=(12, 4.5), layout="constrained")
 for place, view in ((1, (45, 45)), (2, (0, 0))):  # the report's two camera angles
     ax = fig.add_subplot(1, 2, place, projection="3d")
-    viz.plot_body(sim.body, ax=ax, view=view, spheres=spheres, title=f"after 5 s, view {view}")
+    viz.plot_body(
+        sim.body, ax=ax, view=view, spheres=spheres, colour="sag", title=f"after 5 s, view {view}"
+    )
 plt.show()
 
 # %% [markdown]

@@ -83,6 +83,6 @@ def test_a_net_animated_with_its_sag_shares_a_scale_between_runs(tmp_path):
     however deep this run sags, so a heavier ball's deeper sag shows as a deeper colour."""
     run = trampoline.trampoline(ball_mass=5.0).run(steps=100, record_every=10)
     figure = viz.animate(run, max_frames=5, colour="sag")._fig
-    (colour_bar,) = [ax for ax in figure.axes if ax.get_ylabel() == "sag below the rim"]
-    assert colour_bar.get_ylim() == pytest.approx((0.0, 0.9))
+    (colour_bar,) = [ax for ax in figure.axes if ax.get_xlabel() == "sag below the rim"]
+    assert colour_bar.get_xlim() == pytest.approx((0.0, 0.9))  # below the 3-D box
     assert viz.save_animation(run, tmp_path / "net.gif", max_frames=5, colour="sag").exists()

@@ -85,7 +85,7 @@ def test_a_net_can_be_coloured_by_its_sag_below_the_rim():
     touching = (body.spring_a == middle) | (body.spring_b == middle)
     np.testing.assert_allclose(springs.get_array()[touching], 0.25)  # their middles sag 0.25
     np.testing.assert_allclose(springs.get_array()[~touching], 0.0)
-    assert figure.axes[1].get_ylabel() == "sag below the rim"
+    assert figure.axes[1].get_xlabel() == "sag below the rim"  # the colour bar, below the box
 
 
 def test_sag_colouring_needs_a_3d_body():
