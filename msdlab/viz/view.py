@@ -15,17 +15,16 @@ from pathlib import Path
 import numpy as np
 from matplotlib.artist import Artist
 from matplotlib.axes import Axes
-from matplotlib.collections import LineCollection
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 from matplotlib.ticker import MaxNLocator, NullLocator
 from mpl_toolkits.mplot3d import proj3d
-from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
 from ..body import Body
 from ..interaction import SphereContact
 from ..simulation import Simulation
+from .lines import SpringLines, SpringLines3D
 
 UPS = ("x", "y", "z")
 COLOURINGS = ("strain", "sag")  # what the springs' colour shows
@@ -120,21 +119,17 @@ class BodyView:
             "linewidths": 0.6 if thin else 1.2,
             "alpha": 0.7 if thin else 1.0,
         }
-        segments = self._segments(positions)
+        lines = SpringLines3D if self.is_3d else SpringLines
+        self.springs = lines(self._segments(positions), self.values(positions), **style)
+        ax.add_collection(self.springs, autolim=False)  # `fit` sets the limits
         if self.is_3d:
-            self.springs = Line3DCollection(segments, **style)
-            if body.n_springs:  # an empty 3-D collection breaks matplotlib's autoscaling
-                ax.add_collection3d(self.springs)
             azimuth, elevation = (45.0, 30.0) if view is None else view
             ax.view_init(elev=elevation, azim=azimuth - 90.0, vertical_axis=up)
             for axis in (ax.xaxis, ax.yaxis, ax.zaxis):  # few ticks: no overlapping labels
                 axis.set_major_locator(MaxNLocator(4))
             ax.tick_params(labelsize="small", pad=0)
         else:
-            self.springs = LineCollection(segments, **style)
-            ax.add_collection(self.springs)
             ax.set_aspect("equal")
-        self.springs.set_array(self.values(positions))
         dot = 2.0 if body.n_particles > 500 else 3.5
         (self.free,) = ax.plot(*positions[~body.fixed].T, "o", ms=dot, color="0.15")
         (self.pinned,) = ax.plot(*positions[body.fixed].T, "s", ms=5, color="k")
@@ -162,8 +157,7 @@ class BodyView:
 
     def update(self, positions: np.ndarray) -> list:
         """Redraw for ``positions`` (N, d); return the changed artists."""
-        self.springs.set_segments(self._segments(positions))
-        self.springs.set_array(self.values(positions))
+        self.springs.set_springs(self._segments(positions), self.values(positions))
         for artist, mask in ((self.free, ~self.body.fixed), (self.pinned, self.body.fixed)):
             if self.is_3d:
                 artist.set_data_3d(*positions[mask].T)

@@ -4,11 +4,14 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 from matplotlib.collections import LineCollection
+from matplotlib.colors import Normalize
 from matplotlib.patches import Circle
+from matplotlib.path import Path
 
 import msdlab as msd
 from msdlab import viz
 from msdlab.scenes import cloth, gallery, trampoline
+from msdlab.viz.lines import LEVELS, SpringLines
 
 
 @pytest.fixture(autouse=True)
@@ -29,8 +32,8 @@ def test_2d_body_springs_carry_their_strains(tmp_path):
     figure = viz.plot_body(sim.body, title="pulled", save=path)
     ax = figure.axes[0]
     (springs,) = [c for c in ax.collections if isinstance(c, LineCollection)]
-    np.testing.assert_allclose(springs.get_array(), [0.5])  # 150 px over a rest of 100
-    np.testing.assert_allclose(springs.get_segments()[0], [[250.0, 200.0], [400.0, 200.0]])
+    np.testing.assert_allclose(springs.values, [0.5])  # 150 px over a rest of 100
+    np.testing.assert_allclose(springs.ends[0], [[250.0, 200.0], [400.0, 200.0]])
     assert ax.get_title() == "pulled"
     assert path.stat().st_size > 1000
     assert figure.get_size_inches()[0] * 100 >= 600  # report-sized: at least 600 px wide
@@ -61,9 +64,7 @@ def test_body_view_follows_new_positions():
     drawing.update(sim.body.positions)
     *_, z = drawing.free.get_data_3d()
     np.testing.assert_allclose(z, sim.body.positions[~sim.body.fixed, 2])
-    np.testing.assert_allclose(
-        drawing.springs.get_array(), viz.strains(sim.body, sim.body.positions)
-    )
+    np.testing.assert_allclose(drawing.springs.values, viz.strains(sim.body, sim.body.positions))
 
 
 def test_wrong_axes_or_vertical_axis_are_refused():
@@ -83,9 +84,28 @@ def test_a_net_can_be_coloured_by_its_sag_below_the_rim():
     figure = viz.plot_body(body, positions, colour="sag", strain_limit=1.0)
     (springs,) = figure.axes[0].collections[:1]
     touching = (body.spring_a == middle) | (body.spring_b == middle)
-    np.testing.assert_allclose(springs.get_array()[touching], 0.25)  # their middles sag 0.25
-    np.testing.assert_allclose(springs.get_array()[~touching], 0.0)
+    np.testing.assert_allclose(springs.values[touching], 0.25)  # their middles sag 0.25
+    np.testing.assert_allclose(springs.values[~touching], 0.0)
     assert figure.axes[1].get_xlabel() == "sag below the rim"  # the colour bar, below the box
+
+
+def test_spring_lines_draw_every_spring_once_in_the_colour_of_its_value():
+    """Springs are grouped by colour level into one path each; every spring's segment is in
+    the path whose colour value is within half a level of its own (clipped to the scale)."""
+    rng = np.random.default_rng(3)
+    ends = rng.normal(size=(500, 2, 2))
+    values = rng.normal(scale=0.6, size=500)  # some beyond the scale's ±1
+    springs = SpringLines(ends, values, cmap="coolwarm", norm=Normalize(-1.0, 1.0))
+    half_level = 0.5 * 2.0 / LEVELS
+    drawn = []
+    for path, value in zip(springs.get_paths(), springs.get_array()):
+        segments = path.vertices.reshape(-1, 2, 2)
+        assert list(path.codes) == [Path.MOVETO, Path.LINETO] * len(segments)
+        for segment in segments:
+            (spring,) = np.flatnonzero((ends == segment).all(axis=(1, 2)))
+            assert abs(np.clip(values[spring], -1, 1) - value) <= half_level + 1e-12
+            drawn.append(spring)
+    assert sorted(drawn) == list(range(500))
 
 
 def test_sag_colouring_needs_a_3d_body():
