@@ -45,6 +45,8 @@ from .stencil import GridStencil, grid_stencil
 # Below this many springs (particles for the update) one thread is faster than waking the others.
 PARALLEL_MIN_SPRINGS = 50_000
 PARALLEL_MIN_PARTICLES = 20_000
+# Particles a gather block holds (whole grid rows): long inner loops, enough blocks for threads.
+GATHER_BLOCK = 4096
 
 _spring_force = numba.njit(cache=True, inline="always")(equations.spring_force)
 _spring_energy = numba.njit(cache=True, inline="always")(equations.spring_energy)
@@ -124,16 +126,18 @@ def _spring_forces_parallel(x, v, a, b, k, rest, c, partial, out):
 
 
 @numba.njit(cache=True, inline="always", error_model="numpy")
-def _gather_offset(xs, vs, fs, squared, k, rest, c, first, stop, shift):
+def _gather_offset(xs, vs, fs, squared, columns, base, k, rest, c, first, stop, shift):
     """Add to particles ``first`` to ``stop - 1`` the force of their spring to p + ``shift``.
 
     ``xs``, ``vs``, ``fs`` are positions, velocities and forces by coordinate,
     3 contiguous arrays each, so the loop runs on vector registers: d = x_p - x_q
     and p gets f(|d|)·d/|d|, f of eq. (1.2) plus the dashpot, whichever end of
-    the spring p is (the spring computes the same f for both ends). Each |d|²
-    goes to ``squared`` (a running maximum would keep the loop scalar); returns
-    the dashpot power of these springs. Indices are unsigned: numba then needs
-    no negative-index test, which would also keep the loop scalar.
+    the spring p is (the spring computes the same f for both ends).
+    ``columns[p - base]`` is 1 where p has this neighbour and 0 where the
+    offset leaves p's grid row (p then gets no force). Each |d|² goes to
+    ``squared`` (a running maximum would keep the loop scalar); returns the
+    dashpot power of these springs. Indices are unsigned: numba then needs no
+    negative-index test, which would also keep the loop scalar.
     """
     x0, x1, x2 = xs
     f0, f1, f2 = fs
@@ -141,11 +145,13 @@ def _gather_offset(xs, vs, fs, squared, k, rest, c, first, stop, shift):
     if c == 0.0:  # two loops, so that the one without dashpots has no sum across springs
         for i in range(first, stop):
             p, q = numba.uint64(i), numba.uint64(i + shift)
+            there = columns[numba.uint64(i - base)]
             d0, d1, d2 = x0[p] - x0[q], x1[p] - x1[q], x2[p] - x2[q]
-            squared[p] = d0 * d0 + d1 * d1 + d2 * d2
-            length = math.sqrt(squared[p])
+            length_squared = d0 * d0 + d1 * d1 + d2 * d2
+            squared[p] = there * length_squared
+            length = math.sqrt(length_squared)
             safe = length if length > 0.0 else 1.0  # coincident ends: no direction, no force
-            scale = _spring_force(k, rest, safe, 0.0, 0.0) / safe
+            scale = there * _spring_force(k, rest, safe, 0.0, 0.0) / safe
             scale = scale if length > 0.0 else 0.0
             f0[p] += scale * d0
             f1[p] += scale * d1
@@ -154,13 +160,15 @@ def _gather_offset(xs, vs, fs, squared, k, rest, c, first, stop, shift):
     v0, v1, v2 = vs
     for i in range(first, stop):
         p, q = numba.uint64(i), numba.uint64(i + shift)
+        there = columns[numba.uint64(i - base)]
         d0, d1, d2 = x0[p] - x0[q], x1[p] - x1[q], x2[p] - x2[q]
-        squared[p] = d0 * d0 + d1 * d1 + d2 * d2
-        length = math.sqrt(squared[p])
+        length_squared = d0 * d0 + d1 * d1 + d2 * d2
+        squared[p] = there * length_squared
+        length = math.sqrt(length_squared)
         safe = length if length > 0.0 else 1.0
         closing = (v0[p] - v0[q]) * d0 + (v1[p] - v1[q]) * d1 + (v2[p] - v2[q]) * d2
-        power += _dashpot_power_of(c, closing / safe)
-        scale = _spring_force(k, rest, safe, c, closing) / safe
+        power += there * _dashpot_power_of(c, closing / safe)
+        scale = there * _spring_force(k, rest, safe, c, closing) / safe
         scale = scale if length > 0.0 else 0.0
         f0[p] += scale * d0
         f1[p] += scale * d1
@@ -169,48 +177,69 @@ def _gather_offset(xs, vs, fs, squared, k, rest, c, first, stop, shift):
 
 
 @numba.njit(cache=True, inline="always", error_model="numpy")
-def _gather_row(scratch, shape, offsets, k, rest, c, row, out):
-    """Add to ``out`` (N, d) the spring forces on the particles of grid row ``row``.
+def _gather_block(scratch, columns, shape, offsets, k, rest, c, block, rows, out):
+    """Add to ``out`` (N, d) the spring forces on the particles of grid block ``block``:
+    ``rows`` consecutive rows of one plane (the plane's last block may hold fewer).
 
     ``scratch`` (10, N) holds the positions, velocities and forces by
-    coordinate and the squared lengths. For each stencil offset ±o the
-    particles p of the row and their neighbours p ± o are both contiguous.
-    Returns the largest stretch |d|/l and half the dashpot power of the
-    springs met (each spring is met from both ends).
+    coordinate and the squared lengths. For each stencil offset ±o the rows
+    whose neighbours exist are consecutive, so the inner loop runs over all
+    of them at once; ``columns[r + o_2]`` masks the particles whose neighbour
+    would be past the end of their row (see `_column_masks`). Returns the
+    largest stretch |d|/l and half the dashpot power of the springs met (each
+    spring is met from both ends).
     """
     xs = (scratch[0], scratch[1], scratch[2])
     vs = (scratch[3], scratch[4], scratch[5])
     fs = (scratch[6], scratch[7], scratch[8])
     squared = scratch[9]
-    n1, n2 = shape[1], shape[2]
-    i0, i1 = row // n1, row % n1
-    row_start = row * n2
+    n0, n1, n2 = shape[0], shape[1], shape[2]
+    reach = (len(columns) - 1) // 2
+    per_plane = (n1 + rows - 1) // rows
+    plane, row_lo = block // per_plane, (block % per_plane) * rows
+    row_hi = min(row_lo + rows, n1)
+    start, end = (plane * n1 + row_lo) * n2, (plane * n1 + row_hi) * n2
     f0, f1, f2 = fs
-    for p in range(row_start, row_start + n2):
+    for p in range(start, end):
         f0[p] = f1[p] = f2[p] = 0.0
     stretch = 0.0
     power = 0.0
     for m in range(len(offsets)):
         for sign in (1, -1):
             o0, o1, o2 = sign * offsets[m, 0], sign * offsets[m, 1], sign * offsets[m, 2]
-            if 0 <= i0 + o0 < shape[0] and 0 <= i1 + o1 < n1:
-                first, stop = row_start + max(0, -o2), row_start + n2 - max(0, o2)
-                shift = (o0 * n1 + o1) * n2 + o2
-                power += 0.5 * _gather_offset(
-                    xs, vs, fs, squared, k[m], rest[m], c[m], first, stop, shift
-                )
-                if sign == 1:  # -o meets the same springs from their other end
-                    longest = squared[first:stop].max()
-                    stretch = max(stretch, math.sqrt(longest) / rest[m])
-    for p in range(row_start, row_start + n2):
+            lo, hi = max(row_lo, -o1), min(row_hi, n1 - o1)  # rows whose neighbours exist
+            if not (0 <= plane + o0 < n0 and lo < hi):
+                continue
+            shift = (o0 * n1 + o1) * n2 + o2
+            base = (plane * n1 + lo) * n2
+            # the first and last particles masked out may have no neighbour in memory at all
+            first, stop = max(base, -shift), min((plane * n1 + hi) * n2, n0 * n1 * n2 - shift)
+            power += 0.5 * _gather_offset(
+                xs,
+                vs,
+                fs,
+                squared,
+                columns[o2 + reach],
+                base,
+                k[m],
+                rest[m],
+                c[m],
+                first,
+                stop,
+                shift,
+            )
+            if sign == 1:  # -o meets the same springs from their other end
+                longest = squared[first:stop].max()
+                stretch = max(stretch, math.sqrt(longest) / rest[m])
+    for p in range(start, end):
         for q in range(out.shape[1]):
             out[p, q] += fs[q][p]
     return stretch, power
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _gather_serial(x, v, shape, offsets, k, rest, c, scratch, out):
-    """One thread: `_gather_row` for every row; return (largest stretch, dashpot power)."""
+def _gather_serial(x, v, shape, offsets, k, rest, c, columns, rows, scratch, out):
+    """One thread: `_gather_block` for every block; return (largest stretch, dashpot power)."""
     damped = np.any(c != 0.0)
     for q in range(x.shape[1]):
         scratch[q] = x[:, q]
@@ -218,28 +247,47 @@ def _gather_serial(x, v, shape, offsets, k, rest, c, scratch, out):
             scratch[3 + q] = v[:, q]
     stretch = 0.0
     power = 0.0
-    for row in range(shape[0] * shape[1]):
-        row_stretch, row_power = _gather_row(scratch, shape, offsets, k, rest, c, row, out)
-        stretch = max(stretch, row_stretch)
-        power += row_power
+    blocks = shape[0] * ((shape[1] + rows - 1) // rows)
+    for block in range(blocks):
+        sums = _gather_block(scratch, columns, shape, offsets, k, rest, c, block, rows, out)
+        stretch = max(stretch, sums[0])
+        power += sums[1]
     return stretch, power
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
-def _gather_parallel(x, v, shape, offsets, k, rest, c, scratch, out):
-    """Threads: rows split between them, each writing only its own particles' forces."""
+def _gather_parallel(x, v, shape, offsets, k, rest, c, columns, rows, scratch, out):
+    """Threads: blocks split between them, each writing only its own particles' forces."""
     damped = np.any(c != 0.0)
     for p in numba.prange(len(x)):
         for q in range(x.shape[1]):
             scratch[q, p] = x[p, q]
             if damped:
                 scratch[3 + q, p] = v[p, q]
-    rows = shape[0] * shape[1]
-    stretches = np.zeros(rows)
-    powers = np.zeros(rows)
-    for row in numba.prange(rows):
-        stretches[row], powers[row] = _gather_row(scratch, shape, offsets, k, rest, c, row, out)
+    blocks = shape[0] * ((shape[1] + rows - 1) // rows)
+    stretches = np.zeros(blocks)
+    powers = np.zeros(blocks)
+    for block in numba.prange(blocks):
+        stretches[block], powers[block] = _gather_block(
+            scratch, columns, shape, offsets, k, rest, c, block, rows, out
+        )
     return stretches.max(), powers.sum()
+
+
+def _column_masks(shape: np.ndarray, offsets: np.ndarray) -> tuple[np.ndarray, int]:
+    """Masks of the particles that have a neighbour ``o_2`` columns along their grid row.
+
+    Returns (masks, rows): ``masks[r + o_2]`` (rows · n_2,) is 1 where column
+    c + o_2 exists, for a block of ``rows`` rows of the grid, long enough
+    (about ``GATHER_BLOCK`` particles) for the loops over a block to cost
+    little more than their arithmetic.
+    """
+    n1, n2 = int(shape[1]), int(shape[2])
+    rows = max(1, min(n1, GATHER_BLOCK // n2))
+    reach = int(np.abs(offsets[:, 2]).max(initial=0))
+    column = np.arange(n2)
+    masks = [np.tile((column + o >= 0) & (column + o < n2), rows) for o in range(-reach, reach + 1)]
+    return np.array(masks, dtype=float), rows
 
 
 @numba.njit(cache=True)
@@ -399,6 +447,7 @@ class NumbaKernel:
         self._stencil_version = -1
         self._stencil: GridStencil | None = None
         self._stencil_values = np.zeros((3, 0))
+        self._columns = (np.ones((1, 0)), 1)  # see `_column_masks`
         self._scratch = np.zeros((10, 0))  # x, v, forces by coordinate and squared lengths
         self._values_version = -1
         self._uniform = False
@@ -427,7 +476,20 @@ class NumbaKernel:
                 if self._scratch.shape != (10, len(x)):
                     self._scratch = np.zeros((10, len(x)))  # 2-D bodies keep x2 = v2 = 0
                 k, rest, c = self._stencil_values
-                return gather(x, v, stencil.shape, stencil.offsets, k, rest, c, self._scratch, out)
+                columns, rows = self._columns
+                return gather(
+                    x,
+                    v,
+                    stencil.shape,
+                    stencil.offsets,
+                    k,
+                    rest,
+                    c,
+                    columns,
+                    rows,
+                    self._scratch,
+                    out,
+                )
         if springs is not None:
             arrays = (body.spring_a, body.spring_b, *body.spring_values())
             return _spring_forces_serial(x, v, *(array[springs] for array in arrays), out)
@@ -449,6 +511,8 @@ class NumbaKernel:
         if self._stencil_version != body.topology_version:
             self._stencil = grid_stencil(body)
             blocks = 0 if self._stencil is None else len(self._stencil.offsets)
+            if self._stencil is not None:
+                self._columns = _column_masks(self._stencil.shape, self._stencil.offsets)
             self._stencil_values = np.zeros((3, blocks))
             self._stencil_version = body.topology_version
             self._values_version = -1

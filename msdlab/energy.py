@@ -63,8 +63,7 @@ def contact_work(
     two: for position Verlet, (x(t+dt) - x(t-dt))/2dt. A contact that holds a
     particle at rest does no work; one that stops a particle does negative work.
     """
-    mean = 0.5 * (v_before + v_after)
-    return float(np.sum(masses * np.einsum("ij,ij->i", kick, mean)))
+    return 0.5 * float(np.einsum("i,ij,ij->", masses, kick, v_before + v_after))
 
 
 def damping_work(
@@ -78,7 +77,7 @@ def damping_work(
     end velocity v_after. Booking (1 - factor²)·½ Σ m v_before² instead misses
     the work against the forces' kick and leaves a first-order drift.
     """
-    return -contact_work(masses, (factor - 1.0) * v_before, v_before, v_after)
+    return (1.0 - factor) * contact_work(masses, v_before, v_before, v_after)  # linear in Δv
 
 
 def kinetic_energy_removed(masses: np.ndarray, v: np.ndarray, factor: float) -> float:
