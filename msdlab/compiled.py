@@ -15,8 +15,9 @@ added in.
 Grid bodies (`msdlab.stencil`) whose springs share their values per offset
 are gathered instead: each particle sums the forces of its neighbours by grid
 offset, on positions copied by coordinate so that the inner loop walks
-contiguous rows on vector registers; the threads split the rows and write
-only their own particles. Each spring is then computed from both ends, with
+contiguous memory on vector registers, over blocks of whole grid rows (those
+whose neighbour would leave its row masked out); the threads split the blocks
+and write only their own particles. Each spring is then computed from both ends, with
 the same `equations.spring_force`; the two ways agree to rounding.
 
 `NumbaKernel.advance` compiles an integrator's update function (for example
