@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import textwrap
 from collections.abc import Sequence
+from time import perf_counter
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -22,6 +23,7 @@ from ..interaction import Grab, Walls
 from ..simulation import Simulation
 from .view import BodyView, new_axes, spheres_of
 
+CATCH_UP = 0.25  # s of simulation a paced live view may step in one frame after a slow one
 LIVE_STRAIN_LIMIT = 0.3  # strain drawn at full colour: what a drag or a fall reaches
 INSTRUCTIONS_2D = "drag a particle with the left mouse button · close the window (or q) to quit"
 INSTRUCTIONS_3D = "left button: drag a particle · right button: turn · q or close: quit"
@@ -31,6 +33,10 @@ _running: list[Dragger] = []  # live views started by `show`, stopped when a new
 class Dragger:
     """Runs ``sim`` in a figure with mouse grabbing: ``steps_per_frame`` steps per ``interval`` ms.
 
+    With ``steps_per_second`` the simulation keeps that pace instead, however
+    long a frame takes to draw: each frame steps as often as the time since
+    the last one asks (a full matplotlib redraw took about 70 ms here, so a fixed
+    number of steps per frame would run slower than the page's 60 a second).
     `advance` does one frame (the timer calls it; tests call it directly). The
     axes hold the whole box of the scene's `Walls` when it has them.
     """
@@ -41,12 +47,15 @@ class Dragger:
         ax: Axes | None = None,
         *,
         steps_per_frame: int = 1,
+        steps_per_second: float | None = None,
         interval: int = 30,
         view: Sequence[float] | None = None,
         up: str = "z",
     ) -> None:
         self.sim = sim
         self.steps_per_frame = int(steps_per_frame)
+        self.steps_per_second = steps_per_second
+        self._due_since: float | None = None  # time from which steps are owed (s)
         self.grab = Grab()
         sim.constraints.append(self.grab)
         self.ax = ax or new_axes(sim.body, layout="none")  # the mouse needs still axes
@@ -102,13 +111,30 @@ class Dragger:
     def advance(self) -> None:
         """Step the simulation one frame and redraw; on a blow-up, stop and say why."""
         try:
-            for _ in range(self.steps_per_frame):
+            for _ in range(self._steps_due()):
                 self.sim.step()
         except SimulationDiverged as error:
             self.timer.stop()
             self.ax.set_title(textwrap.fill(f"stopped: {error}", 90), fontsize="small")
         self.drawing.update(self.sim.body.positions)
         self.ax.figure.canvas.draw_idle()
+
+    def _steps_due(self) -> int:
+        """Steps for this frame: ``steps_per_frame``, or the steps the time since the last
+        frame asks at ``steps_per_second`` (at most `CATCH_UP` seconds' worth: a frame
+        that hung does not leave a backlog)."""
+        if self.steps_per_second is None:
+            return self.steps_per_frame
+        now = perf_counter()
+        if self._due_since is None:
+            self._due_since = now - 1.0 / self.steps_per_second  # the first frame: one step
+        due = int((now - self._due_since) * self.steps_per_second + 1e-9)  # 0.99999... is 1
+        most = max(1, int(CATCH_UP * self.steps_per_second))
+        if due > most:
+            self._due_since, due = now, most
+        else:
+            self._due_since += due / self.steps_per_second
+        return due
 
     # ------------------------------------------------------------------ mouse
     def on_press(self, event: MouseEvent) -> None:

@@ -153,7 +153,7 @@ HTML(viz.to_html(run, max_frames=60, time_unit="frames"))
 sim = gallery.mesh()
 if importlib.util.find_spec("ipympl"):
     get_ipython().run_line_magic("matplotlib", "widget")
-    dragger = viz.show(sim, steps_per_frame=2)
+    dragger = viz.show(sim, steps_per_second=60)  # the page's pace
 else:
     corner = int(np.argmax(sim.body.positions.sum(axis=1)))
     grab = msd.Grab()

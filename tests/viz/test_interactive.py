@@ -143,3 +143,25 @@ def test_a_new_live_view_stops_the_previous_one(monkeypatch):
     first.timer._on_timer()  # a stopped timer has no callbacks left to run
     assert first.sim.step_count == steps
     second.stop()
+
+
+def test_a_paced_live_view_keeps_its_steps_per_second_whatever_a_frame_costs(monkeypatch):
+    """A clock the test moves: frames of 0.1 s, 0.25 s and 1/60 s all give 60 steps a
+    second; a frame that hung for 2 s steps a quarter second's worth and leaves no backlog."""
+    now = [50.0]
+    monkeypatch.setattr(viz.interactive, "perf_counter", lambda: now[0])
+    dragger = viz.Dragger(gallery.mesh(), steps_per_second=60.0)
+
+    def steps_over(frame_times):
+        before = dragger.sim.step_count
+        for frame_time in frame_times:
+            now[0] += frame_time
+            dragger.advance()
+        return dragger.sim.step_count - before
+
+    assert steps_over([0.0]) == 1  # the first frame
+    assert steps_over([0.1] * 10) in (59, 60, 61)
+    assert steps_over([0.25] * 4) in (59, 60, 61)
+    assert steps_over([1 / 60] * 60) in (59, 60, 61)
+    assert steps_over([2.0]) == 15
+    assert steps_over([0.1]) == 6
