@@ -28,6 +28,7 @@
 
 # %%
 import importlib.util
+from collections.abc import Callable
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -149,12 +150,13 @@ HTML(viz.to_html(run, max_frames=60, time_unit="frames"))
 # let go, it keeps the hand's velocity, not the spring forces it held against
 # (the page set the position only, so a released particle flung away).
 
+
 # %%
-sim = gallery.mesh()
-if importlib.util.find_spec("ipympl"):
-    get_ipython().run_line_magic("matplotlib", "widget")
-    dragger = viz.show(sim, steps_per_second=60)  # the page's pace
-else:
+def drag_corner(
+    sim: msd.Simulation, shift: np.ndarray, frames: int
+) -> Callable[[msd.Simulation], None]:
+    """A callback for ``sim.run`` that holds the mesh's top-right corner, moves it by
+    ``shift`` (px) over ``frames`` frames and then lets go."""
     corner = int(np.argmax(sim.body.positions.sum(axis=1)))
     grab = msd.Grab()
     sim.constraints.append(grab)
@@ -162,12 +164,20 @@ else:
     start = sim.body.positions[corner].copy()
 
     def hand(sim: msd.Simulation) -> None:
-        """Pull the corner 150 px to the left in 60 frames, then let go."""
-        if sim.step_count < 60:
-            grab.move(start + sim.step_count / 60 * np.array([-150.0, 0.0]))
+        if sim.step_count <= frames:
+            grab.move(start + sim.step_count / frames * shift)
         elif grab.particle is not None:
             grab.release()
 
+    return hand
+
+
+sim = gallery.mesh()
+if importlib.util.find_spec("ipympl"):
+    get_ipython().run_line_magic("matplotlib", "widget")
+    dragger = viz.show(sim, steps_per_second=60)  # the page's pace
+else:
+    hand = drag_corner(sim, np.array([-150.0, 0.0]), frames=60)
     run = sim.run(steps=240, record_every=3, callback=hand)
     print("ipympl is not installed: a scripted drag instead of the mouse")
     display(HTML(viz.to_html(run, max_frames=60, time_unit="frames")))
@@ -209,18 +219,7 @@ def pull_and_let_go(pull: float, frames: int) -> msd.Simulation:
     """The mesh (no gravity) after its top-right corner is moved ``pull`` px left and down
     in ``frames`` frames, let go, and left to settle for 600 frames in all."""
     sim = gallery.mesh(gravity=0.0)
-    corner = int(np.argmax(sim.body.positions.sum(axis=1)))
-    grab = msd.Grab()
-    sim.constraints.append(grab)
-    grab.hold(sim.body, corner)
-    start = sim.body.positions[corner].copy()
-
-    def hand(sim: msd.Simulation) -> None:
-        if sim.step_count <= frames:
-            grab.move(start - sim.step_count / frames * np.array([pull, pull]))
-        elif grab.particle is not None:
-            grab.release()
-
+    hand = drag_corner(sim, np.array([-pull, -pull]), frames)
     sim.run(steps=600, record_every=600, callback=hand)
     return sim
 
