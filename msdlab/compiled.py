@@ -16,9 +16,12 @@ Grid bodies (`msdlab.stencil`) whose springs share their values per offset
 are gathered instead: each particle sums the forces of its neighbours by grid
 offset, on positions copied by coordinate so that the inner loop walks
 contiguous memory on vector registers, over blocks of whole grid rows (those
-whose neighbour would leave its row masked out); the threads split the blocks
-and write only their own particles. Each spring is then computed from both ends, with
-the same `equations.spring_force`; the two ways agree to rounding.
+whose neighbour would leave its row masked out), three offsets at a time (a
+particle's position is read and its force written once for three springs);
+the threads split the blocks and write only their own particles. Each spring
+is then computed from both ends, with the same `equations.spring_force`; the
+two ways agree to rounding. Square roots and divisions bound the gather, so
+each spring costs one of each per end.
 
 `NumbaKernel.advance` compiles an integrator's update function (for example
 `integrators.verlet_update`) into one loop over the particles that computes
@@ -75,13 +78,14 @@ def _add_spring_forces(x, v, a, b, k, rest, c, first, stop, out):
             stretch = length / rest[s]
         if length == 0.0:  # coincident ends: no direction, no force
             continue
-        closing = 0.0
+        rate = 0.0
         if c[s] != 0.0:
             closing = (v[i, 0] - v[j, 0]) * d0 + (v[i, 1] - v[j, 1]) * d1
             if three:
                 closing += (v[i, 2] - v[j, 2]) * d2
-            power += _dashpot_power_of(c[s], closing / length)
-        scale = _spring_force(k[s], rest[s], length, c[s], closing) / length
+            rate = closing / length
+            power += _dashpot_power_of(c[s], rate)
+        scale = _spring_force(k[s], rest[s], length, c[s], rate) / length
         out[i, 0] += scale * d0
         out[j, 0] -= scale * d0
         out[i, 1] += scale * d1
@@ -127,152 +131,214 @@ def _spring_forces_parallel(x, v, a, b, k, rest, c, partial, out):
 
 
 @numba.njit(cache=True, inline="always", error_model="numpy")
-def _gather_offset(xs, vs, fs, squared, columns, base, k, rest, c, first, stop, shift):
-    """Add to particles ``first`` to ``stop - 1`` the force of their spring to p + ``shift``.
+def _pull(y0, y1, y2, x0, x1, x2, q, there, k, rest):
+    """Force (N, 3 components) on a particle at y from its spring to particle ``q``, times
+    ``there`` (1, or 0 when that neighbour does not exist), and the squared length (m²).
+
+    f of eq. (1.2) along d = y - x_q, whichever end of the spring the particle is.
+    """
+    d0, d1, d2 = y0 - x0[q], y1 - x1[q], y2 - x2[q]
+    length_squared = d0 * d0 + d1 * d1 + d2 * d2
+    length = math.sqrt(length_squared)
+    safe = length if length > 0.0 else 1.0  # coincident ends: no direction, no force
+    scale = there * _spring_force(k, rest, safe, 0.0, 0.0) / safe
+    scale = scale if length > 0.0 else 0.0
+    return scale * d0, scale * d1, scale * d2, there * length_squared
+
+
+@numba.njit(cache=True, inline="always", error_model="numpy")
+def _pull_damped(y0, y1, y2, u0, u1, u2, xs, vs, q, there, k, rest, c):
+    """`_pull` with the dashpot c (N·s/m) on velocities u and vs; also returns its power (W)."""
+    x0, x1, x2 = xs
+    v0, v1, v2 = vs
+    d0, d1, d2 = y0 - x0[q], y1 - x1[q], y2 - x2[q]
+    length_squared = d0 * d0 + d1 * d1 + d2 * d2
+    length = math.sqrt(length_squared)
+    safe = length if length > 0.0 else 1.0
+    rate = ((u0 - v0[q]) * d0 + (u1 - v1[q]) * d1 + (u2 - v2[q]) * d2) / safe
+    power = there * _dashpot_power_of(c, rate)
+    scale = there * _spring_force(k, rest, safe, c, rate) / safe
+    scale = scale if length > 0.0 else 0.0
+    return scale * d0, scale * d1, scale * d2, there * length_squared, power
+
+
+@numba.njit(cache=True, inline="always", error_model="numpy")
+def _gather_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, values):
+    """Add to particles ``first`` to ``stop - 1`` the forces of their springs to three
+    neighbours, at p + ``shifts[j]``, the same grid row offset apart.
 
     ``xs``, ``vs``, ``fs`` are positions, velocities and forces by coordinate,
-    3 contiguous arrays each, so the loop runs on vector registers: d = x_p - x_q
-    and p gets f(|d|)·d/|d|, f of eq. (1.2) plus the dashpot, whichever end of
-    the spring p is (the spring computes the same f for both ends).
-    ``columns[p - base]`` is 1 where p has this neighbour and 0 where the
-    offset leaves p's grid row (p then gets no force). Each |d|² goes to
-    ``squared`` (a running maximum would keep the loop scalar); returns the
-    dashpot power of these springs. Indices are unsigned: numba then needs no
-    negative-index test, which would also keep the loop scalar.
+    contiguous, so the loop runs on vector registers; a particle's position
+    is read and its force written once for three springs. ``columns[masks[j], p - first]``
+    is 1 where p has neighbour j, 0 where it would leave p's grid row.
+    ``values[j]`` (3, 4) holds the spring's stiffness, rest length, dashpot and
+    1/rest²; ``squared[p]`` keeps the largest |d|²/l² seen (a running maximum
+    would keep the loop scalar). Returns the dashpot power (W) of these
+    springs; with dashpots the loop stays scalar. Indices are unsigned: numba
+    then needs no negative-index test, which would also keep the loop scalar.
     """
     x0, x1, x2 = xs
     f0, f1, f2 = fs
+    ma, mb, mc = masks  # rows of `columns`
+    sa, sb, sc = shifts
+    ka, ra, ca, wa = values[0, 0], values[0, 1], values[0, 2], values[0, 3]
+    kb, rb, cb, wb = values[1, 0], values[1, 1], values[1, 2], values[1, 3]
+    kc, rc, cc, wc = values[2, 0], values[2, 1], values[2, 2], values[2, 3]
     power = 0.0
-    if c == 0.0:  # two loops, so that the one without dashpots has no sum across springs
+    if ca == 0.0 and cb == 0.0 and cc == 0.0:  # no sum across springs: vector registers
         for i in range(first, stop):
-            p, q = numba.uint64(i), numba.uint64(i + shift)
-            there = columns[numba.uint64(i - base)]
-            d0, d1, d2 = x0[p] - x0[q], x1[p] - x1[q], x2[p] - x2[q]
-            length_squared = d0 * d0 + d1 * d1 + d2 * d2
-            squared[p] = there * length_squared
-            length = math.sqrt(length_squared)
-            safe = length if length > 0.0 else 1.0  # coincident ends: no direction, no force
-            scale = there * _spring_force(k, rest, safe, 0.0, 0.0) / safe
-            scale = scale if length > 0.0 else 0.0
-            f0[p] += scale * d0
-            f1[p] += scale * d1
-            f2[p] += scale * d2
+            p, r = numba.uint64(i), numba.uint64(i - first)
+            y0, y1, y2 = x0[p], x1[p], x2[p]
+            a0, a1, a2, la = _pull(
+                y0, y1, y2, x0, x1, x2, numba.uint64(i + sa), columns[ma, r], ka, ra
+            )
+            b0, b1, b2, lb = _pull(
+                y0, y1, y2, x0, x1, x2, numba.uint64(i + sb), columns[mb, r], kb, rb
+            )
+            c0, c1, c2, lc = _pull(
+                y0, y1, y2, x0, x1, x2, numba.uint64(i + sc), columns[mc, r], kc, rc
+            )
+            f0[p] += a0 + b0 + c0
+            f1[p] += a1 + b1 + c1
+            f2[p] += a2 + b2 + c2
+            squared[p] = max(squared[p], la * wa, lb * wb, lc * wc)
         return power
     v0, v1, v2 = vs
     for i in range(first, stop):
-        p, q = numba.uint64(i), numba.uint64(i + shift)
-        there = columns[numba.uint64(i - base)]
-        d0, d1, d2 = x0[p] - x0[q], x1[p] - x1[q], x2[p] - x2[q]
-        length_squared = d0 * d0 + d1 * d1 + d2 * d2
-        squared[p] = there * length_squared
-        length = math.sqrt(length_squared)
-        safe = length if length > 0.0 else 1.0
-        closing = (v0[p] - v0[q]) * d0 + (v1[p] - v1[q]) * d1 + (v2[p] - v2[q]) * d2
-        power += there * _dashpot_power_of(c, closing / safe)
-        scale = there * _spring_force(k, rest, safe, c, closing) / safe
-        scale = scale if length > 0.0 else 0.0
-        f0[p] += scale * d0
-        f1[p] += scale * d1
-        f2[p] += scale * d2
+        p, r = numba.uint64(i), numba.uint64(i - first)
+        y0, y1, y2, u0, u1, u2 = x0[p], x1[p], x2[p], v0[p], v1[p], v2[p]
+        q = numba.uint64(i + sa)
+        a0, a1, a2, la, pa = _pull_damped(
+            y0, y1, y2, u0, u1, u2, xs, vs, q, columns[ma, r], ka, ra, ca
+        )
+        q = numba.uint64(i + sb)
+        b0, b1, b2, lb, pb = _pull_damped(
+            y0, y1, y2, u0, u1, u2, xs, vs, q, columns[mb, r], kb, rb, cb
+        )
+        q = numba.uint64(i + sc)
+        c0, c1, c2, lc, pc = _pull_damped(
+            y0, y1, y2, u0, u1, u2, xs, vs, q, columns[mc, r], kc, rc, cc
+        )
+        f0[p] += a0 + b0 + c0
+        f1[p] += a1 + b1 + c1
+        f2[p] += a2 + b2 + c2
+        squared[p] = max(squared[p], la * wa, lb * wb, lc * wc)
+        power += pa + pb + pc
     return power
 
 
 @numba.njit(cache=True, inline="always", error_model="numpy")
-def _gather_block(scratch, columns, shape, offsets, k, rest, c, block, rows, out):
+def _gather_block(scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, block, out):
     """Add to ``out`` (N, d) the spring forces on the particles of grid block ``block``:
     ``rows`` consecutive rows of one plane (the plane's last block may hold fewer).
 
-    ``scratch`` (10, N) holds the positions, velocities and forces by
-    coordinate and the squared lengths. For each stencil offset ±o the rows
-    whose neighbours exist are consecutive, so the inner loop runs over all
-    of them at once; ``columns[r + o_2]`` masks the particles whose neighbour
-    would be past the end of their row (see `_column_masks`). Returns the
-    largest stretch |d|/l and half the dashpot power of the springs met (each
-    spring is met from both ends).
+    ``scratch`` (10, N + 2·pad) holds the positions, velocities and forces by
+    coordinate and the squared stretches, particle p at p + pad (the padding
+    stays zero, so a masked neighbour past either end is still in memory).
+    Triple t joins each particle to its neighbours at the offsets
+    (``triples[t]``, ``o2s[t, j]``), j = 0, 1, 2, with the spring values
+    ``values[t, j]`` (see `_stencil_triples`); for each, the rows whose
+    neighbours exist are consecutive, so the inner loop runs over all of them
+    at once, and ``columns[rows_of[t, j]]`` masks the particles whose
+    neighbour would be past the end of their row (see `_column_masks`).
+    Returns the largest stretch |d|/l and half the dashpot power of the
+    springs met (each spring is met from both ends).
     """
     xs = (scratch[0], scratch[1], scratch[2])
     vs = (scratch[3], scratch[4], scratch[5])
     fs = (scratch[6], scratch[7], scratch[8])
     squared = scratch[9]
     n0, n1, n2 = shape[0], shape[1], shape[2]
-    reach = (len(columns) - 1) // 2
     per_plane = (n1 + rows - 1) // rows
     plane, row_lo = block // per_plane, (block % per_plane) * rows
     row_hi = min(row_lo + rows, n1)
-    start, end = (plane * n1 + row_lo) * n2, (plane * n1 + row_hi) * n2
-    f0, f1, f2 = fs
+    start, end = (plane * n1 + row_lo) * n2 + pad, (plane * n1 + row_hi) * n2 + pad
     for p in range(start, end):
-        f0[p] = f1[p] = f2[p] = 0.0
-    stretch = 0.0
+        fs[0][p] = fs[1][p] = fs[2][p] = squared[p] = 0.0
     power = 0.0
-    for m in range(len(offsets)):
-        for sign in (1, -1):
-            o0, o1, o2 = sign * offsets[m, 0], sign * offsets[m, 1], sign * offsets[m, 2]
-            lo, hi = max(row_lo, -o1), min(row_hi, n1 - o1)  # rows whose neighbours exist
-            if not (0 <= plane + o0 < n0 and lo < hi):
-                continue
-            shift = (o0 * n1 + o1) * n2 + o2
-            base = (plane * n1 + lo) * n2
-            # the first and last particles masked out may have no neighbour in memory at all
-            first, stop = max(base, -shift), min((plane * n1 + hi) * n2, n0 * n1 * n2 - shift)
-            power += 0.5 * _gather_offset(
-                xs,
-                vs,
-                fs,
-                squared,
-                columns[o2 + reach],
-                base,
-                k[m],
-                rest[m],
-                c[m],
-                first,
-                stop,
-                shift,
-            )
-            if sign == 1:  # -o meets the same springs from their other end
-                longest = squared[first:stop].max()
-                stretch = max(stretch, math.sqrt(longest) / rest[m])
+    for t in range(len(triples)):
+        o0, o1 = triples[t, 0], triples[t, 1]
+        lo, hi = max(row_lo, -o1), min(row_hi, n1 - o1)  # rows whose neighbours exist
+        if not (0 <= plane + o0 < n0 and lo < hi):
+            continue
+        shift = (o0 * n1 + o1) * n2
+        first, stop = (plane * n1 + lo) * n2 + pad, (plane * n1 + hi) * n2 + pad
+        masks = (rows_of[t, 0], rows_of[t, 1], rows_of[t, 2])
+        shifts = (shift + o2s[t, 0], shift + o2s[t, 1], shift + o2s[t, 2])
+        power += 0.5 * _gather_three(
+            xs, vs, fs, squared, columns, masks, first, stop, shifts, values[t]
+        )
     for p in range(start, end):
         for q in range(out.shape[1]):
-            out[p, q] += fs[q][p]
-    return stretch, power
+            out[p - pad, q] += fs[q][p]
+    return math.sqrt(squared[start:end].max()), power
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _gather_serial(x, v, shape, offsets, k, rest, c, columns, rows, scratch, out):
+def _gather_serial(x, v, shape, triples, rows_of, o2s, values, columns, rows, scratch, out):
     """One thread: `_gather_block` for every block; return (largest stretch, dashpot power)."""
-    damped = np.any(c != 0.0)
+    pad = (scratch.shape[1] - len(x)) // 2
+    damped = np.any(values[:, :, 2] != 0.0)
     for q in range(x.shape[1]):
-        scratch[q] = x[:, q]
+        scratch[q, pad : pad + len(x)] = x[:, q]
         if damped:
-            scratch[3 + q] = v[:, q]
+            scratch[3 + q, pad : pad + len(x)] = v[:, q]
     stretch = 0.0
     power = 0.0
     blocks = shape[0] * ((shape[1] + rows - 1) // rows)
     for block in range(blocks):
-        sums = _gather_block(scratch, columns, shape, offsets, k, rest, c, block, rows, out)
+        sums = _gather_block(
+            scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, block, out
+        )
         stretch = max(stretch, sums[0])
         power += sums[1]
     return stretch, power
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
-def _gather_parallel(x, v, shape, offsets, k, rest, c, columns, rows, scratch, out):
+def _gather_parallel(x, v, shape, triples, rows_of, o2s, values, columns, rows, scratch, out):
     """Threads: blocks split between them, each writing only its own particles' forces."""
-    damped = np.any(c != 0.0)
+    pad = (scratch.shape[1] - len(x)) // 2
+    damped = np.any(values[:, :, 2] != 0.0)
     for p in numba.prange(len(x)):
         for q in range(x.shape[1]):
-            scratch[q, p] = x[p, q]
+            scratch[q, p + pad] = x[p, q]
             if damped:
-                scratch[3 + q, p] = v[p, q]
+                scratch[3 + q, p + pad] = v[p, q]
     blocks = shape[0] * ((shape[1] + rows - 1) // rows)
     stretches = np.zeros(blocks)
     powers = np.zeros(blocks)
     for block in numba.prange(blocks):
         stretches[block], powers[block] = _gather_block(
-            scratch, columns, shape, offsets, k, rest, c, block, rows, out
+            scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, block, out
         )
     return stretches.max(), powers.sum()
+
+
+def _stencil_triples(offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The stencil's offsets ±o grouped by their first two coordinates, three at a time.
+
+    Returns (triples, members, o2s): triple t joins each particle to those at
+    (``triples[t]``, ``o2s[t, j]``), j = 0, 1, 2, by the springs of offset
+    block ``members[t, j]``; -1 marks an empty place (no spring).
+    """
+    groups: dict[tuple[int, int], list[tuple[int, int]]] = {}
+    for m, (o0, o1, o2) in enumerate(offsets.tolist()):
+        for sign in (1, -1):
+            groups.setdefault((sign * o0, sign * o1), []).append((sign * o2, m))
+    triples, members, o2s = [], [], []
+    for (o0, o1), group in sorted(groups.items()):
+        group.sort()
+        group += [(0, -1)] * (-len(group) % 3)
+        for first in range(0, len(group), 3):
+            triples.append((o0, o1))
+            o2s.append([o2 for o2, _ in group[first : first + 3]])
+            members.append([m for _, m in group[first : first + 3]])
+    return (
+        np.array(triples, dtype=np.int64).reshape(-1, 2),
+        np.array(members, dtype=np.int64).reshape(-1, 3),
+        np.array(o2s, dtype=np.int64).reshape(-1, 3),
+    )
 
 
 def _column_masks(shape: np.ndarray, offsets: np.ndarray) -> tuple[np.ndarray, int]:
@@ -281,14 +347,24 @@ def _column_masks(shape: np.ndarray, offsets: np.ndarray) -> tuple[np.ndarray, i
     Returns (masks, rows): ``masks[r + o_2]`` (rows · n_2,) is 1 where column
     c + o_2 exists, for a block of ``rows`` rows of the grid, long enough
     (about ``GATHER_BLOCK`` particles) for the loops over a block to cost
-    little more than their arithmetic.
+    little more than their arithmetic; the last mask, all 0, is for no spring.
     """
     n1, n2 = int(shape[1]), int(shape[2])
     rows = max(1, min(n1, GATHER_BLOCK // n2))
     reach = int(np.abs(offsets[:, 2]).max(initial=0))
     column = np.arange(n2)
     masks = [np.tile((column + o >= 0) & (column + o < n2), rows) for o in range(-reach, reach + 1)]
-    return np.array(masks, dtype=float), rows
+    return np.array([*masks, np.zeros(rows * n2, dtype=bool)], dtype=float), rows
+
+
+def _triple_values(values: np.ndarray, members: np.ndarray) -> np.ndarray:
+    """Stiffness, rest length, dashpot and 1/rest² (T, 3, 4) of the springs of each triple
+    (`_stencil_triples`), from the values (3, M) of each offset block; 0 for no spring."""
+    k, rest, c = values[:, members]
+    with np.errstate(divide="ignore"):
+        table = np.stack([k, rest, c, 1.0 / rest**2], axis=-1)
+    table[members < 0] = 0.0
+    return table
 
 
 @numba.njit(cache=True)
@@ -449,7 +525,10 @@ class NumbaKernel:
         self._stencil: GridStencil | None = None
         self._stencil_values = np.zeros((3, 0))
         self._columns = (np.ones((1, 0)), 1)  # see `_column_masks`
-        self._scratch = np.zeros((10, 0))  # x, v, forces by coordinate and squared lengths
+        self._triples: tuple[np.ndarray, ...] = ()  # see `_stencil_triples`, and mask rows
+        self._triple_values = np.zeros((0, 3, 4))
+        self._scratch = np.zeros((10, 0))  # see `_gather_block`
+        self._pad = 0
         self._values_version = -1
         self._uniform = False
         self._order: np.ndarray | None = None
@@ -474,18 +553,18 @@ class NumbaKernel:
             stencil = self.grid_stencil(body)
             if stencil is not None:
                 gather = _gather_parallel if self._parallel(body) else _gather_serial
-                if self._scratch.shape != (10, len(x)):
-                    self._scratch = np.zeros((10, len(x)))  # 2-D bodies keep x2 = v2 = 0
-                k, rest, c = self._stencil_values
+                if self._scratch.shape != (10, len(x) + 2 * self._pad):
+                    self._scratch = np.zeros((10, len(x) + 2 * self._pad))  # 2-D: x2 = v2 = 0
+                triples, _, o2s, rows_of = self._triples
                 columns, rows = self._columns
                 return gather(
                     x,
                     v,
                     stencil.shape,
-                    stencil.offsets,
-                    k,
-                    rest,
-                    c,
+                    triples,
+                    rows_of,
+                    o2s,
+                    self._triple_values,
                     columns,
                     rows,
                     self._scratch,
@@ -514,6 +593,11 @@ class NumbaKernel:
             blocks = 0 if self._stencil is None else len(self._stencil.offsets)
             if self._stencil is not None:
                 self._columns = _column_masks(self._stencil.shape, self._stencil.offsets)
+                triples, members, o2s = _stencil_triples(self._stencil.offsets)
+                self._pad = int(np.abs(o2s).max(initial=0))
+                no_spring = len(self._columns[0]) - 1  # the all-zero mask
+                rows_of = np.where(members >= 0, o2s + self._pad, no_spring)
+                self._triples = (triples, members, o2s, rows_of)
             self._stencil_values = np.zeros((3, blocks))
             self._stencil_version = body.topology_version
             self._values_version = -1
@@ -523,6 +607,8 @@ class NumbaKernel:
         if body.parameters_version != self._values_version or _shared(values):
             self._uniform = _uniform_blocks(*values, self._stencil.starts, self._stencil_values)
             self._values_version = body.parameters_version
+            if self._uniform:
+                self._triple_values = _triple_values(self._stencil_values, self._triples[1])
         return self._stencil if self._uniform else None
 
     def _parallel(self, body: Body) -> bool:

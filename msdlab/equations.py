@@ -16,18 +16,18 @@ import numpy as np
 
 
 def spring_force(
-    stiffness: float, rest: float, length: float, damping: float, closing: float
+    stiffness: float, rest: float, length: float, damping: float, rate: float
 ) -> float:
     """Force (N) along a spring on its end ``a``, eq. (1.2) plus the dashpot.
 
-    ``closing`` is (v_a - v_b)·(x_a - x_b), so ``closing / length`` is the rate
-    (m/s) at which the spring lengthens. Positive pushes ``a`` away from ``b``::
+    ``rate`` ṡ = (v_a - v_b)·n (m/s) is how fast the spring lengthens (0 without
+    a dashpot). Positive pushes ``a`` away from ``b``::
 
-        f = k (l - |x_a - x_b|) - c (v_a - v_b)·n,   n = (x_a - x_b) / |x_a - x_b|
+        f = k (l - |x_a - x_b|) - c ṡ,   n = (x_a - x_b) / |x_a - x_b|
 
     The force vector on ``a`` is f·n and ``b`` feels -f·n (eq. 1.1 sums them).
     """
-    return stiffness * (rest - length) - damping * closing / length
+    return stiffness * (rest - length) - damping * rate
 
 
 def spring_energy(stiffness: float, rest: float, length: float) -> float:

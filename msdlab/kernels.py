@@ -67,12 +67,11 @@ def _spring_forces_and_power(
     length = np.sqrt(np.einsum("ij,ij->i", d, d))
     safe = np.where(length > 0, length, np.inf)  # coincident ends: no direction, no force
     power = 0.0
-    closing = 0.0
+    rate = 0.0
     if np.any(damping):
-        closing = np.einsum("ij,ij->i", v[a] - v[b], d)
-        power = float(np.sum(equations.dashpot_power(damping, closing / safe)))
-    with np.errstate(divide="ignore", invalid="ignore"):  # coincident ends, masked below
-        magnitude = equations.spring_force(stiffness, rest, length, damping, closing)
+        rate = np.einsum("ij,ij->i", v[a] - v[b], d) / safe
+        power = float(np.sum(equations.dashpot_power(damping, rate)))
+    magnitude = equations.spring_force(stiffness, rest, length, damping, rate)
     f = np.where(length > 0, magnitude / safe, 0.0)[:, None] * d
     if out is None:
         out = np.zeros_like(x)

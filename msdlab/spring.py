@@ -82,10 +82,8 @@ class Spring(Bound):
         length = math.dist(x_a, x_b)
         if length == 0.0:  # coincident ends: no direction, no force
             return np.zeros_like(x_a)
-        closing = float(np.dot(v_a - v_b, x_a - x_b))
-        along = equations.spring_force(
-            self.stiffness, self.rest_length, length, self.damping, closing
-        )
+        rate = float(np.dot(v_a - v_b, x_a - x_b)) / length
+        along = equations.spring_force(self.stiffness, self.rest_length, length, self.damping, rate)
         return along * (x_a - x_b) / length
 
     def energy(self) -> float:
