@@ -39,11 +39,11 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from msdlab import viz  # noqa: E402
-from msdlab.scenes import get_scene  # noqa: E402
-from msdlab.simulation import Trajectory  # noqa: E402
+from msdlab import viz
+from msdlab.scenes import get_scene
+from msdlab.simulation import Trajectory
 
 FRAMES = 100
 FORMATS = (".gif", ".html")

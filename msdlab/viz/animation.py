@@ -26,7 +26,8 @@ from ..simulation import Trajectory
 from .view import BodyView, check_colour, new_axes, rim_height, sags, strains
 
 FORMATS = (".gif", ".mp4", ".html")
-PALETTE_COLOURS = 64  # colours per frame image: plenty for coloured lines on white
+PALETTE_COLOURS = 255  # of the frames' shared palette (GIF's 256 less one for transparency)
+PALETTE_SAMPLES = 5  # frames the palette is made from
 
 
 def check_format(path: str | Path) -> str:
@@ -71,7 +72,11 @@ class _Movie:
     draw: object  # Callable[[int], list[Artist]]
 
     def images(self, dpi: float) -> Iterator[Image.Image]:
-        """Each frame as a palette image, drawn by blitting onto the still background."""
+        """Each frame as a palette image, drawn by blitting onto the still background.
+
+        All frames share one palette, made from a few frames spread over the
+        animation (drawn first and kept), so a colour that shows up late has its own.
+        """
         self.figure.set_dpi(dpi)
         canvas = self.figure.canvas
         changing: list[Artist] = self.draw(0)
@@ -79,17 +84,28 @@ class _Movie:
             artist.set_animated(True)
         canvas.draw()  # the background: axes, ticks, colour bar
         background = canvas.copy_from_bbox(self.figure.bbox)
-        for i in range(self.count):
+
+        def rgb(i: int) -> Image.Image:
             canvas.restore_region(background)
             for artist in self.draw(i):
                 artist.set_animated(True)
                 if hasattr(artist, "do_3d_projection"):  # what Axes3D.draw would do
                     artist.do_3d_projection()
                 self.figure.draw_artist(artist)
-            rgba = np.asarray(canvas.buffer_rgba())
-            yield Image.fromarray(rgba[..., :3]).quantize(
-                PALETTE_COLOURS, Image.Quantize.FASTOCTREE
-            )
+            return Image.fromarray(np.asarray(canvas.buffer_rgba())).convert("RGB")
+
+        picks = np.linspace(0, self.count - 1, min(self.count, PALETTE_SAMPLES)).astype(int)
+        samples = {int(i): rgb(int(i)) for i in np.unique(picks)}
+        palette = shared_palette(list(samples.values()))
+        for i in range(self.count):
+            image = samples.pop(i) if i in samples else rgb(i)
+            yield image.quantize(palette=palette, dither=Image.Dither.NONE)
+
+
+def shared_palette(images: Sequence[Image.Image]) -> Image.Image:
+    """A palette image of ``PALETTE_COLOURS`` colours for all of ``images`` (RGB, same width)."""
+    stack = np.concatenate([np.asarray(image) for image in images])
+    return Image.fromarray(stack).quantize(PALETTE_COLOURS, Image.Quantize.FASTOCTREE)
 
 
 def animate(
