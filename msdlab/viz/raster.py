@@ -62,7 +62,7 @@ def _paint(image, segments, starts, colours, width, clip, coverage, touched):
                             mean = (gb - ga) / (b - a)
                         amount += mean if side > 0.0 else -mean
                     amount *= right - left
-                    if amount > 0.0:
+                    if amount > 1e-6:  # less is invisible, and a float32 holds it
                         index = i * wide + j if steep else j * wide + i
                         if coverage[index] == 0.0:
                             touched[count] = index
