@@ -156,17 +156,21 @@ class BodyView:
         return strains(self.body, positions)
 
     def update(self, positions: np.ndarray) -> list:
-        """Redraw for ``positions`` (N, d); return the changed artists."""
+        """Redraw for ``positions`` (N, d); return the changed artists (not the dots of
+        an empty set of particles: none fixed, or all)."""
         self.springs.set_springs(self._segments(positions), self.values(positions))
+        changed = [self.springs]
         for artist, mask in ((self.free, ~self.body.fixed), (self.pinned, self.body.fixed)):
             if self.is_3d:
                 artist.set_data_3d(*positions[mask].T)
             else:
                 artist.set_data(*positions[mask].T)
+            if mask.any():
+                changed.append(artist)
         for ball in self.balls:
             ball.remove()
         self.balls = [self._ball(positions[p], r) for p, r in self.spheres]
-        return [self.springs, self.free, self.pinned, *self.balls]
+        return [*changed, *self.balls]
 
     def fit(self, frames: np.ndarray, margin: float = 0.05, thinnest: float = 0.2) -> None:
         """Set the limits to hold every position of ``frames`` (F, N, d) at equal scales.
