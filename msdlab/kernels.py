@@ -159,9 +159,9 @@ def spring_jacobians(
     transverse = np.maximum(0.0, 1.0 - rest / safe)
     eye = np.eye(dim)[None]
     stiff = stiffness[:, None, None] * (outer + transverse[:, None, None] * (eye - outer))
-    damp = damping[:, None, None] * outer
-    jx, jv = pattern.matrices(stiff, damp)
-    return jx, jv
+    if not np.any(damping):  # no dashpots: ∂F/∂v is zero, with no entries to add up
+        return pattern.matrices(stiff)[0], sp.csr_matrix(pattern.shape)
+    return tuple(pattern.matrices(stiff, damping[:, None, None] * outer))
 
 
 def _block_indices(a: np.ndarray, b: np.ndarray, dim: int) -> tuple[np.ndarray, np.ndarray]:
