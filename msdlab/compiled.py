@@ -466,11 +466,11 @@ def _compile_advance(update: Callable, threads: bool) -> Callable:
     scalar = numba.njit(update)
 
     @numba.njit(parallel=threads)
-    def advance(x, v, forces, masses, fixed, dt, coefficients, x_new, v_new):
+    def advance(x, v, forces, field, masses, fixed, dt, coefficients, x_new, v_new):
         for i in numba.prange(len(masses)):
             inverse = _inverse_mass(masses[i], not fixed[i])
             for q in range(x.shape[1]):
-                a = _acceleration(forces[i, q], inverse)
+                a = _acceleration(forces[i, q] + masses[i] * field[q], inverse)
                 x_new[i, q], v_new[i, q] = scalar(x[i, q], v[i, q], a, dt, *coefficients)
 
     return advance
@@ -645,10 +645,12 @@ class NumbaKernel:
         x: np.ndarray,
         v: np.ndarray,
         forces: np.ndarray,
+        field: np.ndarray,
         dt: float,
         coefficients: tuple[float, ...],
     ) -> tuple[np.ndarray, np.ndarray]:
-        """``update(x, v, a, dt, *coefficients)`` with a = F/m (0 if fixed), in one loop.
+        """``update(x, v, a, dt, *coefficients)`` with a = (F + m·g)/m (0 if fixed),
+        g = ``field`` (d,) in m/s², in one loop.
 
         An update numba cannot compile warns once and runs on whole arrays.
         """
@@ -662,7 +664,9 @@ class NumbaKernel:
         if compiled is not None:
             x_new, v_new = np.empty_like(x), np.empty_like(v)
             try:
-                compiled(x, v, forces, body.masses, body.fixed, dt, coefficients, x_new, v_new)
+                compiled(
+                    x, v, forces, field, body.masses, body.fixed, dt, coefficients, x_new, v_new
+                )
                 return x_new, v_new
             except numba.core.errors.NumbaError as error:
                 _FAILED.add(update)
@@ -673,7 +677,8 @@ class NumbaKernel:
                     stacklevel=4,
                 )
         inverse = equations.inverse_mass(body.masses, ~body.fixed)
-        return update(x, v, equations.acceleration(forces, inverse[:, None]), dt, *coefficients)
+        a = equations.acceleration(forces + body.masses[:, None] * field, inverse[:, None])
+        return update(x, v, a, dt, *coefficients)
 
     def _edge_list(self, body: Body) -> tuple[np.ndarray, ...]:
         """Ends a, b and stiffness, rest length, dashpot of all springs, sorted by (a, b).

@@ -52,15 +52,28 @@ class Dynamics:
 
     def force(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Total force on each particle (N, d) in N."""
-        return self._add_forces(x, v, np.zeros_like(x))
+        total = np.zeros_like(x)
+        self._add_forces(x, v, total)
+        return total
 
-    def _add_forces(self, x: np.ndarray, v: np.ndarray, total: np.ndarray) -> np.ndarray:
-        """Add the spring, dashpot and external forces at (x, v) to ``total``; return it."""
+    def _add_forces(
+        self, x: np.ndarray, v: np.ndarray, total: np.ndarray, fields_apart: bool = False
+    ) -> np.ndarray:
+        """Add the spring, dashpot and external forces at (x, v) to ``total``.
+
+        With ``fields_apart`` the forces that are m·g on every particle
+        (`Force.uniform_acceleration`) are left out; returns the sum of their g (d,).
+        """
         self.max_stretch, power = self.springs.add_spring_forces(self.body, x, v, total, None)
         self._last_power = (x, v, power)
+        field = np.zeros(x.shape[1])
         for force in self.forces:
-            force.add_to(self.body, x, v, total)
-        return total
+            g = force.uniform_acceleration(self.body) if fields_apart else None
+            if g is None:
+                force.add_to(self.body, x, v, total)
+            else:
+                field += g
+        return field
 
     def acceleration(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Acceleration of each particle (N, d) in m/s²; zero for fixed particles."""
@@ -72,13 +85,14 @@ class Dynamics:
         """``update(x, v, a, dt, *coefficients)`` with a = `acceleration` (x, v): one step.
 
         ``update`` is a function of arrays or numbers (like `integrators.verlet_update`)
-        returning the new (x, v); the numba kernel compiles it into one loop with a = F/m.
+        returning the new (x, v); the numba kernel compiles it into one loop with
+        a = F/m + g, g the forces' `Force.uniform_acceleration` (gravity).
         """
         if self._buffer is None or self._buffer.shape != x.shape:
             self._buffer = np.empty_like(x)  # the forces, used up within this call
         self._buffer.fill(0.0)
-        forces = self._add_forces(x, v, self._buffer)
-        return self.springs.advance(update, self.body, x, v, forces, dt, coefficients)
+        field = self._add_forces(x, v, self._buffer, fields_apart=True)
+        return self.springs.advance(update, self.body, x, v, self._buffer, field, dt, coefficients)
 
     def forget_last_state(self) -> None:
         """Drop the dashpot power kept from the last force evaluation (the state changed)."""

@@ -39,6 +39,14 @@ class Force(ABC):
         """Power (W) this force takes out of the body; 0 for conservative forces."""
         return 0.0
 
+    def uniform_acceleration(self, body: Body) -> np.ndarray | None:
+        """The acceleration g (d,) in m/s² if this force is m·g on every particle, else None.
+
+        `Dynamics.advance` then adds g to F/m in the integrator's loop instead of
+        adding m·g to the forces in a pass of its own.
+        """
+        return None
+
     def jacobians(
         self, body: Body, x: np.ndarray, v: np.ndarray
     ) -> tuple[sp.spmatrix | None, sp.spmatrix | None]:
@@ -65,6 +73,9 @@ class Gravity(Force):
         for axis, g in enumerate(self.g):  # per axis: much faster than m[:, None] * g
             if g != 0.0:
                 out[:, axis] += g * body.masses
+
+    def uniform_acceleration(self, body: Body) -> np.ndarray:
+        return self.g
 
     def potential_energy(
         self, body: Body, x: np.ndarray, particles: np.ndarray | None = None

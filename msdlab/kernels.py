@@ -200,10 +200,12 @@ class SpringKernel(Protocol):
         x: np.ndarray,
         v: np.ndarray,
         forces: np.ndarray,
+        field: np.ndarray,
         dt: float,
         coefficients: tuple[float, ...],
     ) -> tuple[np.ndarray, np.ndarray]:
-        """``update(x, v, a, dt, *coefficients)`` with a = F/m (0 for fixed particles)."""
+        """``update(x, v, a, dt, *coefficients)`` with a = (F + m·g)/m, g = ``field`` (d,)
+        in m/s² (0 for fixed particles)."""
 
 
 class NumpyKernel:
@@ -243,11 +245,14 @@ class NumpyKernel:
         x: np.ndarray,
         v: np.ndarray,
         forces: np.ndarray,
+        field: np.ndarray,
         dt: float,
         coefficients: tuple[float, ...],
     ) -> tuple[np.ndarray, np.ndarray]:
-        """``update(x, v, a, dt, *coefficients)`` on whole arrays, a = F/m (0 if fixed)."""
-        return update(x, v, self.to_acceleration(body, forces), dt, *coefficients)
+        """``update(x, v, a, dt, *coefficients)`` on whole arrays, a = (F + m·g)/m (0 if
+        fixed), g = ``field`` (d,) in m/s²."""
+        total = forces + body.masses[:, None] * field if field.any() else forces
+        return update(x, v, self.to_acceleration(body, total), dt, *coefficients)
 
 
 def default_kernel() -> str:
