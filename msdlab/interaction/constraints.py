@@ -77,7 +77,8 @@ class Ground(Constraint):
             depth = self.height - state.x[:, axis[0]]  # much faster than a matrix product
         else:
             depth = self.height - state.x @ n
-        below = np.flatnonzero((depth > 0) & ~state.body.fixed)
+        below = np.flatnonzero(depth > 0)
+        below = below[~state.body.fixed[below]]  # fixed ones only among the few below
         if len(below) == 0:
             return 0.0
         x, v = state.x, state.v
