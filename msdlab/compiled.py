@@ -25,7 +25,8 @@ each spring costs one of each per end.
 
 `NumbaKernel.advance` compiles an integrator's update function (for example
 `integrators.verlet_update`) into one loop over the particles that computes
-a = F/m and the update together; it is compiled once per process and update.
+a = F/m (plus gravity's g) and the update together; it is compiled once per
+process and update.
 
 The spring loops are compiled on first use and cached on disk (``cache=True``),
 so compiling is paid once per machine and numba version. Set the number of
@@ -457,7 +458,7 @@ def _divide_by_masses(forces, masses, fixed):
 
 
 def _compile_advance(update: Callable, threads: bool) -> Callable:
-    """A loop over the particles doing a = F/m then ``update`` per coordinate.
+    """A loop over the particles doing a = (F + m·g)/m then ``update`` per coordinate.
 
     With ``threads`` the particles are split between the threads (each writes
     only its own rows). numba compiles it at its first call, which raises a
