@@ -162,6 +162,32 @@ def small_body_seconds(kernel: str, resting: bool, steps: int = 10_000) -> float
     return time.perf_counter() - start
 
 
+def resting_ledger_ratios(n: int = 20, repeats: int = 9, steps: int = 50) -> dict[str, list[float]]:
+    """Step time with the energy ledger over without it, median and range, for an n³ grid
+    with dashpots resting on the ground (gravity, ground), interleaved in batches."""
+    ratios = {}
+    for name, integrator in INTEGRATORS.items():
+        sims = []
+        for ledger in (True, False):
+            body = msd.Body.grid((n,) * 3, spacing=0.1, stiffness=200.0, neighbours=(1, 2, 3))
+            body.spring_damping[:] = 0.05
+            forces = [msd.Gravity(GRAVITY), msd.Ground()]
+            sim = msd.Simulation(body, integrator(), dt=DT, forces=forces, ledger=ledger)
+            sim.run(steps=300)  # settle onto the ground
+            sims.append(sim)
+        batches = []
+        for _ in range(repeats):
+            seconds = []
+            for sim in sims:
+                start = time.perf_counter()
+                for _ in range(steps):
+                    sim.step()
+                seconds.append(time.perf_counter() - start)
+            batches.append(seconds[0] / seconds[1])
+        ratios[name] = [float(np.median(batches)), min(batches), max(batches)]
+    return ratios
+
+
 def implicit_ms(n: int = 20, repeats: int = 5) -> float:
     """Median ms per `ImplicitEuler` step on an n³ grid with (1, 2, 3) (dt = 10 ms)."""
     body = make_grid(n)[0]
@@ -239,6 +265,7 @@ def main() -> None:
                 for where in ("in the air", "resting on the ground")
             }
             rows["implicit"] = implicit_ms()
+            rows["ledger"] = resting_ledger_ratios()
             print(json.dumps(rows))
         else:
             print(json.dumps(compare(args.n[0], layouts[0], args.repeats)))
@@ -266,6 +293,9 @@ def main() -> None:
     )
     small = child(["--small"])
     print(f"ImplicitEuler, 20³ grid with (1, 2, 3): {small.pop('implicit'):.0f} ms per step")
+    print("20³ grid with dashpots resting on the ground, a step with the ledger ÷ without:")
+    for name, (median, low, high) in small.pop("ledger").items():
+        print(f"  {name}: {median:.2f} ({low:.2f}–{high:.2f})")
     print("10 000 steps of a 2-D body (300 particles, 1 097 springs with dashpots, 3 fixed,")
     print("gravity, ground, drag, Verlet λ = 0.01), seconds:")
     for name, seconds in small.items():
