@@ -131,7 +131,7 @@ def _spring_forces_parallel(x, v, a, b, k, rest, c, partial, out):
     return stretches.max(), powers.sum()
 
 
-@numba.njit(cache=True, inline="always", error_model="numpy")
+@numba.njit(cache=True, error_model="numpy")
 def _pull(y0, y1, y2, x0, x1, x2, q, there, k, rest):
     """Force (N, 3 components) on a particle at y from its spring to particle ``q``, times
     ``there`` (1, or 0 when that neighbour does not exist), and the squared length (m²).
@@ -147,7 +147,7 @@ def _pull(y0, y1, y2, x0, x1, x2, q, there, k, rest):
     return scale * d0, scale * d1, scale * d2, there * length_squared
 
 
-@numba.njit(cache=True, inline="always", error_model="numpy")
+@numba.njit(cache=True, error_model="numpy")
 def _pull_damped(y0, y1, y2, u0, u1, u2, xs, vs, q, there, k, rest, c):
     """`_pull` with the dashpot c (N·s/m) on velocities u and vs; also returns its power (W)."""
     x0, x1, x2 = xs
@@ -163,7 +163,7 @@ def _pull_damped(y0, y1, y2, u0, u1, u2, xs, vs, q, there, k, rest, c):
     return scale * d0, scale * d1, scale * d2, there * length_squared, power
 
 
-@numba.njit(cache=True, inline="always", error_model="numpy")
+@numba.njit(cache=True, error_model="numpy")
 def _gather_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, values):
     """Add to particles ``first`` to ``stop - 1`` the forces of their springs to three
     neighbours, at p + ``shifts[j]``, the same grid row offset apart.
@@ -228,7 +228,7 @@ def _gather_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, valu
     return power
 
 
-@numba.njit(cache=True, inline="always", error_model="numpy")
+@numba.njit(cache=True, error_model="numpy")
 def _gather_block(scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, block, out):
     """Add to ``out`` (N, d) the spring forces on the particles of grid block ``block``:
     ``rows`` consecutive rows of one plane (the plane's last block may hold fewer).
