@@ -122,15 +122,19 @@ def grade(
         report_path = workspace / "report.json"
         command = [
             sys.executable, "-m", "pytest", str(workspace / "checks"), "-q", "--no-header",
-            "-p", "no:cacheprovider", "-p", "no:nbval", "-p", "msdlab.instructor.pytest_sandbox",
+            "-p", "no:cacheprovider", "-p", "msdlab.course.pytest_plugin",
+            "-p", "_hypothesis_pytestplugin", "-p", "msdlab.instructor.pytest_sandbox",
             "--confcutdir", str(workspace / "checks"),
             "--rootdir", str(workspace), "-o", "addopts=", "--impl", str(workspace / "submission"),
             "--sandbox", "--sandbox-timeout", str(call_timeout), "--sandbox-memory", str(memory_mb),
             "--msdlab-report", str(report_path),
             "--allow-delegation", ",".join(str(task) for task in allow_delegation),
         ]  # fmt: skip
-        # the checks' bodies are small: the numpy kernel spares each judge the JIT start-up
+        # the checks' bodies are small: the numpy kernel spares each judge the JIT start-up;
+        # only the plugins named above load (pytest's search of every installed package for
+        # plugins took half of the judge's start-up)
         environment = dict(os.environ, PYTHONDONTWRITEBYTECODE="1", MSDLAB_KERNEL="numpy")
+        environment["PYTEST_DISABLE_PLUGIN_AUTOLOAD"] = "1"
         environment["MSDLAB_SANDBOX_ISOLATION"] = isolation
         (workspace / "tmp").mkdir()  # the sandboxes' logs, removed with the workspace
         environment["TMPDIR"] = str(workspace / "tmp")
