@@ -85,7 +85,7 @@ class JudgeServer:
         return line.decode()
 
     def close(self) -> None:
-        """Stop the server (a judge it forked is not its child's group: it is left alone)."""
+        """Stop the server process (between submissions: no judge of it is running)."""
         if self.process is not None:
             with contextlib.suppress(ProcessLookupError):
                 self.process.kill()
