@@ -30,6 +30,7 @@ from pathlib import Path
 from ..course import TASKS
 from ..course.report import CheckReport
 from . import reference_cache
+from .judge_server import JudgeServer
 
 MAX_FILE_BYTES = 1_000_000
 FIRST_UID = 61000  # as root, sandboxes run as reserved user ids from here on
@@ -100,19 +101,22 @@ def grade(
     isolation: str = "namespace",
     allow_delegation: Sequence[int] = (),
     references: Path | None = None,
+    server: JudgeServer | None = None,
 ) -> Grade:
     """Grade one submission with the checks in ``checks`` (see the module docstring).
 
     As root the sandbox runs as user ``uid`` (default: one reserved for this call).
     ``isolation`` is the sandbox's level (`sandbox.ISOLATION_LEVELS`); a weaker one
     than ``namespace`` is named in the row's notes. ``references`` is a folder the
-    judges share for references (`reference_cache`).
+    judges share for references (`reference_cache`). With a ``server`` the judge is
+    forked from it (`judge_server`) instead of started afresh.
     """
     if uid is None and os.geteuid() == 0:
         with reserved_uids(1) as (reserved,):
             return grade(submission, checks, timeout=timeout, call_timeout=call_timeout,
                          memory_mb=memory_mb, uid=reserved, isolation=isolation,
-                         allow_delegation=allow_delegation, references=references)  # fmt: skip
+                         allow_delegation=allow_delegation, references=references,
+                         server=server)  # fmt: skip
     started = time.monotonic()
     workspace = Path(tempfile.mkdtemp(prefix="msdlab-grade-"))
     try:
@@ -120,17 +124,17 @@ def grade(
         shutil.copytree(checks, workspace / "checks", ignore=shutil.ignore_patterns("__pycache__"))
         os.chmod(workspace, 0o700)  # the sandbox sees only its bind-mounted copy of the tasks
         report_path = workspace / "report.json"
-        command = [
-            sys.executable, "-m", "pytest", str(workspace / "checks"), "-q", "--no-header",
-            "-p", "no:cacheprovider", "-p", "no:nbval", "-p", "msdlab.instructor.pytest_sandbox",
+        arguments = [
+            str(workspace / "checks"), "-q", "--no-header",
+            "-p", "no:cacheprovider", "-p", "msdlab.course.pytest_plugin",
+            "-p", "_hypothesis_pytestplugin", "-p", "msdlab.instructor.pytest_sandbox",
             "--confcutdir", str(workspace / "checks"),
             "--rootdir", str(workspace), "-o", "addopts=", "--impl", str(workspace / "submission"),
             "--sandbox", "--sandbox-timeout", str(call_timeout), "--sandbox-memory", str(memory_mb),
             "--msdlab-report", str(report_path),
             "--allow-delegation", ",".join(str(task) for task in allow_delegation),
         ]  # fmt: skip
-        # the checks' bodies are small: the numpy kernel spares each judge the JIT start-up
-        environment = dict(os.environ, PYTHONDONTWRITEBYTECODE="1", MSDLAB_KERNEL="numpy")
+        environment = judge_environment()
         environment["MSDLAB_SANDBOX_ISOLATION"] = isolation
         (workspace / "tmp").mkdir()  # the sandboxes' logs, removed with the workspace
         environment["TMPDIR"] = str(workspace / "tmp")
@@ -140,7 +144,10 @@ def grade(
             environment["MSDLAB_SANDBOX_UID"] = str(uid)
         if references is not None:
             environment[reference_cache.ENV] = str(references)
-        failure = _run_judge(command, workspace, environment, timeout)
+        if server is None:
+            failure = _run_judge(arguments, workspace, environment, timeout)
+        else:
+            failure = _outcome(*server.run(arguments, workspace, environment, timeout), timeout)
         if uid is not None:
             _kill_user(uid)
         report = _read_report(report_path) if failure is None else None
@@ -155,6 +162,16 @@ def grade(
         shutil.rmtree(workspace, ignore_errors=True)
 
 
+def judge_environment() -> dict[str, str]:
+    """The environment of every judge, before its submission's own settings."""
+    # the checks' bodies are small: the numpy kernel spares each judge the JIT start-up;
+    # only the plugins the judge names load (pytest's search of every installed package
+    # for plugins took half of the judge's start-up)
+    environment = dict(os.environ, PYTHONDONTWRITEBYTECODE="1", MSDLAB_KERNEL="numpy")
+    environment["PYTEST_DISABLE_PLUGIN_AUTOLOAD"] = "1"
+    return environment
+
+
 def grade_all(
     submissions: Sequence[Submission],
     checks: Path,
@@ -167,12 +184,12 @@ def grade_all(
 ) -> list[Grade]:
     """Grade ``submissions``, ``jobs`` at a time; ``progress(grade, done, count)`` as each ends."""
     jobs = max(1, jobs)
-    slots: queue.Queue[int | None] = queue.Queue()
+    slots: queue.Queue[tuple[int | None, JudgeServer]] = queue.Queue()
     finished: list[Grade] = []
     lock = threading.Lock()
 
     def one(submission: Submission) -> Grade:
-        uid = slots.get()
+        uid, server = slots.get()
         try:
             result = grade(
                 submission,
@@ -181,10 +198,11 @@ def grade_all(
                 isolation=isolation,
                 allow_delegation=allow_delegation,
                 references=references,
+                server=server,
                 **limits,
             )
         finally:
-            slots.put(uid)
+            slots.put((uid, server))
         with lock:
             finished.append(result)
             if progress is not None:
@@ -194,11 +212,14 @@ def grade_all(
     with (
         reserved_uids(jobs) as uids,
         tempfile.TemporaryDirectory(prefix="msdlab-references-") as shared,
+        contextlib.ExitStack() as servers,
         ThreadPoolExecutor(max_workers=jobs) as pool,
     ):
         references = Path(shared)
         for uid in uids:
-            slots.put(uid)
+            server = JudgeServer(judge_environment())
+            servers.callback(server.close)
+            slots.put((uid, server))
         return list(pool.map(one, submissions))
 
 
@@ -269,11 +290,11 @@ def _copy_submission(source: Path, target: Path) -> list[str]:
 
 
 def _run_judge(
-    command: list[str], workspace: Path, environment: dict, timeout: float
+    arguments: list[str], workspace: Path, environment: dict, timeout: float
 ) -> str | None:
-    """Run the judge; None if it finished, else why not. The whole process group is killed."""
+    """Run a fresh judge; None if it finished, else why not. The whole process group is killed."""
     process = subprocess.Popen(
-        command,
+        [sys.executable, "-m", "pytest", *arguments],
         cwd=workspace,
         env=environment,
         stdin=subprocess.DEVNULL,
@@ -287,13 +308,20 @@ def _run_judge(
         with contextlib.suppress(ProcessLookupError):
             os.killpg(process.pid, signal.SIGKILL)
         process.communicate()
-        return f"grading timed out after {timeout:g} s"
+        return _outcome(None, "", timeout)
     finally:
         with contextlib.suppress(ProcessLookupError):
             os.killpg(process.pid, signal.SIGKILL)  # and anything left behind
-    if process.returncode not in (0, 1):  # 1: some checks failed, which is a normal grade
-        tail = errors.decode(errors="replace").strip().splitlines()[-3:]
-        return f"the checks could not run (pytest exit {process.returncode}): {' | '.join(tail)}"
+    return _outcome(process.returncode, errors.decode(errors="replace"), timeout)
+
+
+def _outcome(status: int | None, errors: str, timeout: float) -> str | None:
+    """None if the judge finished with exit ``status``, else why not (None: timed out)."""
+    if status is None:
+        return f"grading timed out after {timeout:g} s"
+    if status not in (0, 1):  # 1: some checks failed, which is a normal grade
+        tail = errors.strip().splitlines()[-3:]
+        return f"the checks could not run (pytest exit {status}): {' | '.join(tail)}"
     return None
 
 

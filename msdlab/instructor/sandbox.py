@@ -503,32 +503,69 @@ class RemoteObject:
 
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
         message = {"op": "call", "ref": self._ref, "args": args, "kwargs": kwargs}
+        return self._call(message, self._name, args, kwargs)
+
+    def _call_method(self, name: str, *args: Any) -> Any:
+        """``self.name(*args)`` in one round trip: the submission looks the method up and calls
+        it, as ``getattr`` and a call of what it returns would."""
+        message = {"op": "call", "ref": self._ref, "name": name, "args": args, "kwargs": {}}
+        return self._call(message, f"{self._name}.{name}", args, {})
+
+    def _call(self, message: dict, name: str, args: tuple, kwargs: dict) -> Any:
         message["refuse"] = self._sandbox.refused_task  # see msdlab.course.delegation
         arguments = {**{str(i): a for i, a in enumerate(args)}, **kwargs}
         arrays = {k: a for k, a in arguments.items() if isinstance(a, np.ndarray)}
-        return self._request(message, f"{self._name}()", arrays)
+        value = self._sandbox.request(message, self._generation, name, arguments=arrays)
+        return _wrap(self._sandbox, value, f"{name}()")
 
     def __repr__(self) -> str:
         return f"<submission {self._ref.kind}>"
 
 
 class RemoteIntegrator(RemoteObject, Integrator):
-    """A submission's `Integrator`: the engine steps it, each step runs in the sandbox."""
+    """A submission's `Integrator`: the engine steps it, each step runs in the sandbox.
+
+    Each method call is one round trip. `velocity_at_positions` and `dissipated_energy`
+    that the submission's class takes unchanged from `Integrator` run here, as the
+    engine's own code: the engine calls them at every step, and an answer of the
+    submission's process that they are unchanged when they are not gains it nothing
+    it could not have by returning those same numbers.
+    """
+
+    ENGINE_DEFAULTS = ("velocity_at_positions", "dissipated_energy")
+
+    def __init__(self, sandbox: SandboxProcess, ref: wire.Ref, name: str) -> None:
+        super().__init__(sandbox, ref, name)
+        self._inherited: frozenset[str] | None = None
 
     def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: Any) -> Any:
-        return self.__getattr__("step")(x, v, dt, dynamics)
+        return self._call_method("step", x, v, dt, dynamics)
 
     def dissipated_energy(
         self, v: np.ndarray, masses: np.ndarray, v_new: np.ndarray | None = None
     ) -> float:
-        return self.__getattr__("dissipated_energy")(v, masses, v_new)
+        if self._engine_default("dissipated_energy"):
+            return Integrator.dissipated_energy(self, v, masses, v_new)
+        return self._call_method("dissipated_energy", v, masses, v_new)
 
     def velocity_at_positions(self, v: np.ndarray, a: np.ndarray, dt: float) -> np.ndarray:
-        return self.__getattr__("velocity_at_positions")(v, a, dt)
+        if self._engine_default("velocity_at_positions"):
+            return Integrator.velocity_at_positions(self, v, a, dt)
+        return self._call_method("velocity_at_positions", v, a, dt)
+
+    def _engine_default(self, name: str) -> bool:
+        """True if the submission's integrator takes ``name`` unchanged from `Integrator`
+        (asked once per integrator)."""
+        if self._inherited is None or self._generation != self._sandbox.generation:
+            message = {"op": "inherited", "ref": self._ref, "names": list(self.ENGINE_DEFAULTS)}
+            answer = self._sandbox.request(message, self._generation, self._name)
+            names = answer if isinstance(answer, list) else []
+            self._inherited = frozenset(n for n in names if n in self.ENGINE_DEFAULTS)
+        return name in self._inherited
 
     def __repr__(self) -> str:
         try:
-            return str(self.__getattr__("__repr__")())
+            return str(self._call_method("__repr__"))
         except Exception:
             return "<submission integrator>"
 

@@ -150,8 +150,10 @@ class Server:
                 value = self.task(int(request["n"]))
             elif op == "getattr":
                 value = getattr(self.objects[request["ref"].id], request["name"])
-            elif op == "call":
+            elif op == "call":  # of the object, or of its method "name"
                 target = self.objects[request["ref"].id]
+                if "name" in request:
+                    target = getattr(target, request["name"])
                 args, kwargs = self.local(request["args"]), self.local(request["kwargs"])
                 _refuse_delegation(request.get("refuse"), self.folder)
                 before = _array_arguments(args, kwargs)
@@ -159,6 +161,8 @@ class Server:
                 changed = _changed_arguments(before, args, kwargs)
                 if changed:
                     return {"ok": value, "args": changed}
+            elif op == "inherited":
+                value = _inherited(self.objects[request["ref"].id], request["names"])
             elif op == "release":
                 for ref in request["refs"]:
                     self.objects.pop(ref.id, None)
@@ -246,6 +250,24 @@ class GraderObject:
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
         message = {"op": "call", "ref": self._ref, "args": args, "kwargs": kwargs}
         return self._server.callback(message)
+
+
+def _inherited(integrator: Any, names: list[str]) -> list[str]:
+    """Those of ``names`` that ``integrator`` takes unchanged from ``msdlab.Integrator``."""
+    import msdlab
+
+    kind = type(integrator)
+    if not isinstance(integrator, msdlab.Integrator) or (
+        kind.__getattribute__ is not object.__getattribute__
+    ):
+        return []
+    own = getattr(integrator, "__dict__", {})
+    return [
+        name
+        for name in names
+        if name not in own
+        and getattr(kind, name, None) is getattr(msdlab.Integrator, name, object())
+    ]
 
 
 def _refuse_delegation(task: Any, folder: str) -> None:
