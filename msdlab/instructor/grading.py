@@ -144,10 +144,12 @@ def grade(
             environment["MSDLAB_SANDBOX_UID"] = str(uid)
         if references is not None:
             environment[reference_cache.ENV] = str(references)
-        if server is None:
-            failure = _run_judge(arguments, workspace, environment, timeout)
-        else:
+        try:
+            if server is None:
+                raise EOFError("no judge server")
             failure = _outcome(*server.run(arguments, workspace, environment, timeout), timeout)
+        except EOFError:  # the server could not start or died: a fresh judge grades (or says why)
+            failure = _run_judge(arguments, workspace, environment, timeout)
         if uid is not None:
             _kill_user(uid)
         report = _read_report(report_path) if failure is None else None

@@ -6,6 +6,8 @@ from __future__ import annotations
 import csv
 import os
 import shutil
+import subprocess
+import sys
 import textwrap
 from pathlib import Path
 
@@ -14,6 +16,7 @@ import pytest
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
 from msdlab.instructor import grading
+from msdlab.instructor.judge_server import JudgeServer
 
 SOLUTIONS = PROJECT_ROOT / "solutions"
 CHECKS = PROJECT_ROOT / "tests" / "tasks"
@@ -164,6 +167,33 @@ def test_a_refused_action_at_import_costs_only_that_task(tmp_path):
     grade = grading.grade(grading.Submission("rude", rude), checks, **LIMITS)
     assert grade.points(1) == 0 and grade.points(2) > 0
     assert any("task1" in note and "sandbox forbids" in note for note in grade.notes), grade.notes
+
+
+class DeadServer(JudgeServer):
+    """A judge server that dies as it starts (say, an import that fails in its Python)."""
+
+    def _start(self) -> None:
+        self.close()
+        self.process = subprocess.Popen(
+            [sys.executable, "-c", "raise SystemExit(1)"],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+        )
+
+
+def test_a_judge_server_that_dies_leaves_the_grading_to_a_fresh_judge(tmp_path):
+    checks = tmp_path / "checks"
+    checks.mkdir()
+    for name in ("conftest.py", "test_task1.py"):
+        shutil.copy(CHECKS / name, checks)
+    server = DeadServer(grading.judge_environment())
+    try:
+        folder = submission(tmp_path, "alice")
+        grade = grading.grade(grading.Submission("alice", folder), checks, server=server, **LIMITS)
+    finally:
+        server.close()
+    assert grade.report is not None and grade.points(1) > 0, grade.notes
+    assert not any("server" in note for note in grade.notes), grade.notes
 
 
 def test_reading_the_solutions_does_not_help(graded):
