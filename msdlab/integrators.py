@@ -191,7 +191,7 @@ class ImplicitEuler(Integrator):
     numerically (the drift in the energy ledger). The system is symmetric
     positive definite and is solved by conjugate gradients over the free
     particles, with BLAS on one thread: its vectors are too short to share out,
-    and BLAS threads waiting for work slowed a 20³ step 3-fold on 2 busy cores.
+    and BLAS threads waiting for work slowed a 20³ step 5-fold on 2 busy cores.
     """
 
     def __init__(self, tolerance: float = 1e-10) -> None:
