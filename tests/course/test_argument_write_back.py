@@ -3,11 +3,6 @@ checks as they do in one process; changes that could break the judge fail the ca
 
 from __future__ import annotations
 
-import shutil
-import tempfile
-import textwrap
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -40,14 +35,8 @@ def untouched(x):
 
 
 @pytest.fixture(scope="module")
-def remote() -> RemoteImplementation:
-    folder = Path(tempfile.mkdtemp(prefix="msdlab-mutating-"))  # readable by the sandbox user
-    folder.chmod(0o755)
-    (folder / "task1.py").write_text(textwrap.dedent(MUTATING))
-    implementation = RemoteImplementation(folder, timeout=20.0, memory_bytes=1024 * 2**20)
-    yield implementation
-    implementation.close()
-    shutil.rmtree(folder)
+def remote(serve_task) -> RemoteImplementation:
+    return serve_task("task1.py", MUTATING)
 
 
 def test_values_changed_in_place_reach_the_caller(remote):

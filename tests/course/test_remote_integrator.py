@@ -3,10 +3,7 @@ per call, and the engine's own defaults run in the grader only where the submiss
 
 from __future__ import annotations
 
-import shutil
-import tempfile
 import textwrap
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -36,14 +33,8 @@ class Patched(Plain):
 
 
 @pytest.fixture(scope="module")
-def remote() -> RemoteImplementation:
-    folder = Path(tempfile.mkdtemp(prefix="msdlab-integrators-"))  # readable by the sandbox user
-    folder.chmod(0o755)
-    (folder / "task5.py").write_text(textwrap.dedent(INTEGRATORS))
-    implementation = RemoteImplementation(folder, timeout=20.0, memory_bytes=1024 * 2**20)
-    yield implementation
-    implementation.close()
-    shutil.rmtree(folder)
+def remote(serve_task) -> RemoteImplementation:
+    return serve_task("task5.py", INTEGRATORS)
 
 
 def counted(remote: RemoteImplementation, monkeypatch: pytest.MonkeyPatch) -> list[str]:
