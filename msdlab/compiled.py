@@ -13,15 +13,16 @@ sorted by their ends, so memory is read in order whatever order they were
 added in.
 
 Grid bodies (`msdlab.stencil`) whose springs share their values per offset
-are gathered instead: each particle sums the forces of its neighbours by grid
-offset, on positions copied by coordinate so that the inner loop walks
-contiguous memory on vector registers, over blocks of whole grid rows (those
-whose neighbour would leave its row masked out), three offsets at a time (a
-particle's position is read and its force written once for three springs);
-the threads split the blocks and write only their own particles. Each spring
-is then computed from both ends, with the same `equations.spring_force`; the
-two ways agree to rounding. Square roots and divisions bound the gather, so
-each spring costs one of each per end.
+go by offset instead, with no list of springs: each particle computes its
+springs to the neighbours ahead of it (half the stencil, so each spring
+once, with the same `equations.spring_force`), adds their forces to itself
+and, in a second loop, their opposites to the neighbours. The positions are
+copied by coordinate so that the inner loops walk contiguous memory on
+vector registers, over whole grid rows (those whose neighbour would leave
+its row masked out), three offsets at a time (a particle's position is read
+and its force written once for three springs). The threads take grid
+planes, every third one at once in three rounds, so that no two write the
+same particle; one thread takes them in the same order, with the same sums.
 
 `NumbaKernel.advance` compiles an integrator's update function (for example
 `integrators.verlet_update`) into one loop over the particles that computes
@@ -133,10 +134,9 @@ def _spring_forces_parallel(x, v, a, b, k, rest, c, partial, out):
 
 @numba.njit(cache=True, error_model="numpy")
 def _pull(y0, y1, y2, x0, x1, x2, q, there, k, rest):
-    """Force (N, 3 components) on a particle at y from its spring to particle ``q``, times
-    ``there`` (1, or 0 when that neighbour does not exist), and the squared length (m²).
-
-    f of eq. (1.2) along d = y - x_q, whichever end of the spring the particle is.
+    """The spring from a particle at y to particle ``q``, times ``there`` (1, or 0 when
+    that neighbour does not exist): f/|d| of eq. (1.2) (N/m), d = y - x_q (3 components)
+    and |d|² (m²). The force on the particle is (f/|d|)·d, on ``q`` its opposite.
     """
     d0, d1, d2 = y0 - x0[q], y1 - x1[q], y2 - x2[q]
     length_squared = d0 * d0 + d1 * d1 + d2 * d2
@@ -144,7 +144,7 @@ def _pull(y0, y1, y2, x0, x1, x2, q, there, k, rest):
     safe = length if length > 0.0 else 1.0  # coincident ends: no direction, no force
     scale = there * _spring_force(k, rest, safe, 0.0, 0.0) / safe
     scale = scale if length > 0.0 else 0.0
-    return scale * d0, scale * d1, scale * d2, there * length_squared
+    return scale, d0, d1, d2, there * length_squared
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -160,13 +160,14 @@ def _pull_damped(y0, y1, y2, u0, u1, u2, xs, vs, q, there, k, rest, c):
     power = there * _dashpot_power_of(c, rate)
     scale = there * _spring_force(k, rest, safe, c, rate) / safe
     scale = scale if length > 0.0 else 0.0
-    return scale * d0, scale * d1, scale * d2, there * length_squared, power
+    return scale, d0, d1, d2, there * length_squared, power
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _gather_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, values):
+def _push_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, values, scales, pad):
     """Add to particles ``first`` to ``stop - 1`` the forces of their springs to three
-    neighbours, at p + ``shifts[j]``, the same grid row offset apart.
+    neighbours, at p + ``shifts[j]``, the same grid row offset apart, and keep each
+    spring's f/|d| in ``scales[j, pad + p - first]`` for `_react`.
 
     ``xs``, ``vs``, ``fs`` are positions, velocities and forces by coordinate,
     contiguous, so the loop runs on vector registers; a particle's position
@@ -185,120 +186,161 @@ def _gather_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, valu
     ka, ra, ca, wa = values[0, 0], values[0, 1], values[0, 2], values[0, 3]
     kb, rb, cb, wb = values[1, 0], values[1, 1], values[1, 2], values[1, 3]
     kc, rc, cc, wc = values[2, 0], values[2, 1], values[2, 2], values[2, 3]
+    kept_a, kept_b, kept_c = scales[0], scales[1], scales[2]
     power = 0.0
     if ca == 0.0 and cb == 0.0 and cc == 0.0:  # no sum across springs: vector registers
         for i in range(first, stop):
             p, r = numba.uint64(i), numba.uint64(i - first)
             y0, y1, y2 = x0[p], x1[p], x2[p]
-            a0, a1, a2, la = _pull(
-                y0, y1, y2, x0, x1, x2, numba.uint64(i + sa), columns[ma, r], ka, ra
-            )
-            b0, b1, b2, lb = _pull(
-                y0, y1, y2, x0, x1, x2, numba.uint64(i + sb), columns[mb, r], kb, rb
-            )
-            c0, c1, c2, lc = _pull(
-                y0, y1, y2, x0, x1, x2, numba.uint64(i + sc), columns[mc, r], kc, rc
-            )
-            f0[p] += a0 + b0 + c0
-            f1[p] += a1 + b1 + c1
-            f2[p] += a2 + b2 + c2
+            qa, qb, qc = numba.uint64(i + sa), numba.uint64(i + sb), numba.uint64(i + sc)
+            a, a0, a1, a2, la = _pull(y0, y1, y2, x0, x1, x2, qa, columns[ma, r], ka, ra)
+            b, b0, b1, b2, lb = _pull(y0, y1, y2, x0, x1, x2, qb, columns[mb, r], kb, rb)
+            c, c0, c1, c2, lc = _pull(y0, y1, y2, x0, x1, x2, qc, columns[mc, r], kc, rc)
+            f0[p] += a * a0 + b * b0 + c * c0
+            f1[p] += a * a1 + b * b1 + c * c1
+            f2[p] += a * a2 + b * b2 + c * c2
+            kept = numba.uint64(i - first + pad)
+            kept_a[kept], kept_b[kept], kept_c[kept] = a, b, c
             squared[p] = max(squared[p], la * wa, lb * wb, lc * wc)
         return power
     v0, v1, v2 = vs
     for i in range(first, stop):
         p, r = numba.uint64(i), numba.uint64(i - first)
         y0, y1, y2, u0, u1, u2 = x0[p], x1[p], x2[p], v0[p], v1[p], v2[p]
-        q = numba.uint64(i + sa)
-        a0, a1, a2, la, pa = _pull_damped(
-            y0, y1, y2, u0, u1, u2, xs, vs, q, columns[ma, r], ka, ra, ca
-        )
-        q = numba.uint64(i + sb)
-        b0, b1, b2, lb, pb = _pull_damped(
-            y0, y1, y2, u0, u1, u2, xs, vs, q, columns[mb, r], kb, rb, cb
-        )
-        q = numba.uint64(i + sc)
-        c0, c1, c2, lc, pc = _pull_damped(
-            y0, y1, y2, u0, u1, u2, xs, vs, q, columns[mc, r], kc, rc, cc
-        )
-        f0[p] += a0 + b0 + c0
-        f1[p] += a1 + b1 + c1
-        f2[p] += a2 + b2 + c2
+        y, u = (y0, y1, y2), (u0, u1, u2)
+        qa, qb, qc = numba.uint64(i + sa), numba.uint64(i + sb), numba.uint64(i + sc)
+        a, a0, a1, a2, la, pa = _pull_damped(*y, *u, xs, vs, qa, columns[ma, r], ka, ra, ca)
+        b, b0, b1, b2, lb, pb = _pull_damped(*y, *u, xs, vs, qb, columns[mb, r], kb, rb, cb)
+        c, c0, c1, c2, lc, pc = _pull_damped(*y, *u, xs, vs, qc, columns[mc, r], kc, rc, cc)
+        f0[p] += a * a0 + b * b0 + c * c0
+        f1[p] += a * a1 + b * b1 + c * c1
+        f2[p] += a * a2 + b * b2 + c * c2
+        kept = numba.uint64(i - first + pad)
+        kept_a[kept], kept_b[kept], kept_c[kept] = a, b, c
         squared[p] = max(squared[p], la * wa, lb * wb, lc * wc)
         power += pa + pb + pc
     return power
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _gather_block(scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, block, out):
-    """Add to ``out`` (N, d) the spring forces on the particles of grid block ``block``:
-    ``rows`` consecutive rows of one plane (the plane's last block may hold fewer).
+def _react(xs, fs, scales, first, stop, shifts, pad):
+    """Add to each neighbour q = p + ``shifts[j]`` of particles p = ``first`` to ``stop - 1``
+    the opposite of the force its spring exerts on p (eq. 1.1), -(f/|d|)·(x_p - x_q),
+    with f/|d| from ``scales[j, pad + p - first]`` (see `_push_three`).
+
+    One loop over the neighbours q takes the three springs, so q's position is
+    read and its force written once. ``scales`` is 0 in its first and last
+    ``pad`` columns (pad ≥ the spread of the shifts), where q has no spring j;
+    the scratch padding is as wide, so p stays in memory there.
+    """
+    x0, x1, x2 = xs
+    f0, f1, f2 = fs
+    kept_a, kept_b, kept_c = scales[0], scales[1], scales[2]
+    sa, sb, sc = shifts
+    low, high = min(sa, sb, sc), max(sa, sb, sc)
+    scales[:, pad + stop - first :] = 0.0
+    for i in range(first + low, stop + high):
+        q = numba.uint64(i)
+        pa, pb, pc = numba.uint64(i - sa), numba.uint64(i - sb), numba.uint64(i - sc)
+        a = kept_a[numba.uint64(i - sa - first + pad)]
+        b = kept_b[numba.uint64(i - sb - first + pad)]
+        c = kept_c[numba.uint64(i - sc - first + pad)]
+        y0, y1, y2 = x0[q], x1[q], x2[q]
+        f0[q] -= a * (x0[pa] - y0) + b * (x0[pb] - y0) + c * (x0[pc] - y0)
+        f1[q] -= a * (x1[pa] - y1) + b * (x1[pb] - y1) + c * (x1[pc] - y1)
+        f2[q] -= a * (x2[pa] - y2) + b * (x2[pb] - y2) + c * (x2[pc] - y2)
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _push_rows(scratch, pad, columns, shape, triples, rows_of, o2s, values, plane, rows, scales):
+    """Add the forces of the springs from the particles of grid rows ``rows`` (first, stop)
+    of ``plane`` to their neighbours ahead to both ends; return their dashpot power (W).
 
     ``scratch`` (10, N + 2·pad) holds the positions, velocities and forces by
     coordinate and the squared stretches, particle p at p + pad (the padding
-    stays zero, so a masked neighbour past either end is still in memory).
+    stays zero, so a masked neighbour past either end is still in memory);
+    ``scales`` (3, rows·n_2 + 2·pad) is the room `_push_three` and `_react` share.
     Triple t joins each particle to its neighbours at the offsets
     (``triples[t]``, ``o2s[t, j]``), j = 0, 1, 2, with the spring values
     ``values[t, j]`` (see `_stencil_triples`); for each, the rows whose
-    neighbours exist are consecutive, so the inner loop runs over all of them
+    neighbours exist are consecutive, so the inner loops run over all of them
     at once, and ``columns[rows_of[t, j]]`` masks the particles whose
     neighbour would be past the end of their row (see `_column_masks`).
-    Returns the largest stretch |d|/l and half the dashpot power of the
-    springs met (each spring is met from both ends).
     """
     xs = (scratch[0], scratch[1], scratch[2])
     vs = (scratch[3], scratch[4], scratch[5])
     fs = (scratch[6], scratch[7], scratch[8])
-    squared = scratch[9]
     n0, n1, n2 = shape[0], shape[1], shape[2]
-    per_plane = (n1 + rows - 1) // rows
-    plane, row_lo = block // per_plane, (block % per_plane) * rows
-    row_hi = min(row_lo + rows, n1)
-    start, end = (plane * n1 + row_lo) * n2 + pad, (plane * n1 + row_hi) * n2 + pad
-    for p in range(start, end):
-        fs[0][p] = fs[1][p] = fs[2][p] = squared[p] = 0.0
     power = 0.0
     for t in range(len(triples)):
         o0, o1 = triples[t, 0], triples[t, 1]
-        lo, hi = max(row_lo, -o1), min(row_hi, n1 - o1)  # rows whose neighbours exist
+        lo, hi = max(rows[0], -o1), min(rows[1], n1 - o1)  # rows whose neighbours exist
         if not (0 <= plane + o0 < n0 and lo < hi):
             continue
         shift = (o0 * n1 + o1) * n2
         first, stop = (plane * n1 + lo) * n2 + pad, (plane * n1 + hi) * n2 + pad
         masks = (rows_of[t, 0], rows_of[t, 1], rows_of[t, 2])
         shifts = (shift + o2s[t, 0], shift + o2s[t, 1], shift + o2s[t, 2])
-        power += 0.5 * _gather_three(
-            xs, vs, fs, squared, columns, masks, first, stop, shifts, values[t]
+        power += _push_three(
+            xs, vs, fs, scratch[9], columns, masks, first, stop, shifts, values[t], scales, pad
         )
-    for p in range(start, end):
-        for q in range(out.shape[1]):
-            out[p - pad, q] += fs[q][p]
-    return math.sqrt(squared[start:end].max()), power
+        _react(xs, fs, scales, first, stop, shifts, pad)
+    return power
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _push_unit(scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, unit):
+    """`_push_rows` for a unit of work: grid plane ``unit`` (3-D), or rows ``unit``·rows
+    to (``unit`` + 1)·rows - 1 (2-D), ``rows`` at a time. Returns the largest squared
+    stretch |d|²/l² of the springs from its particles and their dashpot power (W).
+
+    A unit's springs reach the next unit only, and its masked neighbours (whose
+    force is 0) the one after; so units three apart can be pushed at once.
+    """
+    n0, n1, n2 = shape[0], shape[1], shape[2]
+    plane, lo, hi = (unit, 0, n1) if n0 > 1 else (0, unit * rows, min(unit * rows + rows, n1))
+    scales = np.zeros((3, rows * n2 + 2 * pad))
+    power = 0.0
+    for first in range(lo, hi, rows):
+        block = (first, min(first + rows, hi))
+        power += _push_rows(
+            scratch, pad, columns, shape, triples, rows_of, o2s, values, plane, block, scales
+        )
+    start, end = (plane * n1 + lo) * n2 + pad, (plane * n1 + hi) * n2 + pad
+    return scratch[9, start:end].max(), power
 
 
 @numba.njit(cache=True, error_model="numpy")
 def _gather_serial(x, v, shape, triples, rows_of, o2s, values, columns, rows, scratch, out):
-    """One thread: `_gather_block` for every block; return (largest stretch, dashpot power)."""
+    """One thread: `_gather_parallel`'s work in the same order (so the same sums)."""
     pad = (scratch.shape[1] - len(x)) // 2
     damped = np.any(values[:, :, 2] != 0.0)
+    scratch[6:, :] = 0.0
     for q in range(x.shape[1]):
         scratch[q, pad : pad + len(x)] = x[:, q]
         if damped:
             scratch[3 + q, pad : pad + len(x)] = v[:, q]
-    stretch = 0.0
-    power = 0.0
-    blocks = shape[0] * ((shape[1] + rows - 1) // rows)
-    for block in range(blocks):
-        sums = _gather_block(
-            scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, block, out
-        )
-        stretch = max(stretch, sums[0])
-        power += sums[1]
-    return stretch, power
+    units = shape[0] if shape[0] > 1 else (shape[1] + rows - 1) // rows
+    squared, power = 0.0, 0.0
+    for phase in range(3):
+        for unit in range(phase, units, 3):
+            sums = _push_unit(
+                scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, unit
+            )
+            squared, power = max(squared, sums[0]), power + sums[1]
+    for q in range(x.shape[1]):
+        out[:, q] += scratch[6 + q, pad : pad + len(x)]
+    return math.sqrt(squared), power
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
 def _gather_parallel(x, v, shape, triples, rows_of, o2s, values, columns, rows, scratch, out):
-    """Threads: blocks split between them, each writing only its own particles' forces."""
+    """Add to ``out`` (N, d) the forces of a grid body's springs, each computed once, from
+    the particle behind (`_push_unit`); return (largest stretch |d|/l, dashpot power).
+
+    The threads push every third unit at once, in three rounds, so no two
+    write the same particle.
+    """
     pad = (scratch.shape[1] - len(x)) // 2
     damped = np.any(values[:, :, 2] != 0.0)
     for p in numba.prange(len(x)):
@@ -306,27 +348,34 @@ def _gather_parallel(x, v, shape, triples, rows_of, o2s, values, columns, rows, 
             scratch[q, p + pad] = x[p, q]
             if damped:
                 scratch[3 + q, p + pad] = v[p, q]
-    blocks = shape[0] * ((shape[1] + rows - 1) // rows)
-    stretches = np.zeros(blocks)
-    powers = np.zeros(blocks)
-    for block in numba.prange(blocks):
-        stretches[block], powers[block] = _gather_block(
-            scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, block, out
-        )
-    return stretches.max(), powers.sum()
+        scratch[6, p + pad] = scratch[7, p + pad] = scratch[8, p + pad] = scratch[9, p + pad] = 0.0
+    units = shape[0] if shape[0] > 1 else (shape[1] + rows - 1) // rows
+    squares = np.zeros(units)
+    powers = np.zeros(units)
+    for phase in range(3):
+        for u in numba.prange((units - phase + 2) // 3):
+            unit = phase + 3 * u
+            squares[unit], powers[unit] = _push_unit(
+                scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, unit
+            )
+    for p in numba.prange(len(x)):
+        for q in range(x.shape[1]):
+            out[p, q] += scratch[6 + q, p + pad]
+    return math.sqrt(squares.max()), powers.sum()
 
 
 def _stencil_triples(offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The stencil's offsets ±o grouped by their first two coordinates, three at a time.
+    """The stencil's offsets, each pointing ahead (o or -o, whichever is later in C order),
+    grouped by their first two coordinates, three at a time.
 
     Returns (triples, members, o2s): triple t joins each particle to those at
     (``triples[t]``, ``o2s[t, j]``), j = 0, 1, 2, by the springs of offset
     block ``members[t, j]``; -1 marks an empty place (no spring).
     """
     groups: dict[tuple[int, int], list[tuple[int, int]]] = {}
-    for m, (o0, o1, o2) in enumerate(offsets.tolist()):
-        for sign in (1, -1):
-            groups.setdefault((sign * o0, sign * o1), []).append((sign * o2, m))
+    for m, offset in enumerate(offsets.tolist()):
+        o0, o1, o2 = offset if tuple(offset) > (0, 0, 0) else [-o for o in offset]
+        groups.setdefault((o0, o1), []).append((o2, m))
     triples, members, o2s = [], [], []
     for (o0, o1), group in sorted(groups.items()):
         group.sort()
@@ -595,9 +644,10 @@ class NumbaKernel:
             if self._stencil is not None:
                 self._columns = _column_masks(self._stencil.shape, self._stencil.offsets)
                 triples, members, o2s = _stencil_triples(self._stencil.offsets)
-                self._pad = int(np.abs(o2s).max(initial=0))
+                reach = int(np.abs(o2s).max(initial=0))
+                self._pad = 2 * reach  # see `_react`
                 no_spring = len(self._columns[0]) - 1  # the all-zero mask
-                rows_of = np.where(members >= 0, o2s + self._pad, no_spring)
+                rows_of = np.where(members >= 0, o2s + reach, no_spring)
                 self._triples = (triples, members, o2s, rows_of)
             self._stencil_values = np.zeros((3, blocks))
             self._stencil_version = body.topology_version

@@ -47,7 +47,13 @@ def assert_agree(body: msd.Body, numba_kernel: NumbaKernel) -> None:
 
 @pytest.mark.parametrize(
     ("shape", "neighbours"),
-    [((5, 4, 6), (1, 2, 3)), ((6, 5, 4), (1, 2, 3, 4)), ((7, 5), (1, 2)), ((1, 1, 5), (1,))],
+    [
+        ((5, 4, 6), (1, 2, 3)),
+        ((6, 5, 4), (1, 2, 3, 4)),
+        ((7, 5), (1, 2)),
+        ((1, 1, 5), (1,)),
+        ((170, 100), (1, 2)),  # 2-D: five blocks of rows, taken as planes are in 3-D
+    ],
 )
 @pytest.mark.parametrize("damping", [0.0, 0.3])
 @pytest.mark.parametrize("threaded", [False, True])
@@ -67,6 +73,41 @@ def test_gather_matches_edge_loop_and_numpy(
     edge_loop = NumbaKernel()
     monkeypatch.setattr(edge_loop, "grid_stencil", lambda body: None)
     assert_agree(body, edge_loop)
+
+
+@pytest.mark.parametrize(("shape", "neighbours"), [((9, 4, 6), (1, 2, 3)), ((170, 100), (1, 2))])
+@pytest.mark.parametrize("damping", [0.0, 0.3])
+def test_threads_give_the_same_sums_as_one_thread(
+    shape: tuple[int, ...],
+    neighbours: tuple[int, ...],
+    damping: float,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    body = shaken_grid(shape, neighbours, damping)
+    one_thread = forces_by(NumbaKernel(), body)
+    monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
+    threads = forces_by(NumbaKernel(), body)
+    np.testing.assert_array_equal(threads[0], one_thread[0])
+    assert threads[1:] == one_thread[1:]
+
+
+def test_springs_pointing_back_are_gathered() -> None:
+    """A grid whose springs join each particle to the one behind it (ends swapped)."""
+    grid = shaken_grid((4, 5, 3), (1, 2, 3), 0.2)
+    pairs = np.stack([grid.spring_b, grid.spring_a], axis=1)
+    body = msd.Body.from_arrays(
+        grid.positions,
+        pairs,
+        velocities=grid.velocities,
+        stiffness=grid.stiffness,
+        rest_lengths=grid.rest_lengths,
+        damping=0.2,
+    )
+    body.grid_shape = grid.grid_shape
+    kernel = NumbaKernel()
+    assert kernel.grid_stencil(body) is not None
+    assert (grid_stencil(body).offsets == -grid_stencil(grid).offsets).all()
+    assert_agree(body, kernel)
 
 
 def test_coincident_ends_exert_no_force() -> None:
