@@ -40,13 +40,18 @@ import math
 import sys
 import warnings
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numba
 import numpy as np
+import scipy.sparse as sp
 
 from . import equations
 from .body import Body
 from .stencil import GridStencil, grid_stencil
+
+if TYPE_CHECKING:
+    from .kernels import JacobianPattern
 
 # Below this many springs (particles for the update) one thread is faster than waking the others.
 PARALLEL_MIN_SPRINGS = 50_000
@@ -57,6 +62,7 @@ GATHER_BLOCK = 4096
 _spring_force = numba.njit(cache=True, inline="always")(equations.spring_force)
 _spring_energy = numba.njit(cache=True, inline="always")(equations.spring_energy)
 _dashpot_power_of = numba.njit(cache=True, inline="always")(equations.dashpot_power)
+_transverse_stiffness = numba.njit(cache=True, inline="always")(equations.transverse_stiffness)
 _inverse_mass = numba.njit(cache=True, inline="always")(equations.inverse_mass)
 _acceleration = numba.njit(cache=True, inline="always")(equations.acceleration)
 
@@ -498,6 +504,29 @@ def _elastic_energy_parallel(x, a, b, k, rest, blocks):
 
 
 @numba.njit(cache=True)
+def _jacobian_blocks(x, a, b, k, rest, c, stiff, damp):
+    """Each spring's blocks (E, d, d) of `kernels.spring_jacobians`: B = (k - k_t) n nᵀ + k_t I
+    into ``stiff`` and, if it is not empty, C = c n nᵀ into ``damp``."""
+    dim = x.shape[1]
+    n = np.empty(dim)
+    for s in range(len(a)):
+        squared = 0.0
+        for i in range(dim):
+            n[i] = x[a[s], i] - x[b[s], i]
+            squared += n[i] * n[i]
+        length = math.sqrt(squared) if squared > 0.0 else math.inf  # coincident: n = 0
+        inverse = 1.0 / length
+        for i in range(dim):
+            n[i] *= inverse
+        across = _transverse_stiffness(k[s], rest[s], length)
+        for i in range(dim):
+            for j in range(dim):
+                stiff[s, i, j] = (k[s] - across) * n[i] * n[j] + (across if i == j else 0.0)
+                if len(damp):
+                    damp[s, i, j] = c[s] * n[i] * n[j]
+
+
+@numba.njit(cache=True)
 def _divide_by_masses(forces, masses, fixed):
     """Turn forces (N, d) into accelerations in place: a = F/m, and 0 for fixed particles."""
     for i in range(len(masses)):
@@ -682,6 +711,21 @@ class NumbaKernel:
         if not self._parallel(body):
             return _elastic_energy_serial(x, *arrays)
         return _elastic_energy_parallel(x, *arrays, self._threads)
+
+    @staticmethod
+    def jacobians(
+        body: Body, x: np.ndarray, pattern: JacobianPattern
+    ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """∂F/∂x and ∂F/∂v of the springs on ``pattern``, as `kernels.spring_jacobians`,
+        with the blocks computed spring by spring."""
+        values = body.spring_values()
+        dim = x.shape[1]
+        stiff = np.empty((body.n_springs, dim, dim))
+        damp = np.empty((body.n_springs if values[2].any() else 0, dim, dim))
+        _jacobian_blocks(x, body.spring_a, body.spring_b, *values, stiff, damp)
+        if not len(damp):  # no dashpots: ∂F/∂v is zero, with no entries to add up
+            return pattern.matrices(stiff)[0], sp.csr_matrix(pattern.shape)
+        return tuple(pattern.matrices(stiff, damp))
 
     @staticmethod
     def to_acceleration(body: Body, forces: np.ndarray) -> np.ndarray:

@@ -135,7 +135,7 @@ class Dynamics:
         """
         if self._pattern is None or self._pattern.topology_version != self.body.topology_version:
             self._pattern = kernels.JacobianPattern(self.body)
-        jx, jv = kernels.spring_jacobians(self.body, x, self._pattern)
+        jx, jv = self.springs.jacobians(self.body, x, self._pattern)
         for force in self.forces:
             fx, fv = force.jacobians(self.body, x, v)
             jx = jx if fx is None else jx + fx

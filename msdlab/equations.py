@@ -40,6 +40,16 @@ def dashpot_power(damping: float, rate: float) -> float:
     return damping * rate**2
 
 
+def transverse_stiffness(stiffness: float, rest: float, length: float) -> float:
+    """Stiffness k·max(0, 1 - l/|d|) (N/m) of a spring across its direction n.
+
+    With it the spring's Jacobian block is B = k n nᵀ + k_t (I - n nᵀ); it is 0
+    for a compressed spring (as Baraff & Witkin do, so that -∂F/∂x stays
+    positive semi-definite).
+    """
+    return stiffness * np.maximum(0.0, 1.0 - rest / length)
+
+
 def inverse_mass(mass: float, free: bool) -> float:
     """1/m (1/kg) for a free particle, 0 for a fixed one (so it never accelerates)."""
     return free / mass

@@ -142,23 +142,20 @@ def spring_jacobians(
 ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
     """∂F/∂x and ∂F/∂v (N·d × N·d, sparse) of the spring and dashpot forces.
 
-    Per spring with n = d/|d|, the stiffness block is
-    B = k [n nᵀ + max(0, 1 - l/|d|)(I - n nᵀ)] (the transverse part is dropped
-    for compressed springs, as Baraff & Witkin do, so -∂F/∂x stays positive
-    semi-definite) and the dashpot block is C = c n nᵀ. Both enter as
-    -B on the (a, a) and (b, b) blocks and +B on (a, b) and (b, a).
+    Per spring with n = d/|d|, the stiffness block is B = k n nᵀ + k_t (I - n nᵀ),
+    k_t = `equations.transverse_stiffness`, and the dashpot block is C = c n nᵀ.
+    Both enter as -B on the (a, a) and (b, b) blocks and +B on (a, b) and (b, a).
     ``pattern`` reuses the sparsity of an earlier call on the same springs.
     """
     pattern = JacobianPattern(body) if pattern is None else pattern
     dim = x.shape[1]
     d, length = spring_vectors(body, x)
-    safe = np.where(length > 0, length, np.inf)
+    safe = np.where(length > 0, length, np.inf)  # coincident ends: n = 0, B = k I
     n = d / safe[:, None]
     outer = n[:, :, None] * n[:, None, :]
     stiffness, rest, damping = body.spring_values()
-    transverse = np.maximum(0.0, 1.0 - rest / safe)
-    eye = np.eye(dim)[None]
-    stiff = stiffness[:, None, None] * (outer + transverse[:, None, None] * (eye - outer))
+    across = equations.transverse_stiffness(stiffness, rest, safe)[:, None, None]
+    stiff = (stiffness[:, None, None] - across) * outer + across * np.eye(dim)
     if not np.any(damping):  # no dashpots: ∂F/∂v is zero, with no entries to add up
         return pattern.matrices(stiff)[0], sp.csr_matrix(pattern.shape)
     return tuple(pattern.matrices(stiff, damping[:, None, None] * outer))
@@ -189,6 +186,11 @@ class SpringKernel(Protocol):
 
     def dashpot_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
         """Power (W) the dashpots take out at (x, v)."""
+
+    def jacobians(
+        self, body: Body, x: np.ndarray, pattern: JacobianPattern
+    ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """∂F/∂x and ∂F/∂v of the springs on ``pattern`` (see `spring_jacobians`)."""
 
     def to_acceleration(self, body: Body, forces: np.ndarray) -> np.ndarray:
         """Accelerations a = F/m (N, d) from forces (N, d), 0 for fixed (may reuse ``forces``)."""
@@ -232,6 +234,12 @@ class NumpyKernel:
     def dashpot_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
         """Power (W) the dashpots take out at (x, v)."""
         return dashpot_power(body, x, v)
+
+    def jacobians(
+        self, body: Body, x: np.ndarray, pattern: JacobianPattern
+    ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """∂F/∂x and ∂F/∂v of the springs on ``pattern`` (see `spring_jacobians`)."""
+        return spring_jacobians(body, x, pattern)
 
     def to_acceleration(self, body: Body, forces: np.ndarray) -> np.ndarray:
         """Accelerations a = F/m (N, d) in m/s² from forces (N, d); 0 for fixed particles."""

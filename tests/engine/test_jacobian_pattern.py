@@ -98,3 +98,29 @@ def test_implicit_steps_match_fresh_assembly(kernel: str) -> None:
         np.testing.assert_allclose(body.positions, expected_body.positions, rtol=0, atol=1e-11)
         np.testing.assert_allclose(body.velocities, expected_body.velocities, rtol=0, atol=1e-9)
     assert np.all(body.velocities[body.fixed] == 0.0)
+
+
+@pytest.mark.parametrize("shape", [(4, 3, 3), (5, 4)])
+def test_each_kernel_sums_the_blocks_a_fresh_assembly_sums(kernel: str, shape: tuple) -> None:
+    body = shaken_grid(3)
+    if len(shape) == 2:
+        body = msd.Body.grid(shape, spacing=0.1, stiffness=40.0, neighbours=(1, 2))
+        body.positions[:] += np.random.default_rng(3).normal(scale=0.03, size=(20, 2))
+        body.spring_damping[::2] = 0.3
+    pattern = kernels.JacobianPattern(body)
+    jx, jv = kernels.make_kernel(kernel).jacobians(body, body.positions, pattern)
+    fresh_x, fresh_v = fresh_jacobians(body, body.positions)
+    np.testing.assert_allclose(jx.toarray(), fresh_x.toarray(), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(jv.toarray(), fresh_v.toarray(), rtol=1e-12, atol=1e-12)
+
+
+def test_coincident_ends_give_an_isotropic_block(kernel: str) -> None:
+    """No direction: the stiffness block of a spring of length 0 is k I, its dashpot's 0."""
+    body = msd.Body.from_arrays([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]], [[0, 1]], stiffness=7.0)
+    body.spring_damping[:] = 0.5
+    body.positions[1] = body.positions[0]
+    pattern = kernels.JacobianPattern(body)
+    jx, jv = kernels.make_kernel(kernel).jacobians(body, body.positions, pattern)
+    block = 7.0 * np.eye(3)
+    np.testing.assert_array_equal(jx.toarray(), np.block([[-block, block], [block, -block]]))
+    np.testing.assert_array_equal(jv.toarray(), np.zeros((6, 6)))
