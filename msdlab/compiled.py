@@ -327,16 +327,16 @@ def _gather_serial(x, v, shape, triples, rows_of, o2s, values, columns, rows, sc
         if damped:
             scratch[3 + q, pad : pad + len(x)] = v[:, q]
     units = shape[0] if shape[0] > 1 else (shape[1] + rows - 1) // rows
-    squared, power = 0.0, 0.0
+    squares = np.zeros(units)
+    powers = np.zeros(units)
     for phase in range(3):
         for unit in range(phase, units, 3):
-            sums = _push_unit(
+            squares[unit], powers[unit] = _push_unit(
                 scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, unit
             )
-            squared, power = max(squared, sums[0]), power + sums[1]
     for q in range(x.shape[1]):
         out[:, q] += scratch[6 + q, pad : pad + len(x)]
-    return math.sqrt(squared), power
+    return math.sqrt(squares.max()), powers.sum()
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
