@@ -318,7 +318,7 @@ def _push_unit(scratch, pad, columns, shape, rows, triples, rows_of, o2s, values
 
 @numba.njit(cache=True, error_model="numpy")
 def _gather_serial(x, v, shape, triples, rows_of, o2s, values, columns, rows, scratch, out):
-    """One thread: `_gather_parallel`'s work in the same order (so the same sums)."""
+    """One thread: `_gather_parallel`'s work in the same order, so the same sums."""
     pad = (scratch.shape[1] - len(x)) // 2
     damped = np.any(values[:, :, 2] != 0.0)
     scratch[6:, :] = 0.0
@@ -336,13 +336,14 @@ def _gather_serial(x, v, shape, triples, rows_of, o2s, values, columns, rows, sc
             )
     for q in range(x.shape[1]):
         out[:, q] += scratch[6 + q, pad : pad + len(x)]
-    return math.sqrt(squares.max()), powers.sum()
+    return squares, powers
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
 def _gather_parallel(x, v, shape, triples, rows_of, o2s, values, columns, rows, scratch, out):
     """Add to ``out`` (N, d) the forces of a grid body's springs, each computed once, from
-    the particle behind (`_push_unit`); return (largest stretch |d|/l, dashpot power).
+    the particle behind (`_push_unit`); return each unit's largest squared stretch
+    |d|²/l² and dashpot power (W).
 
     The threads push every third unit at once, in three rounds, so no two
     write the same particle.
@@ -367,7 +368,7 @@ def _gather_parallel(x, v, shape, triples, rows_of, o2s, values, columns, rows, 
     for p in numba.prange(len(x)):
         for q in range(x.shape[1]):
             out[p, q] += scratch[6 + q, p + pad]
-    return math.sqrt(squares.max()), powers.sum()
+    return squares, powers
 
 
 def _stencil_triples(offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -636,19 +637,9 @@ class NumbaKernel:
                     self._scratch = np.zeros((10, len(x) + 2 * self._pad))  # 2-D: x2 = v2 = 0
                 triples, _, o2s, rows_of = self._triples
                 columns, rows = self._columns
-                return gather(
-                    x,
-                    v,
-                    stencil.shape,
-                    triples,
-                    rows_of,
-                    o2s,
-                    self._triple_values,
-                    columns,
-                    rows,
-                    self._scratch,
-                    out,
-                )
+                layout = (stencil.shape, triples, rows_of, o2s, self._triple_values, columns, rows)
+                squares, powers = gather(x, v, *layout, self._scratch, out)
+                return math.sqrt(squares.max()), float(powers.sum())  # one order, any threads
         if springs is not None:
             arrays = (body.spring_a, body.spring_b, *body.spring_values())
             return _spring_forces_serial(x, v, *(array[springs] for array in arrays), out)
