@@ -19,7 +19,7 @@ class Dynamics:
     F is the sum of the spring and dashpot forces (eq. 1.2) and the external
     ``forces``. Fixed particles have zero inverse mass, so they get zero
     acceleration. Integrators call `acceleration` or `advance` (and `force`,
-    `jacobians`, `masses`, `free` for implicit methods).
+    `jacobians` or `implicit_matrix`, `masses`, `free` for implicit methods).
 
     ``kernel`` picks the spring kernel (`msdlab.kernels`): "numba" (compiled,
     threaded) or "numpy" (readable); the default is ``MSDLAB_KERNEL`` or "numba".
@@ -133,14 +133,40 @@ class Dynamics:
 
         The sparsity pattern of the springs is built once per topology and refilled.
         """
-        if self._pattern is None or self._pattern.topology_version != self.body.topology_version:
-            self._pattern = kernels.JacobianPattern(self.body)
-        jx, jv = self.springs.jacobians(self.body, x, self._pattern)
+        jx, jv = self._spring_jacobians(x)
         for force in self.forces:
             fx, fv = force.jacobians(self.body, x, v)
             jx = jx if fx is None else jx + fx
             jv = jv if fv is None else jv + fv
         return jx, jv
+
+    def implicit_matrix(
+        self, x: np.ndarray, v: np.ndarray, h_v: float, h_x: float
+    ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """M - h_v ∂F/∂v - h_x ∂F/∂x (N·d × N·d, sparse) and ∂F/∂x, for implicit
+        integrators (linearised backward Euler: h_v = dt, h_x = dt², in s and s²).
+
+        The springs' Jacobians share one sparsity that holds the whole diagonal,
+        so this is arithmetic on their values; forces add theirs as matrices.
+        """
+        jx, jv = self._spring_jacobians(x)
+        values = -h_x * jx.data
+        if jv.nnz:  # dashpots: on the same pattern
+            values -= h_v * jv.data
+        values[self._pattern.diagonal] += np.repeat(self.masses, x.shape[1])
+        matrix = self._pattern.matrix(values)
+        for force in self.forces:
+            fx, fv = force.jacobians(self.body, x, v)
+            jx = jx if fx is None else jx + fx
+            matrix = matrix if fx is None else matrix - h_x * fx
+            matrix = matrix if fv is None else matrix - h_v * fv
+        return matrix, jx
+
+    def _spring_jacobians(self, x: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """∂F/∂x and ∂F/∂v of the springs, on their pattern (rebuilt when they change)."""
+        if self._pattern is None or self._pattern.topology_version != self.body.topology_version:
+            self._pattern = kernels.JacobianPattern(self.body)
+        return self.springs.jacobians(self.body, x, self._pattern)
 
     def elastic_energy(self, x: np.ndarray, springs: np.ndarray | None = None) -> float:
         """Energy stored in the springs (or in the given ones), Σ ½ k (|x_a - x_b| - l)² (J)."""

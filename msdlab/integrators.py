@@ -199,9 +199,7 @@ class ImplicitEuler(Integrator):
 
     def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: Dynamics) -> State:
         dim = x.shape[1]
-        jx, jv = dynamics.jacobians(x, v)
-        masses = sp.diags(np.repeat(dynamics.masses, dim), format="csr")
-        matrix = masses - dt * jv - dt * dt * jx
+        matrix, jx = dynamics.implicit_matrix(x, v, dt, dt * dt)  # M - dt ∂F/∂v - dt² ∂F/∂x
         rhs = dt * (dynamics.force(x, v).ravel() + dt * (jx @ v.ravel()))
         free = np.repeat(dynamics.free, dim)
         with _thread_pools().limit(limits=1, user_api="blas"):

@@ -102,7 +102,8 @@ class JacobianPattern:
     """Sparsity of the spring Jacobians (N·d × N·d, CSR), built once per topology.
 
     Holds the rows and columns of every (a, a), (b, b), (a, b), (b, a) block and
-    of the whole diagonal, sorted and merged once, and a sparse map ``assemble``
+    of the whole diagonal (``diagonal``: where each (i, i) is in the values),
+    sorted and merged once, and a sparse map ``assemble``
     that sums the per-spring blocks (E·d·d values) into the CSR ``data``, -B on
     (a, a) and (b, b), +B on (a, b) and (b, a): refilling is one sparse product.
     """
@@ -120,6 +121,7 @@ class JacobianPattern:
         self.indices = (unique % max(n_dof, 1)).astype(index)
         self.indptr = np.zeros(n_dof + 1, dtype=index)
         np.cumsum(np.bincount(unique // max(n_dof, 1), minlength=n_dof), out=self.indptr[1:])
+        self.diagonal = np.searchsorted(unique, diagonal * (n_dof + 1))  # where (i, i) is
         block_entries = body.n_springs * dim * dim
         signs = np.repeat([-1.0, -1.0, 1.0, 1.0], block_entries)
         entry = np.tile(np.arange(block_entries), 4)
@@ -131,10 +133,11 @@ class JacobianPattern:
         """One CSR matrix per array of spring blocks (E, d, d), on this pattern."""
         values = np.stack([block.ravel() for block in blocks], axis=1)
         data = self.assemble @ values
-        return [
-            sp.csr_matrix((data[:, i], self.indices, self.indptr), shape=self.shape, copy=False)
-            for i in range(len(blocks))
-        ]
+        return [self.matrix(data[:, i]) for i in range(len(blocks))]
+
+    def matrix(self, data: np.ndarray) -> sp.csr_matrix:
+        """The CSR matrix with values ``data`` on this pattern."""
+        return sp.csr_matrix((data, self.indices, self.indptr), shape=self.shape, copy=False)
 
 
 def spring_jacobians(

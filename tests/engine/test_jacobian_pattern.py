@@ -124,3 +124,18 @@ def test_coincident_ends_give_an_isotropic_block(kernel: str) -> None:
     block = 7.0 * np.eye(3)
     np.testing.assert_array_equal(jx.toarray(), np.block([[-block, block], [block, -block]]))
     np.testing.assert_array_equal(jv.toarray(), np.zeros((6, 6)))
+
+
+@pytest.mark.parametrize("dashpots", [False, True])
+def test_implicit_matrix_is_the_sum_of_the_jacobians(dashpots: bool) -> None:
+    """M - h_v ∂F/∂v - h_x ∂F/∂x on the pattern's values, a force's Jacobian included."""
+    body = shaken_grid(4)
+    if not dashpots:
+        body.spring_damping[:] = 0.0
+    dynamics = Dynamics(body, [msd.ViscousDamping(0.3)])
+    x, v = body.positions, body.velocities
+    matrix, jx = dynamics.implicit_matrix(x, v, 0.02, 0.0004)
+    expected_x, expected_v = dynamics.jacobians(x, v)
+    expected = sp.diags(np.repeat(body.masses, 3)) - 0.02 * expected_v - 0.0004 * expected_x
+    np.testing.assert_allclose(matrix.toarray(), expected.toarray(), rtol=1e-13, atol=1e-13)
+    np.testing.assert_array_equal(jx.toarray(), expected_x.toarray())
