@@ -86,8 +86,11 @@ class _OneMode:
     ) -> tuple[np.ndarray, np.ndarray]:
         return update(x, v, self.acceleration(x, v), dt, *coefficients)
 
-    def jacobians(self, x: np.ndarray, v: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
-        return sp.csr_matrix([[-(self.mode.omega**2)]]), sp.csr_matrix([[-self.mode.gamma]])
+    def implicit_matrix(
+        self, x: np.ndarray, v: np.ndarray, h_v: float, h_x: float
+    ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        jx = sp.csr_matrix([[-(self.mode.omega**2)]])
+        return sp.csr_matrix([[1.0 + h_v * self.mode.gamma]]) - h_x * jx, jx
 
 
 def spectral_radius(integrator: Integrator, mode: Mode, dt: float) -> float:
