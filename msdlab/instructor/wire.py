@@ -22,6 +22,7 @@ MAX_DEPTH = 32
 _KINDS = "biufc"  # bool, int, uint, float, complex
 _AS_IS = frozenset({str, bool, int, type(None)})  # exact types a frame holds as they are
 _SCALARS = _AS_IS | {float}
+_JSON = json.JSONEncoder(allow_nan=False)  # json.dumps(..., allow_nan=False), built once
 
 
 class WireError(Exception):
@@ -62,6 +63,10 @@ def encode(value: Any, reference: Callable[[Any], Ref] | None = None) -> bytes:
             return frame_array(item)
         if kind is tuple:
             return {"$t": [walk(x, depth + 1) for x in item]}
+        if kind is dict and all(isinstance(k, str) for k in item):
+            return {"$d": {k: walk(x, depth + 1) for k, x in item.items()}}
+        if kind is Ref:
+            return {"$r": item.id, "k": item.kind}
         if item is None or isinstance(item, (bool, str)):
             return item
         if isinstance(item, (int, np.integer)) and not isinstance(item, np.bool_):
@@ -85,7 +90,7 @@ def encode(value: Any, reference: Callable[[Any], Ref] | None = None) -> bytes:
             return {"$r": item.id, "k": item.kind}
         raise WireError(f"{type(item).__name__} is not plain data")
 
-    header = json.dumps(walk(value, 0), allow_nan=False).encode()
+    header = _JSON.encode(walk(value, 0)).encode()
     parts = [struct.pack("<QQ", len(header), len(buffers)), header]
     for buffer in buffers:
         parts += [struct.pack("<Q", len(buffer)), buffer]
