@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 from msdlab.cli import main
-from msdlab.course import PROJECT_ROOT
+from msdlab.course import PROJECT_ROOT, reference_cache
 from msdlab.course.report import CheckReport, CheckResult
-from msdlab.instructor import feedback, gradebook, intake, reference_cache
+from msdlab.instructor import feedback, gradebook, intake
 from msdlab.instructor.grading import Grade
 
 SOLUTIONS = PROJECT_ROOT / "solutions"

@@ -13,7 +13,7 @@ import numpy as np
 
 import msdlab as msd
 from msdlab.course import oracles
-from msdlab.instructor.reference_cache import cached
+from msdlab.course.reference_cache import cached
 
 
 def first_floor_contact(y0: float, dt: float, g: float, limit: int = 1_000_000) -> int:
