@@ -179,7 +179,7 @@ class Reader:
             wanted = min(max(size - len(buffer), CHUNK_BYTES), 1 << 20)
             chunk = os.read(self.fd, wanted)
             if not chunk:
-                raise EOFError("the other process closed the connection")
+                raise EOFError  # the grader names the reason (`SandboxProcess._death_reason`)
             buffer += chunk
         data = bytes(buffer[:size])
         del buffer[:size]
