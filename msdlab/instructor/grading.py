@@ -27,9 +27,8 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..course import TASKS
+from ..course import TASKS, reference_cache
 from ..course.report import CheckReport
-from . import reference_cache
 from .judge_server import JudgeServer
 
 MAX_FILE_BYTES = 1_000_000

@@ -204,6 +204,7 @@ class SandboxProcess:
         self.members: dict[tuple[int, str], wire.Ref] = {}
         self.broken: dict[str, SandboxError] = {}  # name -> its failure, until `forgive`
         self.refused_task: int | None = None  # whose engine answers the submission may not use
+        self._deadline, self._limit = 0.0, timeout  # of the answer being waited for
 
     @property
     def isolation(self) -> str:
@@ -233,6 +234,7 @@ class SandboxProcess:
         self.close()
         to_child, self._send_fd = os.pipe()
         self._recv_fd, from_child = os.pipe()
+        self._reader = wire.Reader(self._recv_fd, self._wait_for_answer)  # nothing left over
         sites = _sites()
         if self.strong:
             folder, scratch, library = INSIDE_FOLDER, INSIDE_SCRATCH, INSIDE_LIBRARY
@@ -336,7 +338,7 @@ class SandboxProcess:
             while True:
                 reply = self._receive(deadline, limit)
                 if isinstance(reply, dict) and "op" in reply:
-                    wire.write_all(self._send_fd, wire.encode(self._serve(reply)))
+                    wire.write_all(self._send_fd, self._serve(reply))
                     continue
                 break
         except SubmissionTimeout as error:
@@ -363,24 +365,18 @@ class SandboxProcess:
             self.broken[name] = error
 
     def _receive(self, deadline: float, limit: float) -> Any:
-        def read(size: int) -> bytes:
-            chunks, left = [], size
-            while left:
-                remaining = deadline - time.monotonic()
-                ready, _, _ = select.select([self._recv_fd], [], [], max(remaining, 0))
-                if not ready:
-                    raise SubmissionTimeout(
-                        f"the submission did not answer within {limit:g} s "
-                        "(an endless loop, or far too much work?)"
-                    )
-                chunk = os.read(self._recv_fd, min(left, 1 << 20))
-                if not chunk:
-                    raise EOFError
-                chunks.append(chunk)
-                left -= len(chunk)
-            return b"".join(chunks)
+        self._deadline, self._limit = deadline, limit
+        return wire.decode(self._reader)
 
-        return wire.decode(read)
+    def _wait_for_answer(self) -> None:
+        """Wait until the child has written something, or raise `SubmissionTimeout`."""
+        remaining = self._deadline - time.monotonic()
+        ready, _, _ = select.select([self._recv_fd], [], [], max(remaining, 0))
+        if not ready:
+            raise SubmissionTimeout(
+                f"the submission did not answer within {self._limit:g} s "
+                "(an endless loop, or far too much work?)"
+            )
 
     def _death_reason(self) -> str:
         if self.process is None:
@@ -402,8 +398,9 @@ class SandboxProcess:
         self.exports[id(value)] = value
         return wire.Ref(id(value), "grader")
 
-    def _serve(self, request: dict) -> dict:
-        """Answer a callback: a whitelisted attribute or a call of an exported callable."""
+    def _serve(self, request: dict) -> bytes:
+        """Answer a callback, encoded: a whitelisted attribute or a call of an exported
+        callable (an answer that is not plain data is an error for the submission)."""
         try:
             target = self.exports[request["ref"].id]
             if request["op"] == "getattr":
@@ -414,15 +411,15 @@ class SandboxProcess:
                 if key not in self.members:
                     value = getattr(target, name)
                     if not callable(value):
-                        return {"ok": _plain(value)}
+                        return wire.encode({"ok": value})
                     self.members[key] = self._export(value)
-                return {"ok": self.members[key]}
+                return wire.encode({"ok": self.members[key]})
             if request["op"] == "call" and callable(target):
                 args = [np.asarray(a, dtype=float) for a in request["args"]]
-                return {"ok": _plain(target(*args))}
+                return wire.encode({"ok": target(*args)})
             raise ValueError("unknown callback")
         except Exception as error:
-            return {"error": f"{type(error).__name__}: {error}"}
+            return wire.encode({"error": f"{type(error).__name__}: {error}"})
 
 
 def write_back(arguments: dict[str, np.ndarray], changed: Any, name: str) -> None:
@@ -460,11 +457,6 @@ def write_back(arguments: dict[str, np.ndarray], changed: Any, name: str) -> Non
 
 class ArgumentChanged(AssertionError):
     """A submission's function changed the shape or dtype of an array it was given."""
-
-
-def _plain(value: Any) -> Any:
-    wire.encode(value)  # raises WireError if it is not plain data
-    return value
 
 
 def _raise(error: dict) -> None:

@@ -12,12 +12,13 @@ import sys
 import zipfile
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from msdlab.cli import main
-from msdlab.course import PROJECT_ROOT
+from msdlab.course import PROJECT_ROOT, reference_cache
 from msdlab.course.report import CheckReport, CheckResult
-from msdlab.instructor import feedback, gradebook, intake, reference_cache
+from msdlab.instructor import feedback, gradebook, intake
 from msdlab.instructor.grading import Grade
 
 SOLUTIONS = PROJECT_ROOT / "solutions"
@@ -246,3 +247,17 @@ def test_references_are_computed_once_per_run_and_read_back_exactly(tmp_path, mo
     first = reference(0.1)
     assert reference(0.1) == first == 0.1 / 3.0 + 3 and len(calls) == 3
     assert reference(0.1, steps=4) != first and len(calls) == 4
+
+
+def test_array_references_are_read_back_bit_for_bit(tmp_path, monkeypatch):
+    calls = []
+
+    @reference_cache.cached
+    def frames(scale: float) -> np.ndarray:
+        calls.append(scale)
+        return scale * np.array([[0.1, -0.0], [np.pi, 1e-300]])
+
+    monkeypatch.setenv(reference_cache.ENV, str(tmp_path))
+    first, again = frames(3.0), frames(3.0)
+    assert len(calls) == 1 and again.dtype == first.dtype and again.shape == (2, 2)
+    assert again.tobytes() == first.tobytes()  # every bit, the sign of -0.0 included

@@ -13,7 +13,7 @@ import numpy as np
 
 import msdlab as msd
 from msdlab.course import oracles
-from msdlab.instructor.reference_cache import cached
+from msdlab.course.reference_cache import cached
 
 
 def first_floor_contact(y0: float, dt: float, g: float, limit: int = 1_000_000) -> int:
@@ -80,3 +80,18 @@ def drop_rotated_cube(
         steps=steps, record_every=steps
     )
     return oracles.flatness(body.positions) / before
+
+
+def solved_setting(integrator: msd.Integrator) -> np.ndarray:
+    """Positions every 50 of 800 steps of the solved setting run by ``integrator``: a 4³
+    jelly (spacing and k 0.5, 26 neighbours) turned 58.3° about z, dt = 0.4, gravity, floor."""
+    body = msd.Body.grid((4, 4, 4), 0.5, 0.5, neighbours=(1, 2, 3), origin=(-1.0, 1.5, -1.0))
+    body.rotate(msd.rotation_matrix(58.3, (0.0, 0.0, 1.0)))
+    forces = [msd.Gravity(oracles.TEMPLATE_GRAVITY), msd.Ground(0.0)]
+    return msd.Simulation(body, integrator, 0.4, forces).run(steps=800, record_every=50).positions
+
+
+@cached  # the same for every submission: computed once per grading run
+def solved_setting_verlet(damping: float = 0.01) -> np.ndarray:
+    """`solved_setting` run by the engine's msd.Verlet(damping)."""
+    return solved_setting(msd.Verlet(damping))
