@@ -27,6 +27,8 @@ from pathlib import Path
 class JudgeServer:
     """The grader's side: a server process, restarted if it is found dead."""
 
+    command = (sys.executable, "-m", "msdlab.instructor.judge_server")
+
     def __init__(self, environment: dict[str, str]) -> None:
         self.environment = environment
         self.process: subprocess.Popen | None = None
@@ -63,7 +65,7 @@ class JudgeServer:
     def _start(self) -> None:
         self.close()
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "msdlab.instructor.judge_server"],
+            self.command,
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL,

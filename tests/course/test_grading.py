@@ -6,7 +6,6 @@ from __future__ import annotations
 import csv
 import os
 import shutil
-import subprocess
 import sys
 import textwrap
 from pathlib import Path
@@ -172,13 +171,7 @@ def test_a_refused_action_at_import_costs_only_that_task(tmp_path):
 class DeadServer(JudgeServer):
     """A judge server that dies as it starts (say, an import that fails in its Python)."""
 
-    def _start(self) -> None:
-        self.close()
-        self.process = subprocess.Popen(
-            [sys.executable, "-c", "raise SystemExit(1)"],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-        )
+    command = (sys.executable, "-c", "raise SystemExit(1)")
 
 
 def test_a_judge_server_that_dies_leaves_the_grading_to_a_fresh_judge(tmp_path):
