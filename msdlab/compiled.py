@@ -714,9 +714,7 @@ class NumbaKernel:
         stiff = np.empty((body.n_springs, dim, dim))
         damp = np.empty((body.n_springs if values[2].any() else 0, dim, dim))
         _jacobian_blocks(x, body.spring_a, body.spring_b, *values, stiff, damp)
-        if not len(damp):  # no dashpots: ∂F/∂v is zero, with no entries to add up
-            return pattern.matrices(stiff)[0], sp.csr_matrix(pattern.shape)
-        return tuple(pattern.matrices(stiff, damp))
+        return pattern.jacobians(stiff, damp if len(damp) else None)
 
     @staticmethod
     def to_acceleration(body: Body, forces: np.ndarray) -> np.ndarray:

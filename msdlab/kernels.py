@@ -129,11 +129,17 @@ class JacobianPattern:
             (signs, (inverse[: len(rows)], entry)), shape=(len(unique), block_entries)
         )
 
-    def matrices(self, *blocks: np.ndarray) -> list[sp.csr_matrix]:
-        """One CSR matrix per array of spring blocks (E, d, d), on this pattern."""
+    def jacobians(
+        self, stiff: np.ndarray, damp: np.ndarray | None
+    ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """∂F/∂x and ∂F/∂v on this pattern from the springs' blocks B and C (E, d, d);
+        ``damp`` None (no dashpots) gives a ∂F/∂v with no entries to add up."""
+        blocks = [stiff] if damp is None else [stiff, damp]
         values = np.stack([block.ravel() for block in blocks], axis=1)
         data = self.assemble @ values
-        return [self.matrix(data[:, i]) for i in range(len(blocks))]
+        if damp is None:
+            return self.matrix(data[:, 0]), sp.csr_matrix(self.shape)
+        return self.matrix(data[:, 0]), self.matrix(data[:, 1])
 
     def matrix(self, data: np.ndarray) -> sp.csr_matrix:
         """The CSR matrix with values ``data`` on this pattern."""
@@ -159,9 +165,7 @@ def spring_jacobians(
     stiffness, rest, damping = body.spring_values()
     across = equations.transverse_stiffness(stiffness, rest, safe)[:, None, None]
     stiff = (stiffness[:, None, None] - across) * outer + across * np.eye(dim)
-    if not np.any(damping):  # no dashpots: ∂F/∂v is zero, with no entries to add up
-        return pattern.matrices(stiff)[0], sp.csr_matrix(pattern.shape)
-    return tuple(pattern.matrices(stiff, damping[:, None, None] * outer))
+    return pattern.jacobians(stiff, damping[:, None, None] * outer if damping.any() else None)
 
 
 def _block_indices(a: np.ndarray, b: np.ndarray, dim: int) -> tuple[np.ndarray, np.ndarray]:
