@@ -29,7 +29,7 @@ Update = Callable[..., tuple[np.ndarray, np.ndarray]]
 
 def spring_vectors(body: Body, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Spring vectors x_a - x_b (E, d) and lengths (E,) in m."""
-    d = x[body.spring_a] - x[body.spring_b]
+    d = x.take(body.spring_a, axis=0) - x.take(body.spring_b, axis=0)
     return d, np.sqrt(np.einsum("ij,ij->i", d, d))
 
 
@@ -52,33 +52,46 @@ def spring_forces(
     return out, stretch
 
 
+def component_indices(body: Body, dim: int) -> tuple[np.ndarray, np.ndarray]:
+    """Where each spring's ends sit in the positions flattened to (N·d,): (E, d) each."""
+    components = np.arange(dim)
+    return body.spring_a[:, None] * dim + components, body.spring_b[:, None] * dim + components
+
+
 def _spring_forces_and_power(
     body: Body,
     x: np.ndarray,
     v: np.ndarray,
     out: np.ndarray | None = None,
     springs: np.ndarray | None = None,
+    ends: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> tuple[np.ndarray, float, float]:
-    """`spring_forces`, and the power (W) the dashpots take at (x, v)."""
-    pick = slice(None) if springs is None else springs
-    a, b = body.spring_a[pick], body.spring_b[pick]
-    stiffness, rest, damping = (values[pick] for values in body.spring_values())
-    d = x[a] - x[b]
+    """`spring_forces`, and the power (W) the dashpots take at (x, v).
+
+    ``ends`` may pass `component_indices` (body, d), kept from an earlier call.
+    """
+    a, b = body.spring_a, body.spring_b
+    stiffness, rest, damping = body.spring_values()
+    ends_a, ends_b = component_indices(body, x.shape[1]) if ends is None else ends
+    if springs is not None:
+        a, b, stiffness, rest, damping, ends_a, ends_b = (
+            values[springs] for values in (a, b, stiffness, rest, damping, ends_a, ends_b)
+        )
+    d = x.take(a, axis=0) - x.take(b, axis=0)
     length = np.sqrt(np.einsum("ij,ij->i", d, d))
     safe = np.where(length > 0, length, np.inf)  # coincident ends: no direction, no force
     power = 0.0
     rate = 0.0
-    if np.any(damping):
-        rate = np.einsum("ij,ij->i", v[a] - v[b], d) / safe
+    if damping.any():
+        rate = np.einsum("ij,ij->i", v.take(a, axis=0) - v.take(b, axis=0), d) / safe
         power = float(np.sum(equations.dashpot_power(damping, rate)))
     magnitude = equations.spring_force(stiffness, rest, length, damping, rate)
-    f = np.where(length > 0, magnitude / safe, 0.0)[:, None] * d
+    f = ((magnitude / safe)[:, None] * d).ravel()  # d = 0 where the ends coincide
     if out is None:
         out = np.zeros_like(x)
-    n = len(x)
-    for axis in range(x.shape[1]):
-        out[:, axis] += np.bincount(a, f[:, axis], n) - np.bincount(b, f[:, axis], n)
-    stretch = float(np.max(length / rest)) if len(length) else 0.0
+    on_a = np.bincount(ends_a.ravel(), f, out.size)
+    out += (on_a - np.bincount(ends_b.ravel(), f, out.size)).reshape(out.shape)
+    stretch = float((length / rest).max()) if len(length) else 0.0
     return out, stretch, power
 
 
@@ -222,6 +235,10 @@ class NumpyKernel:
 
     name = "numpy"
 
+    def __init__(self) -> None:
+        self._version = -1
+        self._ends = (np.zeros((0, 3), dtype=np.int64),) * 2  # `component_indices` of the body
+
     def add_spring_forces(
         self,
         body: Body,
@@ -231,7 +248,10 @@ class NumpyKernel:
         springs: np.ndarray | None = None,
     ) -> tuple[float, float]:
         """Add the spring and dashpot forces (N) to ``out``; return (largest stretch, power W)."""
-        _, stretch, power = _spring_forces_and_power(body, x, v, out, springs)
+        if self._version != body.topology_version or self._ends[0].shape[1:] != x.shape[1:]:
+            self._ends = component_indices(body, x.shape[1])
+            self._version = body.topology_version
+        _, stretch, power = _spring_forces_and_power(body, x, v, out, springs, self._ends)
         return stretch, power
 
     def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
