@@ -16,6 +16,8 @@ from ..body import Body
 from ..constraint import Constraint, StepState
 from ..errors import check_non_negative
 
+_UP = {2: (0.0, 1.0), 3: (0.0, 1.0, 0.0)}  # the default ground normal, +y
+
 
 class Ground(Constraint):
     """The template's floor: particles that end a step below the plane are put back on it.
@@ -59,9 +61,7 @@ class Ground(Constraint):
         self.friction = float(friction)
 
     def _normal(self, body: Body) -> np.ndarray:
-        if self.normal is None:
-            return np.eye(body.dim)[1]
-        return self.normal
+        return np.array(_UP[body.dim]) if self.normal is None else self.normal
 
     def check(self, body: Body) -> None:
         if len(self._normal(body)) != body.dim:
@@ -72,26 +72,28 @@ class Ground(Constraint):
 
     def apply(self, state: StepState) -> float:
         n = self._normal(state.body)
-        axis = np.flatnonzero(n)
-        if len(axis) == 1 and n[axis[0]] == 1.0:  # a floor along an axis: read one column,
-            depth = self.height - state.x[:, axis[0]]  # much faster than a matrix product
-        else:
-            depth = self.height - state.x @ n
-        below = np.flatnonzero(depth > 0)
+        up = state.x[:, 1] if self.normal is None else state.x @ n  # y: no matrix product
+        depth = self.height - up
+        below = (depth > 0).nonzero()[0]
         below = below[~state.body.fixed[below]]  # fixed ones only among the few below
         if len(below) == 0:
             return 0.0
-        x, v = state.x, state.v
-        x[below] += depth[below, None] * n
-        landing = v[below] @ n
-        normal_speed = (x[below] - state.x_old[below]) @ n / state.dt
-        tangential = v[below] - landing[:, None] * n
-        v[below] = (1.0 - self.friction) * tangential + normal_speed[:, None] * n
-        masses = state.body.masses[below]
+        x = state.x.take(below, axis=0) + depth.take(below)[:, None] * n
+        v = state.v.take(below, axis=0)
+        state.x[below] = x
+        landing = v @ n
+        normal_speed = (x - state.x_old.take(below, axis=0)) @ n / state.dt
+        tangential = v - landing[:, None] * n
+        state.v[below] = (1.0 - self.friction) * tangential + normal_speed[:, None] * n
+        masses = state.body.masses.take(below)
         kick = (normal_speed - landing)[:, None] * n
-        normal_before = (state.v_old[below] @ n)[:, None] * n
+        normal_before = (state.v_old.take(below, axis=0) @ n)[:, None] * n
         work = energy.contact_work(masses, kick, normal_before, normal_speed[:, None] * n)
-        rubbed = energy.kinetic_energy_removed(masses, tangential, 1.0 - self.friction)
+        rubbed = (
+            energy.kinetic_energy_removed(masses, tangential, 1.0 - self.friction)
+            if self.friction
+            else 0.0  # no friction: the tangential velocity is kept
+        )
         return rubbed - work
 
     def __repr__(self) -> str:
