@@ -274,7 +274,7 @@ class Simulation:
         return energy
 
     def _check_divergence(self, x: np.ndarray, x_new: np.ndarray, v_new: np.ndarray) -> None:
-        finite = math.isfinite(float(np.sum(x_new)) + float(np.sum(v_new)))
+        finite = math.isfinite(float(x_new.sum()) + float(v_new.sum()))
         stretched = self.max_stretch is not None and self.dynamics.max_stretch > self.max_stretch
         if not finite or stretched:
             diagnosis = diagnose_divergence(
