@@ -145,7 +145,13 @@ def _answers(entry: str, function: Callable, args: tuple, kwargs: dict) -> bool:
 
 def _is_student(filename: str) -> bool:
     folder = _state["folder"]
-    return bool(folder) and os.path.realpath(filename).startswith(folder)
+    return bool(folder) and _resolved(filename).startswith(folder)
+
+
+@functools.cache
+def _resolved(filename: str) -> str:
+    """``os.path.realpath(filename)``, once per file (a guarded step asks every step)."""
+    return os.path.realpath(filename)
 
 
 def _defined_by_student(cls: type) -> bool:
