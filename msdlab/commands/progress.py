@@ -10,7 +10,10 @@ from typing import TextIO
 class ProgressBar:
     """Call with the number of steps done; draws ``[#####.....] 50%`` once ``delay`` s have passed.
 
-    Quick runs print nothing. `close` ends the line if a bar was drawn.
+    Quick runs print nothing. `close` ends the line if a bar was drawn. The time
+    left is estimated from the pace since the first call, so a slow first step
+    (loading or compiling kernels) does not inflate it; until the steps have
+    moved on from there, no estimate is shown.
     """
 
     def __init__(
@@ -23,20 +26,29 @@ class ProgressBar:
         self.started = time.perf_counter()
         self.last_drawn = -1.0
         self.shown = False
+        self.first: tuple[float, int] | None = None  # (time, steps done) at the first call
+        self.width = 0  # of the longest line drawn
 
     def __call__(self, done: int) -> None:
         now = time.perf_counter()
+        if self.first is None:
+            self.first = (now, done)
         if now - self.started < self.delay or (now - self.last_drawn < 0.1 and done < self.total):
             return
         self.last_drawn, self.shown = now, True
         fraction = min(done / self.total, 1.0)
         filled = int(30 * fraction)
         elapsed = now - self.started
-        left = elapsed * (1 - fraction) / fraction if fraction > 0 else 0.0
+        since, done_then = self.first
+        if done > done_then:
+            pace = (now - since) / (done - done_then)  # s per step
+            left = f"~{pace * (self.total - min(done, self.total)):4.1f} s left"
+        else:
+            left = "time left unknown yet"
         bar = "#" * filled + "." * (30 - filled)
-        self.stream.write(
-            f"\r{self.label} [{bar}] {100 * fraction:3.0f}%  {elapsed:5.1f} s, ~{left:4.1f} s left"
-        )
+        line = f"{self.label} [{bar}] {100 * fraction:3.0f}%  {elapsed:5.1f} s, {left}"
+        self.stream.write(f"\r{line:<{self.width}}")  # blank out a longer line drawn before
+        self.width = max(self.width, len(line))
         self.stream.flush()
 
     def close(self) -> None:

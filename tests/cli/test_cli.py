@@ -136,6 +136,18 @@ def test_progress_bar_only_for_runs_that_take_a_moment():
     assert text.endswith("\n")
 
 
+def test_progress_bar_estimates_the_time_left_from_the_pace_after_the_first_step(monkeypatch):
+    """A first step that loads the kernels (2 s) does not count toward the pace of the rest."""
+    clock = iter([0.0, 2.0, 3.0])  # perf_counter: created, then one per call
+    monkeypatch.setattr("msdlab.commands.progress.time.perf_counter", lambda: next(clock))
+    stream = io.StringIO()
+    bar = ProgressBar(1000, "run", stream=stream, delay=0.0)
+    bar(1)  # at 2 s: one step done, the first one slow
+    assert stream.getvalue().endswith("time left unknown yet")
+    bar(101)  # at 3 s: 100 steps in 1 s since then, 899 to go
+    assert stream.getvalue().rstrip().endswith("~ 9.0 s left")
+
+
 def test_quick_start_demo_in_a_real_process(tmp_path):
     """The README's `msdlab demo`, as a user runs it: a few seconds, no display."""
     result = subprocess.run(
