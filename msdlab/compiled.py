@@ -10,7 +10,9 @@ Large bodies split the springs between the threads, each summing into its own
 force buffer (no two threads write the same memory; the first one writes the
 result), and the buffers are then added per particle. The springs are visited
 sorted by their ends, so memory is read in order whatever order they were
-added in.
+added in; along the springs of one first end, its position and force stay in
+registers. Their stiffness, rest length and dashpot come from a small table
+of the distinct triples, through a one- or two-byte class per spring.
 
 Grid bodies (`msdlab.stencil`) whose springs share their values per offset
 go by offset instead, with no list of springs: each particle computes its
@@ -58,6 +60,11 @@ PARALLEL_MIN_SPRINGS = 50_000
 PARALLEL_MIN_PARTICLES = 20_000
 # Particles a gather block holds (whole grid rows): long inner loops, enough blocks for threads.
 GATHER_BLOCK = 4096
+# At most this many distinct (stiffness, rest length, dashpot) triples are kept as a table
+# with a class number per spring (uint8 up to 256, else uint16); past it, the values per spring.
+SPRING_CLASSES = 65_536
+# Odd constants that mix the bits of the spring values into a hash (see `_spring_classes`).
+_MIX = (np.uint64(0x9E3779B97F4A7C15), np.uint64(0xC2B2AE3D27D4EB4F), np.uint64(0x165667B19E3779F9))
 
 _spring_force = numba.njit(cache=True, inline="always")(equations.spring_force)
 _spring_energy = numba.njit(cache=True, inline="always")(equations.spring_energy)
@@ -68,50 +75,78 @@ _acceleration = numba.njit(cache=True, inline="always")(equations.acceleration)
 
 
 @numba.njit(cache=True, inline="always")
-def _add_spring_forces(x, v, a, b, k, rest, c, first, stop, out):
-    """Add the forces of springs ``first`` to ``stop - 1`` to ``out`` (2-D or 3-D).
+def _add_spring_forces(x, v, a, b, kinds, k, rest, c, first, stop, out, three):
+    """Add the forces of springs ``first`` to ``stop - 1`` to ``out``, (N, 3) if ``three``
+    else (N, 2). Returns the largest stretch |d|/l and the dashpot power (W) of those springs.
 
-    Returns the largest stretch |d|/l and the dashpot power (W) of those springs.
+    Spring s has the stiffness, rest length and dashpot ``k``, ``rest``, ``c`` at
+    ``kinds[s]`` (see `_spring_classes`), or at s when ``kinds`` is None. Along a
+    run of springs with the same end a, a's position and force stay in registers:
+    its force is summed in the same order as in memory, so the sums do not change.
     """
-    three = x.shape[1] == 3
     stretch = 0.0
     power = 0.0
+    if first >= stop:
+        return stretch, power
+    i = a[numba.uint64(first)]
+    y0, y1, y2 = x[i, 0], x[i, 1], x[i, 2] if three else 0.0
+    f0, f1, f2 = out[i, 0], out[i, 1], out[i, 2] if three else 0.0
     for s in range(first, stop):
-        i, j = a[s], b[s]
-        d0 = x[i, 0] - x[j, 0]
-        d1 = x[i, 1] - x[j, 1]
-        d2 = x[i, 2] - x[j, 2] if three else 0.0
+        u = numba.uint64(s)  # unsigned: no test for negative indices
+        if a[u] != i:
+            out[i, 0], out[i, 1] = f0, f1
+            if three:
+                out[i, 2] = f2
+            i = a[u]
+            y0, y1, y2 = x[i, 0], x[i, 1], x[i, 2] if three else 0.0
+            f0, f1, f2 = out[i, 0], out[i, 1], out[i, 2] if three else 0.0
+        j = b[u]
+        m = u if kinds is None else kinds[u]
+        d0 = y0 - x[j, 0]
+        d1 = y1 - x[j, 1]
+        d2 = y2 - x[j, 2] if three else 0.0
         length = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-        if length > stretch * rest[s]:  # cheaper than dividing for every spring
-            stretch = length / rest[s]
+        if length > stretch * rest[m]:  # cheaper than dividing for every spring
+            stretch = length / rest[m]
         if length == 0.0:  # coincident ends: no direction, no force
             continue
         rate = 0.0
-        if c[s] != 0.0:
+        if c[m] != 0.0:
             closing = (v[i, 0] - v[j, 0]) * d0 + (v[i, 1] - v[j, 1]) * d1
             if three:
                 closing += (v[i, 2] - v[j, 2]) * d2
             rate = closing / length
-            power += _dashpot_power_of(c[s], rate)
-        scale = _spring_force(k[s], rest[s], length, c[s], rate) / length
-        out[i, 0] += scale * d0
+            power += _dashpot_power_of(c[m], rate)
+        scale = _spring_force(k[m], rest[m], length, c[m], rate) / length
+        f0 += scale * d0
         out[j, 0] -= scale * d0
-        out[i, 1] += scale * d1
+        f1 += scale * d1
         out[j, 1] -= scale * d1
         if three:
-            out[i, 2] += scale * d2
+            f2 += scale * d2
             out[j, 2] -= scale * d2
+    out[i, 0], out[i, 1] = f0, f1
+    if three:
+        out[i, 2] = f2
     return stretch, power
 
 
+@numba.njit(cache=True, inline="always")
+def _add_spring_block(x, v, a, b, kinds, k, rest, c, first, stop, out):
+    """`_add_spring_forces` compiled apart for 2-D and 3-D (``three`` a constant in each)."""
+    if x.shape[1] == 3:
+        return _add_spring_forces(x, v, a, b, kinds, k, rest, c, first, stop, out, True)
+    return _add_spring_forces(x, v, a, b, kinds, k, rest, c, first, stop, out, False)
+
+
 @numba.njit(cache=True)
-def _spring_forces_serial(x, v, a, b, k, rest, c, out):
+def _spring_forces_serial(x, v, a, b, kinds, k, rest, c, out):
     """One thread: add every spring's force to ``out``; return (largest stretch, dashpot power)."""
-    return _add_spring_forces(x, v, a, b, k, rest, c, 0, len(a), out)
+    return _add_spring_block(x, v, a, b, kinds, k, rest, c, 0, len(a), out)
 
 
 @numba.njit(cache=True, parallel=True)
-def _spring_forces_parallel(x, v, a, b, k, rest, c, partial, out):
+def _spring_forces_parallel(x, v, a, b, kinds, k, rest, c, partial, out):
     """Threads: spring block 0 is summed into ``out``, block t > 0 into ``partial[t - 1]``.
 
     The partial buffers are then added to ``out`` particle by particle.
@@ -123,10 +158,10 @@ def _spring_forces_parallel(x, v, a, b, k, rest, c, partial, out):
     for t in numba.prange(blocks):
         first, stop = t * count // blocks, (t + 1) * count // blocks
         if t == 0:
-            sums = _add_spring_forces(x, v, a, b, k, rest, c, first, stop, out)
+            sums = _add_spring_block(x, v, a, b, kinds, k, rest, c, first, stop, out)
         else:
             partial[t - 1] = 0.0
-            sums = _add_spring_forces(x, v, a, b, k, rest, c, first, stop, partial[t - 1])
+            sums = _add_spring_block(x, v, a, b, kinds, k, rest, c, first, stop, partial[t - 1])
         stretches[t], powers[t] = sums
     n, dim = out.shape
     for i in numba.prange(n):
@@ -136,6 +171,41 @@ def _spring_forces_parallel(x, v, a, b, k, rest, c, partial, out):
                 total += partial[t, i, q]
             out[i, q] = total
     return stretches.max(), powers.sum()
+
+
+@numba.njit(cache=True)
+def _spring_classes(k_bits, rest_bits, c_bits, order, slots, kinds, table):
+    """Number the distinct (stiffness, rest length, dashpot) triples of the springs, in one pass.
+
+    Spring s, the body's spring ``order[s]`` (s itself if ``order`` is empty),
+    gets in ``kinds[s]`` the class of its triple, whose bit patterns (int64
+    views of the values, so equal means identical) go to ``table[class]``.
+    ``slots`` (a power of two long, zero) is the hash table of the classes
+    (class + 1, 0 for free). Returns the number of classes, or -1 if there
+    are more than ``len(table)``.
+    """
+    mask = numba.uint64(len(slots) - 1)
+    count = 0
+    for s in range(len(kinds)):
+        e = order[s] if len(order) else s
+        key = (k_bits[e], rest_bits[e], c_bits[e])
+        h = numba.uint64(key[0]) * _MIX[0] ^ numba.uint64(key[1]) * _MIX[1]
+        h ^= numba.uint64(key[2]) * _MIX[2]
+        slot = (h ^ (h >> numba.uint64(32))) & mask
+        while slots[slot] != 0 and (
+            table[slots[slot] - 1, 0] != key[0]
+            or table[slots[slot] - 1, 1] != key[1]
+            or table[slots[slot] - 1, 2] != key[2]
+        ):
+            slot = (slot + numba.uint64(1)) & mask
+        if slots[slot] == 0:
+            if count == len(table):
+                return -1
+            table[count, 0], table[count, 1], table[count, 2] = key
+            count += 1
+            slots[slot] = count
+        kinds[s] = slots[slot] - 1
+    return count
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -613,7 +683,7 @@ class NumbaKernel:
         self._uniform = False
         self._order: np.ndarray | None = None
         self._sorted_version = -1
-        self._sorted_values: tuple[np.ndarray, ...] = ()
+        self._classes: tuple[np.ndarray | None, ...] = (None,)  # see `_edge_list`
 
     name = "numba"
 
@@ -641,8 +711,9 @@ class NumbaKernel:
                 squares, powers = gather(x, v, *layout, self._scratch, out)
                 return math.sqrt(squares.max()), float(powers.sum())  # one order, any threads
         if springs is not None:
-            arrays = (body.spring_a, body.spring_b, *body.spring_values())
-            return _spring_forces_serial(x, v, *(array[springs] for array in arrays), out)
+            a, b, k, rest, c = (body.spring_a, body.spring_b, *body.spring_values())
+            a, b, k, rest, c = (array[springs] for array in (a, b, k, rest, c))
+            return _spring_forces_serial(x, v, a, b, None, k, rest, c, out)
         arrays = self._edge_list(body)
         if not self._parallel(body):
             return _spring_forces_serial(x, v, *arrays, out)
@@ -764,18 +835,21 @@ class NumbaKernel:
         a = equations.acceleration(forces + body.masses[:, None] * field, inverse[:, None])
         return update(x, v, a, dt, *coefficients)
 
-    def _edge_list(self, body: Body) -> tuple[np.ndarray, ...]:
-        """Ends a, b and stiffness, rest length, dashpot of all springs, sorted by (a, b).
+    def _edge_list(self, body: Body) -> tuple[np.ndarray | None, ...]:
+        """Ends a, b of all springs sorted by (a, b), each one's class (or None) and the
+        stiffness, rest length and dashpot of each class (or of each spring).
 
         In that order consecutive springs share or neighbour their particles,
         so the edge loop reads and writes memory it has just used, whatever
         order the springs were added in (a shuffled 60³ grid: several times
-        faster). The ends (int32: half the memory traffic of int64) and the
-        order are kept per topology; the sorted values are copied again when
-        they may have changed (see `grid_stencil`).
+        faster). The ends (uint32: half the memory traffic of int64) and the
+        order are kept per topology; the classes (`_spring_classes`) are found
+        again when the values may have changed (see `grid_stencil`). Past
+        `SPRING_CLASSES` distinct values the loop reads them per spring: the
+        body's arrays, or copies in the sorted order.
         """
         if self._version != body.topology_version:
-            index = np.int32 if body.n_particles < 2**31 else np.int64
+            index = np.uint32 if body.n_particles < 2**32 else np.uint64
             order = np.lexsort((body.spring_b, body.spring_a))
             self._order = None if np.array_equal(order, np.arange(len(order))) else order
             ends = (body.spring_a, body.spring_b)
@@ -785,9 +859,28 @@ class NumbaKernel:
             self._version = body.topology_version
             self._sorted_version = -1
         values = body.spring_values()
-        if self._order is None:
-            return self._a, self._b, *values
         if body.parameters_version != self._sorted_version or _shared(values):
-            self._sorted_values = tuple(array[self._order] for array in values)
+            self._classes = self._spring_classes(values)
             self._sorted_version = body.parameters_version
-        return self._a, self._b, *self._sorted_values
+        if self._classes[0] is None and self._order is None:
+            return self._a, self._b, None, *values  # not kept: a reference would look shared
+        return self._a, self._b, *self._classes
+
+    def _spring_classes(self, values: tuple[np.ndarray, ...]) -> tuple[np.ndarray | None, ...]:
+        """Each sorted spring's class (uint8 or uint16) and the stiffness (N/m), rest length
+        (m) and dashpot (N·s/m) of each class; (None,) past `SPRING_CLASSES` classes,
+        with the values in the sorted order if they are not in the body's."""
+        most = min(len(values[0]), SPRING_CLASSES)
+        slots = np.zeros(1 << max(4, (2 * most).bit_length()), np.int32)
+        kinds = np.empty(len(values[0]), np.uint16)
+        table = np.empty((most, 3), np.int64)
+        order = np.zeros(0, np.int64) if self._order is None else self._order
+        bits = (array.view(np.int64) for array in values)
+        classes = _spring_classes(*bits, order, slots, kinds, table)
+        if classes < 0:
+            if self._order is None:
+                return (None,)
+            return None, *(array[self._order] for array in values)
+        table = table[:classes].view(np.float64)
+        kinds = kinds.astype(np.uint8) if classes <= 256 else kinds
+        return kinds, *(np.ascontiguousarray(column) for column in table.T)
