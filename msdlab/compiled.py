@@ -84,10 +84,10 @@ def _add_spring_forces(x, v, a, b, kinds, k, rest, c, first, stop, out, three):
     run of springs with the same end a, a's position and force stay in registers:
     its force is summed in the same order as in memory, so the sums do not change.
     """
-    stretch = 0.0
+    peak = np.zeros(1)  # the stretch, in memory: a register would make it divide every time
     power = 0.0
     if first >= stop:
-        return stretch, power
+        return 0.0, power
     i = a[numba.uint64(first)]
     y0, y1, y2 = x[i, 0], x[i, 1], x[i, 2] if three else 0.0
     f0, f1, f2 = out[i, 0], out[i, 1], out[i, 2] if three else 0.0
@@ -106,8 +106,8 @@ def _add_spring_forces(x, v, a, b, kinds, k, rest, c, first, stop, out, three):
         d1 = y1 - x[j, 1]
         d2 = y2 - x[j, 2] if three else 0.0
         length = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-        if length > stretch * rest[m]:  # cheaper than dividing for every spring
-            stretch = length / rest[m]
+        if length > peak[0] * rest[m]:  # cheaper than dividing for every spring
+            peak[0] = length / rest[m]
         if length == 0.0:  # coincident ends: no direction, no force
             continue
         rate = 0.0
@@ -128,7 +128,7 @@ def _add_spring_forces(x, v, a, b, kinds, k, rest, c, first, stop, out, three):
     out[i, 0], out[i, 1] = f0, f1
     if three:
         out[i, 2] = f2
-    return stretch, power
+    return peak[0], power
 
 
 @numba.njit(cache=True, inline="always")
