@@ -29,7 +29,9 @@ same particle; one thread takes them in the same order, with the same sums.
 `NumbaKernel.advance` compiles an integrator's update function (for example
 `integrators.verlet_update`) into one loop over the particles that computes
 a = F/m (plus gravity's g) and the update together; it is compiled once per
-process and update.
+process and update. When the springs' forces are all the forces
+(`NumbaKernel.advance_with_springs`), the threads' force buffers are added in
+that loop too, not in a pass of their own.
 
 The spring loops are compiled on first use and cached on disk (``cache=True``),
 so compiling is paid once per machine and numba version. Set the number of
@@ -146,10 +148,11 @@ def _spring_forces_serial(x, v, a, b, kinds, k, rest, c, out):
 
 
 @numba.njit(cache=True, parallel=True)
-def _spring_forces_parallel(x, v, a, b, kinds, k, rest, c, partial, out):
+def _spring_forces_parallel(x, v, a, b, kinds, k, rest, c, partial, out, reduce):
     """Threads: spring block 0 is summed into ``out``, block t > 0 into ``partial[t - 1]``.
 
-    The partial buffers are then added to ``out`` particle by particle.
+    With ``reduce`` the partial buffers are then added to ``out`` particle by
+    particle; else the caller adds them in its own loop (see `_compile_advance`).
     """
     blocks = len(partial) + 1
     count = len(a)
@@ -164,7 +167,7 @@ def _spring_forces_parallel(x, v, a, b, kinds, k, rest, c, partial, out):
             sums = _add_spring_block(x, v, a, b, kinds, k, rest, c, first, stop, partial[t - 1])
         stretches[t], powers[t] = sums
     n, dim = out.shape
-    for i in numba.prange(n):
+    for i in numba.prange(n if reduce else 0):
         for q in range(dim):
             total = out[i, q]
             for t in range(blocks - 1):
@@ -609,6 +612,8 @@ def _divide_by_masses(forces, masses, fixed):
 def _compile_advance(update: Callable, threads: bool) -> Callable:
     """A loop over the particles doing a = (F + m·g)/m then ``update`` per coordinate.
 
+    F is ``forces`` plus the threads' partial spring forces ``partial`` (T, N, d)
+    not yet added to it (T = 0 if none), summed as `_spring_forces_parallel` would.
     With ``threads`` the particles are split between the threads (each writes
     only its own rows). numba compiles it at its first call, which raises a
     numba error if it cannot.
@@ -616,11 +621,14 @@ def _compile_advance(update: Callable, threads: bool) -> Callable:
     scalar = numba.njit(update)
 
     @numba.njit(parallel=threads)
-    def advance(x, v, forces, field, masses, fixed, dt, coefficients, x_new, v_new):
+    def advance(x, v, forces, partial, field, masses, fixed, dt, coefficients, x_new, v_new):
         for i in numba.prange(len(masses)):
             inverse = _inverse_mass(masses[i], not fixed[i])
             for q in range(x.shape[1]):
-                a = _acceleration(forces[i, q] + masses[i] * field[q], inverse)
+                total = forces[i, q]
+                for t in range(len(partial)):
+                    total += partial[t, i, q]
+                a = _acceleration(total + masses[i] * field[q], inverse)
                 x_new[i, q], v_new[i, q] = scalar(x[i, q], v[i, q], a, dt, *coefficients)
 
     return advance
@@ -670,6 +678,7 @@ class NumbaKernel:
         self._version = -1
         self._a = self._b = np.zeros(0, dtype=np.int32)
         self._partial: np.ndarray | None = None
+        self._none = np.zeros((0, 0, 0))  # see `_no_partial`
         self._threads = 1
         self._stencil_version = -1
         self._stencil: GridStencil | None = None
@@ -699,6 +708,20 @@ class NumbaKernel:
 
         Returns the largest stretch |d|/l and the power (W) the dashpots take.
         """
+        return self._spring_forces(body, x, v, out, springs, reduce=True)[:2]
+
+    def _spring_forces(
+        self,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        out: np.ndarray,
+        springs: np.ndarray | None,
+        reduce: bool,
+    ) -> tuple[float, float, np.ndarray]:
+        """`add_spring_forces`, and the threads' forces (T, N, d) still to add to ``out``:
+        none (T = 0) with ``reduce``, else those of `_spring_forces_parallel`."""
+        none = self._no_partial(x)
         if springs is None:
             stencil = self.grid_stencil(body)
             if stencil is not None:
@@ -709,17 +732,24 @@ class NumbaKernel:
                 columns, rows = self._columns
                 layout = (stencil.shape, triples, rows_of, o2s, self._triple_values, columns, rows)
                 squares, powers = gather(x, v, *layout, self._scratch, out)
-                return math.sqrt(squares.max()), float(powers.sum())  # one order, any threads
+                return math.sqrt(squares.max()), float(powers.sum()), none  # any threads
         if springs is not None:
             a, b, k, rest, c = (body.spring_a, body.spring_b, *body.spring_values())
             a, b, k, rest, c = (array[springs] for array in (a, b, k, rest, c))
-            return _spring_forces_serial(x, v, a, b, None, k, rest, c, out)
+            return *_spring_forces_serial(x, v, a, b, None, k, rest, c, out), none
         arrays = self._edge_list(body)
         if not self._parallel(body):
-            return _spring_forces_serial(x, v, *arrays, out)
+            return *_spring_forces_serial(x, v, *arrays, out), none
         if self._partial is None or self._partial.shape[1:] != x.shape:
             self._partial = np.empty((self._threads - 1, *x.shape))
-        return _spring_forces_parallel(x, v, *arrays, self._partial, out)
+        sums = _spring_forces_parallel(x, v, *arrays, self._partial, out, reduce)
+        return *sums, none if reduce else self._partial
+
+    def _no_partial(self, x: np.ndarray) -> np.ndarray:
+        """An empty (0, N, d) array: no partial forces (see `_compile_advance`)."""
+        if self._none.shape[1:] != x.shape:
+            self._none = np.zeros((0, *x.shape))
+        return self._none
 
     def grid_stencil(self, body: Body) -> GridStencil | None:
         """The body's grid stencil if its forces can be gathered by offset now, else None.
@@ -809,6 +839,41 @@ class NumbaKernel:
 
         An update numba cannot compile warns once and runs on whole arrays.
         """
+        return self._advance(
+            update, body, x, v, forces, self._no_partial(x), field, dt, coefficients
+        )
+
+    def advance_with_springs(
+        self,
+        update: Callable,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        forces: np.ndarray,
+        field: np.ndarray,
+        dt: float,
+        coefficients: tuple[float, ...],
+    ) -> tuple[np.ndarray, np.ndarray, float, float]:
+        """`add_spring_forces` to ``forces``, then `advance`: (x_new, v_new, largest stretch,
+        dashpot power W). The threads' partial spring forces are added to F in the
+        update's loop, not in a pass of their own; ``forces`` then lacks them."""
+        stretch, power, partial = self._spring_forces(body, x, v, forces, None, reduce=False)
+        x_new, v_new = self._advance(update, body, x, v, forces, partial, field, dt, coefficients)
+        return x_new, v_new, stretch, power
+
+    def _advance(
+        self,
+        update: Callable,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        forces: np.ndarray,
+        partial: np.ndarray,
+        field: np.ndarray,
+        dt: float,
+        coefficients: tuple[float, ...],
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """`advance` with F = ``forces`` plus ``partial`` (T, N, d) (see `_compile_advance`)."""
         threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
         if update in _FAILED:
             compiled = None
@@ -819,8 +884,9 @@ class NumbaKernel:
         if compiled is not None:
             x_new, v_new = np.empty_like(x), np.empty_like(v)
             try:
+                masses, fixed = body.masses, body.fixed
                 compiled(
-                    x, v, forces, field, body.masses, body.fixed, dt, coefficients, x_new, v_new
+                    x, v, forces, partial, field, masses, fixed, dt, coefficients, x_new, v_new
                 )
                 return x_new, v_new
             except numba.core.errors.NumbaError as error:
@@ -829,8 +895,10 @@ class NumbaKernel:
                     f"numba cannot compile {update.__qualname__} ({type(error).__name__}); "
                     "it runs on whole numpy arrays instead, with the same result, more slowly",
                     RuntimeWarning,
-                    stacklevel=4,
+                    stacklevel=5,
                 )
+        for part in partial:
+            forces = forces + part  # in the order of `_spring_forces_parallel`
         inverse = equations.inverse_mass(body.masses, ~body.fixed)
         a = equations.acceleration(forces + body.masses[:, None] * field, inverse[:, None])
         return update(x, v, a, dt, *coefficients)
