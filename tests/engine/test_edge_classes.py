@@ -86,20 +86,42 @@ def test_wide_classes_and_no_classes_give_the_same_sums(
     assert_same(forces_by(unclassed, body), forces_by(wide, body))
 
 
-def test_past_the_limit_in_the_bodys_order(monkeypatch: pytest.MonkeyPatch) -> None:
-    """Springs already sorted, more classes than allowed: the loop reads the body's arrays."""
+def sorted_body() -> msd.Body:
+    """`shuffled_body` with its springs added sorted by their ends, as the edge loop takes them."""
     shuffled = shuffled_body(3)
     order = np.lexsort((shuffled.spring_b, shuffled.spring_a))
     pairs = np.stack([shuffled.spring_a[order], shuffled.spring_b[order]], axis=1)
-    body = msd.Body.from_arrays(
+    return msd.Body.from_arrays(
         shuffled.positions, pairs, rest_lengths=shuffled.rest_lengths[order]
     )
+
+
+def test_past_the_limit_in_the_bodys_order(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Springs already sorted, more classes than allowed: the loop reads the body's arrays."""
+    body = sorted_body()
     monkeypatch.setattr("msdlab.compiled.SPRING_CLASSES", 2)
     kernel = NumbaKernel()
     _, _, kinds, k, _, _ = kernel._edge_list(body)
     assert kinds is None and np.shares_memory(k, body.spring_values()[0])
     held = body.stiffness
     held[4] = 7.0  # seen without copying
+    assert_close_to_numpy(body, kernel)
+
+
+def test_sorted_springs_with_a_held_view_read_the_bodys_arrays() -> None:
+    """No classes to find again at every step while a view is held: the body's own arrays."""
+    body = sorted_body()
+    kernel = NumbaKernel()
+    classed = forces_by(kernel, body)
+    assert kernel._edge_list(body)[2] is not None
+    held = body.rest_lengths
+    assert kernel._edge_list(body)[2] is None
+    assert_same(forces_by(kernel, body), classed)
+    held[6] *= 1.1
+    assert_close_to_numpy(body, kernel)
+    del held
+    body.spring_damping[2] = 0.1  # no view left, an edit: classes again
+    assert kernel._edge_list(body)[2] is not None
     assert_close_to_numpy(body, kernel)
 
 
