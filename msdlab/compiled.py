@@ -10,7 +10,9 @@ Large bodies split the springs between the threads, each summing into its own
 force buffer (no two threads write the same memory; the first one writes the
 result), and the buffers are then added per particle. The springs are visited
 sorted by their ends, so memory is read in order whatever order they were
-added in.
+added in; along the springs of one first end, its position and force stay in
+registers. Their stiffness, rest length and dashpot come from a small table
+of the distinct triples, through a one- or two-byte class per spring.
 
 Grid bodies (`msdlab.stencil`) whose springs share their values per offset
 go by offset instead, with no list of springs: each particle computes its
@@ -27,7 +29,9 @@ same particle; one thread takes them in the same order, with the same sums.
 `NumbaKernel.advance` compiles an integrator's update function (for example
 `integrators.verlet_update`) into one loop over the particles that computes
 a = F/m (plus gravity's g) and the update together; it is compiled once per
-process and update.
+process and update. When the springs' forces are all the forces
+(`NumbaKernel.advance_with_springs`), the threads' force buffers are added in
+that loop too, not in a pass of their own.
 
 The spring loops are compiled on first use and cached on disk (``cache=True``),
 so compiling is paid once per machine and numba version. Set the number of
@@ -58,6 +62,11 @@ PARALLEL_MIN_SPRINGS = 50_000
 PARALLEL_MIN_PARTICLES = 20_000
 # Particles a gather block holds (whole grid rows): long inner loops, enough blocks for threads.
 GATHER_BLOCK = 4096
+# At most this many distinct (stiffness, rest length, dashpot) triples are kept as a table
+# with a class number per spring (uint8 up to 256, else uint16); past it, the values per spring.
+SPRING_CLASSES = 65_536
+# Odd constants that mix the bits of the spring values into a hash (see `_spring_classes`).
+_MIX = (np.uint64(0x9E3779B97F4A7C15), np.uint64(0xC2B2AE3D27D4EB4F), np.uint64(0x165667B19E3779F9))
 
 _spring_force = numba.njit(cache=True, inline="always")(equations.spring_force)
 _spring_energy = numba.njit(cache=True, inline="always")(equations.spring_energy)
@@ -68,53 +77,82 @@ _acceleration = numba.njit(cache=True, inline="always")(equations.acceleration)
 
 
 @numba.njit(cache=True, inline="always")
-def _add_spring_forces(x, v, a, b, k, rest, c, first, stop, out):
-    """Add the forces of springs ``first`` to ``stop - 1`` to ``out`` (2-D or 3-D).
+def _add_spring_forces(x, v, a, b, kinds, k, rest, c, first, stop, out, three):
+    """Add the forces of springs ``first`` to ``stop - 1`` to ``out``, (N, 3) if ``three``
+    else (N, 2). Returns the largest stretch |d|/l and the dashpot power (W) of those springs.
 
-    Returns the largest stretch |d|/l and the dashpot power (W) of those springs.
+    Spring s has the stiffness, rest length and dashpot ``k``, ``rest``, ``c`` at
+    ``kinds[s]`` (see `_spring_classes`), or at s when ``kinds`` is None. Along a
+    run of springs with the same end a, a's position and force stay in registers:
+    its force is summed in the same order as in memory, so the sums do not change.
     """
-    three = x.shape[1] == 3
-    stretch = 0.0
+    peak = np.zeros(1)  # the stretch, in memory: a register would make it divide every time
     power = 0.0
+    if first >= stop:
+        return 0.0, power
+    i = a[numba.uint64(first)]
+    y0, y1, y2 = x[i, 0], x[i, 1], x[i, 2] if three else 0.0
+    f0, f1, f2 = out[i, 0], out[i, 1], out[i, 2] if three else 0.0
     for s in range(first, stop):
-        i, j = a[s], b[s]
-        d0 = x[i, 0] - x[j, 0]
-        d1 = x[i, 1] - x[j, 1]
-        d2 = x[i, 2] - x[j, 2] if three else 0.0
+        u = numba.uint64(s)  # unsigned: no test for negative indices
+        if a[u] != i:
+            out[i, 0], out[i, 1] = f0, f1
+            if three:
+                out[i, 2] = f2
+            i = a[u]
+            y0, y1, y2 = x[i, 0], x[i, 1], x[i, 2] if three else 0.0
+            f0, f1, f2 = out[i, 0], out[i, 1], out[i, 2] if three else 0.0
+        j = b[u]
+        m = u if kinds is None else kinds[u]
+        d0 = y0 - x[j, 0]
+        d1 = y1 - x[j, 1]
+        d2 = y2 - x[j, 2] if three else 0.0
         length = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-        if length > stretch * rest[s]:  # cheaper than dividing for every spring
-            stretch = length / rest[s]
+        if length > peak[0] * rest[m]:  # cheaper than dividing for every spring
+            peak[0] = length / rest[m]
         if length == 0.0:  # coincident ends: no direction, no force
             continue
         rate = 0.0
-        if c[s] != 0.0:
+        if c[m] != 0.0:
             closing = (v[i, 0] - v[j, 0]) * d0 + (v[i, 1] - v[j, 1]) * d1
             if three:
                 closing += (v[i, 2] - v[j, 2]) * d2
             rate = closing / length
-            power += _dashpot_power_of(c[s], rate)
-        scale = _spring_force(k[s], rest[s], length, c[s], rate) / length
-        out[i, 0] += scale * d0
+            power += _dashpot_power_of(c[m], rate)
+        scale = _spring_force(k[m], rest[m], length, c[m], rate) / length
+        f0 += scale * d0
         out[j, 0] -= scale * d0
-        out[i, 1] += scale * d1
+        f1 += scale * d1
         out[j, 1] -= scale * d1
         if three:
-            out[i, 2] += scale * d2
+            f2 += scale * d2
             out[j, 2] -= scale * d2
-    return stretch, power
+    out[i, 0], out[i, 1] = f0, f1
+    if three:
+        out[i, 2] = f2
+    return peak[0], power
+
+
+@numba.njit(cache=True, inline="always")
+def _add_spring_block(x, v, a, b, kinds, k, rest, c, first, stop, out):
+    """`_add_spring_forces` compiled apart for 2-D and 3-D (``three`` a constant in each)."""
+    if x.shape[1] == 3:
+        return _add_spring_forces(x, v, a, b, kinds, k, rest, c, first, stop, out, True)
+    return _add_spring_forces(x, v, a, b, kinds, k, rest, c, first, stop, out, False)
 
 
 @numba.njit(cache=True)
-def _spring_forces_serial(x, v, a, b, k, rest, c, out):
+def _spring_forces_serial(x, v, a, b, kinds, k, rest, c, out):
     """One thread: add every spring's force to ``out``; return (largest stretch, dashpot power)."""
-    return _add_spring_forces(x, v, a, b, k, rest, c, 0, len(a), out)
+    return _add_spring_block(x, v, a, b, kinds, k, rest, c, 0, len(a), out)
 
 
 @numba.njit(cache=True, parallel=True)
-def _spring_forces_parallel(x, v, a, b, k, rest, c, partial, out):
+def _spring_forces_parallel(x, v, a, b, kinds, k, rest, c, partial, out, reduce):
     """Threads: spring block 0 is summed into ``out``, block t > 0 into ``partial[t - 1]``.
 
-    The partial buffers are then added to ``out`` particle by particle.
+    With ``reduce`` the partial buffers are then added to ``out`` particle by
+    particle; else the caller adds them in its own loop (see `_compile_advance`).
     """
     blocks = len(partial) + 1
     count = len(a)
@@ -123,19 +161,52 @@ def _spring_forces_parallel(x, v, a, b, k, rest, c, partial, out):
     for t in numba.prange(blocks):
         first, stop = t * count // blocks, (t + 1) * count // blocks
         if t == 0:
-            sums = _add_spring_forces(x, v, a, b, k, rest, c, first, stop, out)
+            sums = _add_spring_block(x, v, a, b, kinds, k, rest, c, first, stop, out)
         else:
             partial[t - 1] = 0.0
-            sums = _add_spring_forces(x, v, a, b, k, rest, c, first, stop, partial[t - 1])
+            sums = _add_spring_block(x, v, a, b, kinds, k, rest, c, first, stop, partial[t - 1])
         stretches[t], powers[t] = sums
     n, dim = out.shape
-    for i in numba.prange(n):
+    for i in numba.prange(n if reduce else 0):
         for q in range(dim):
             total = out[i, q]
             for t in range(blocks - 1):
                 total += partial[t, i, q]
             out[i, q] = total
     return stretches.max(), powers.sum()
+
+
+@numba.njit(cache=True)
+def _spring_classes(k_bits, rest_bits, c_bits, slots, kinds, table):
+    """Number the distinct (stiffness, rest length, dashpot) triples of the springs, in one pass.
+
+    Spring s gets in ``kinds[s]`` the class of its triple, whose bit patterns
+    (int64 views of the values, so equal means identical) go to ``table[class]``.
+    ``slots`` (a power of two long, zero) is the hash table of the classes
+    (class + 1, 0 for free). Returns the number of classes, or -1 if there
+    are more than ``len(table)``.
+    """
+    mask = numba.uint64(len(slots) - 1)
+    count = 0
+    for s in range(len(kinds)):
+        key = (k_bits[s], rest_bits[s], c_bits[s])
+        h = numba.uint64(key[0]) * _MIX[0] ^ numba.uint64(key[1]) * _MIX[1]
+        h ^= numba.uint64(key[2]) * _MIX[2]
+        slot = (h ^ (h >> numba.uint64(32))) & mask
+        while slots[slot] != 0 and (
+            table[slots[slot] - 1, 0] != key[0]
+            or table[slots[slot] - 1, 1] != key[1]
+            or table[slots[slot] - 1, 2] != key[2]
+        ):
+            slot = (slot + numba.uint64(1)) & mask
+        if slots[slot] == 0:
+            if count == len(table):
+                return -1
+            table[count, 0], table[count, 1], table[count, 2] = key
+            count += 1
+            slots[slot] = count
+        kinds[s] = slots[slot] - 1
+    return count
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -539,6 +610,8 @@ def _divide_by_masses(forces, masses, fixed):
 def _compile_advance(update: Callable, threads: bool) -> Callable:
     """A loop over the particles doing a = (F + m·g)/m then ``update`` per coordinate.
 
+    F is ``forces`` plus the threads' partial spring forces ``partial`` (T, N, d)
+    not yet added to it (T = 0 if none), summed as `_spring_forces_parallel` would.
     With ``threads`` the particles are split between the threads (each writes
     only its own rows). numba compiles it at its first call, which raises a
     numba error if it cannot.
@@ -546,11 +619,14 @@ def _compile_advance(update: Callable, threads: bool) -> Callable:
     scalar = numba.njit(update)
 
     @numba.njit(parallel=threads)
-    def advance(x, v, forces, field, masses, fixed, dt, coefficients, x_new, v_new):
+    def advance(x, v, forces, partial, field, masses, fixed, dt, coefficients, x_new, v_new):
         for i in numba.prange(len(masses)):
             inverse = _inverse_mass(masses[i], not fixed[i])
             for q in range(x.shape[1]):
-                a = _acceleration(forces[i, q] + masses[i] * field[q], inverse)
+                total = forces[i, q]
+                for t in range(len(partial)):
+                    total += partial[t, i, q]
+                a = _acceleration(total + masses[i] * field[q], inverse)
                 x_new[i, q], v_new[i, q] = scalar(x[i, q], v[i, q], a, dt, *coefficients)
 
     return advance
@@ -600,6 +676,7 @@ class NumbaKernel:
         self._version = -1
         self._a = self._b = np.zeros(0, dtype=np.int32)
         self._partial: np.ndarray | None = None
+        self._none = np.zeros((0, 0, 0))  # see `_no_partial`
         self._threads = 1
         self._stencil_version = -1
         self._stencil: GridStencil | None = None
@@ -613,7 +690,7 @@ class NumbaKernel:
         self._uniform = False
         self._order: np.ndarray | None = None
         self._sorted_version = -1
-        self._sorted_values: tuple[np.ndarray, ...] = ()
+        self._classes: tuple[np.ndarray | None, ...] = (None,)  # see `_edge_list`
 
     name = "numba"
 
@@ -629,6 +706,20 @@ class NumbaKernel:
 
         Returns the largest stretch |d|/l and the power (W) the dashpots take.
         """
+        return self._spring_forces(body, x, v, out, springs, reduce=True)[:2]
+
+    def _spring_forces(
+        self,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        out: np.ndarray,
+        springs: np.ndarray | None,
+        reduce: bool,
+    ) -> tuple[float, float, np.ndarray]:
+        """`add_spring_forces`, and the threads' forces (T, N, d) still to add to ``out``:
+        none (T = 0) with ``reduce``, else those of `_spring_forces_parallel`."""
+        none = self._no_partial(x)
         if springs is None:
             stencil = self.grid_stencil(body)
             if stencil is not None:
@@ -639,16 +730,24 @@ class NumbaKernel:
                 columns, rows = self._columns
                 layout = (stencil.shape, triples, rows_of, o2s, self._triple_values, columns, rows)
                 squares, powers = gather(x, v, *layout, self._scratch, out)
-                return math.sqrt(squares.max()), float(powers.sum())  # one order, any threads
+                return math.sqrt(squares.max()), float(powers.sum()), none  # any threads
         if springs is not None:
-            arrays = (body.spring_a, body.spring_b, *body.spring_values())
-            return _spring_forces_serial(x, v, *(array[springs] for array in arrays), out)
+            a, b, k, rest, c = (body.spring_a, body.spring_b, *body.spring_values())
+            a, b, k, rest, c = (array[springs] for array in (a, b, k, rest, c))
+            return *_spring_forces_serial(x, v, a, b, None, k, rest, c, out), none
         arrays = self._edge_list(body)
         if not self._parallel(body):
-            return _spring_forces_serial(x, v, *arrays, out)
+            return *_spring_forces_serial(x, v, *arrays, out), none
         if self._partial is None or self._partial.shape[1:] != x.shape:
             self._partial = np.empty((self._threads - 1, *x.shape))
-        return _spring_forces_parallel(x, v, *arrays, self._partial, out)
+        sums = _spring_forces_parallel(x, v, *arrays, self._partial, out, reduce)
+        return *sums, none if reduce else self._partial
+
+    def _no_partial(self, x: np.ndarray) -> np.ndarray:
+        """An empty (0, N, d) array: no partial forces (see `_compile_advance`)."""
+        if self._none.shape[1:] != x.shape:
+            self._none = np.zeros((0, *x.shape))
+        return self._none
 
     def grid_stencil(self, body: Body) -> GridStencil | None:
         """The body's grid stencil if its forces can be gathered by offset now, else None.
@@ -738,6 +837,41 @@ class NumbaKernel:
 
         An update numba cannot compile warns once and runs on whole arrays.
         """
+        return self._advance(
+            update, body, x, v, forces, self._no_partial(x), field, dt, coefficients
+        )
+
+    def advance_with_springs(
+        self,
+        update: Callable,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        forces: np.ndarray,
+        field: np.ndarray,
+        dt: float,
+        coefficients: tuple[float, ...],
+    ) -> tuple[np.ndarray, np.ndarray, float, float]:
+        """`add_spring_forces` to ``forces``, then `advance`: (x_new, v_new, largest stretch,
+        dashpot power W). The threads' partial spring forces are added to F in the
+        update's loop, not in a pass of their own; ``forces`` then lacks them."""
+        stretch, power, partial = self._spring_forces(body, x, v, forces, None, reduce=False)
+        x_new, v_new = self._advance(update, body, x, v, forces, partial, field, dt, coefficients)
+        return x_new, v_new, stretch, power
+
+    def _advance(
+        self,
+        update: Callable,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        forces: np.ndarray,
+        partial: np.ndarray,
+        field: np.ndarray,
+        dt: float,
+        coefficients: tuple[float, ...],
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """`advance` with F = ``forces`` plus ``partial`` (T, N, d) (see `_compile_advance`)."""
         threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
         if update in _FAILED:
             compiled = None
@@ -748,8 +882,9 @@ class NumbaKernel:
         if compiled is not None:
             x_new, v_new = np.empty_like(x), np.empty_like(v)
             try:
+                masses, fixed = body.masses, body.fixed
                 compiled(
-                    x, v, forces, field, body.masses, body.fixed, dt, coefficients, x_new, v_new
+                    x, v, forces, partial, field, masses, fixed, dt, coefficients, x_new, v_new
                 )
                 return x_new, v_new
             except numba.core.errors.NumbaError as error:
@@ -758,24 +893,29 @@ class NumbaKernel:
                     f"numba cannot compile {update.__qualname__} ({type(error).__name__}); "
                     "it runs on whole numpy arrays instead, with the same result, more slowly",
                     RuntimeWarning,
-                    stacklevel=4,
+                    stacklevel=5,
                 )
+        for part in partial:
+            forces = forces + part  # in the order of `_spring_forces_parallel`
         inverse = equations.inverse_mass(body.masses, ~body.fixed)
         a = equations.acceleration(forces + body.masses[:, None] * field, inverse[:, None])
         return update(x, v, a, dt, *coefficients)
 
-    def _edge_list(self, body: Body) -> tuple[np.ndarray, ...]:
-        """Ends a, b and stiffness, rest length, dashpot of all springs, sorted by (a, b).
+    def _edge_list(self, body: Body) -> tuple[np.ndarray | None, ...]:
+        """Ends a, b of all springs sorted by (a, b), each one's class (or None) and the
+        stiffness, rest length and dashpot of each class (or of each spring).
 
         In that order consecutive springs share or neighbour their particles,
         so the edge loop reads and writes memory it has just used, whatever
         order the springs were added in (a shuffled 60³ grid: several times
-        faster). The ends (int32: half the memory traffic of int64) and the
-        order are kept per topology; the sorted values are copied again when
-        they may have changed (see `grid_stencil`).
+        faster). The ends (uint32: half the memory traffic of int64) and the
+        order are kept per topology; the classes (`_spring_classes`) are found
+        again when the values may have changed (see `grid_stencil`). Past
+        `SPRING_CLASSES` distinct values the loop reads them per spring: the
+        body's arrays, or copies in the sorted order.
         """
         if self._version != body.topology_version:
-            index = np.int32 if body.n_particles < 2**31 else np.int64
+            index = np.uint32 if body.n_particles < 2**32 else np.uint64
             order = np.lexsort((body.spring_b, body.spring_a))
             self._order = None if np.array_equal(order, np.arange(len(order))) else order
             ends = (body.spring_a, body.spring_b)
@@ -785,9 +925,34 @@ class NumbaKernel:
             self._version = body.topology_version
             self._sorted_version = -1
         values = body.spring_values()
-        if self._order is None:
-            return self._a, self._b, *values
-        if body.parameters_version != self._sorted_version or _shared(values):
-            self._sorted_values = tuple(array[self._order] for array in values)
+        shared = _shared(values)
+        if body.parameters_version != self._sorted_version or shared:
+            # sorted springs and a view held: the body's arrays, not classes to find every step
+            self._classes = (None,) if shared and self._order is None else self._classify(values)
             self._sorted_version = body.parameters_version
-        return self._a, self._b, *self._sorted_values
+        if self._classes[0] is None and self._order is None:
+            return self._a, self._b, None, *values  # not kept: a reference would look shared
+        return self._a, self._b, *self._classes
+
+    def _classify(self, values: tuple[np.ndarray, ...]) -> tuple[np.ndarray | None, ...]:
+        """Each sorted spring's class (uint8 or uint16) and the stiffness (N/m), rest length
+        (m) and dashpot (N·s/m) of each class; (None,) past `SPRING_CLASSES` classes,
+        with the values in the sorted order if they are not in the body's.
+
+        The classes are found in the body's order (`_spring_classes`, reading memory
+        in order), then put in the sorted order: one small array to permute, not three.
+        """
+        most = min(len(values[0]), SPRING_CLASSES)
+        slots = np.zeros(1 << max(4, (2 * most).bit_length()), np.int32)
+        kinds = np.empty(len(values[0]), np.uint16)
+        table = np.empty((most, 3), np.int64)
+        classes = _spring_classes(*(array.view(np.int64) for array in values), slots, kinds, table)
+        if classes < 0:
+            if self._order is None:
+                return (None,)
+            return None, *(array[self._order] for array in values)
+        table = table[:classes].view(np.float64)
+        kinds = kinds.astype(np.uint8) if classes <= 256 else kinds
+        if self._order is not None:
+            kinds = kinds[self._order]
+        return kinds, *(np.ascontiguousarray(column) for column in table.T)

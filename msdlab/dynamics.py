@@ -57,23 +57,19 @@ class Dynamics:
         return total
 
     def _add_forces(
-        self, x: np.ndarray, v: np.ndarray, total: np.ndarray, fields_apart: bool = False
-    ) -> np.ndarray:
-        """Add the spring, dashpot and external forces at (x, v) to ``total``.
-
-        With ``fields_apart`` the forces that are m·g on every particle
-        (`Force.uniform_acceleration`) are left out; returns the sum of their g (d,).
-        """
+        self,
+        x: np.ndarray,
+        v: np.ndarray,
+        total: np.ndarray,
+        fields: list[np.ndarray | None] | None = None,
+    ) -> None:
+        """Add the spring, dashpot and external forces at (x, v) to ``total``, but those
+        of the forces whose `Force.uniform_acceleration` is given in ``fields`` (not None)."""
         self.max_stretch, power = self.springs.add_spring_forces(self.body, x, v, total, None)
         self._last_power = (x, v, power)
-        field = np.zeros(x.shape[1])
-        for force in self.forces:
-            g = force.uniform_acceleration(self.body) if fields_apart else None
-            if g is None:
+        for i, force in enumerate(self.forces):
+            if fields is None or fields[i] is None:
                 force.add_to(self.body, x, v, total)
-            else:
-                field += g
-        return field
 
     def acceleration(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Acceleration of each particle (N, d) in m/s²; zero for fixed particles."""
@@ -86,12 +82,25 @@ class Dynamics:
 
         ``update`` is a function of arrays or numbers (like `integrators.verlet_update`)
         returning the new (x, v); the numba kernel compiles it into one loop with
-        a = F/m + g, g the forces' `Force.uniform_acceleration` (gravity).
+        a = F/m + g, g the forces' `Force.uniform_acceleration` (gravity). When every
+        force is such a g, F is the springs' alone and the kernel computes it and the
+        update in one go (`SpringKernel.advance_with_springs`).
         """
         if self._buffer is None or self._buffer.shape != x.shape:
             self._buffer = np.empty_like(x)  # the forces, used up within this call
         self._buffer.fill(0.0)
-        field = self._add_forces(x, v, self._buffer, fields_apart=True)
+        fields = [force.uniform_acceleration(self.body) for force in self.forces]
+        field = np.zeros(x.shape[1])
+        for g in fields:
+            if g is not None:
+                field += g
+        if all(g is not None for g in fields):  # the springs' forces only: the kernel sums them
+            x_new, v_new, self.max_stretch, power = self.springs.advance_with_springs(
+                update, self.body, x, v, self._buffer, field, dt, coefficients
+            )
+            self._last_power = (x, v, power)
+            return x_new, v_new
+        self._add_forces(x, v, self._buffer, fields)
         return self.springs.advance(update, self.body, x, v, self._buffer, field, dt, coefficients)
 
     def forget_last_state(self) -> None:

@@ -229,6 +229,20 @@ class SpringKernel(Protocol):
         """``update(x, v, a, dt, *coefficients)`` with a = (F + m·g)/m, g = ``field`` (d,)
         in m/s² (0 for fixed particles)."""
 
+    def advance_with_springs(
+        self,
+        update: Update,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        forces: np.ndarray,
+        field: np.ndarray,
+        dt: float,
+        coefficients: tuple[float, ...],
+    ) -> tuple[np.ndarray, np.ndarray, float, float]:
+        """`add_spring_forces` to ``forces``, then `advance`: (x_new, v_new, largest stretch,
+        dashpot power W). ``forces`` is left to the kernel (it may hold only part of them)."""
+
 
 class NumpyKernel:
     """The readable kernel: the functions above on whole arrays."""
@@ -288,6 +302,22 @@ class NumpyKernel:
         fixed), g = ``field`` (d,) in m/s²."""
         total = forces + body.masses[:, None] * field if field.any() else forces
         return update(x, v, self.to_acceleration(body, total), dt, *coefficients)
+
+    def advance_with_springs(
+        self,
+        update: Update,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        forces: np.ndarray,
+        field: np.ndarray,
+        dt: float,
+        coefficients: tuple[float, ...],
+    ) -> tuple[np.ndarray, np.ndarray, float, float]:
+        """`add_spring_forces` to ``forces``, then `advance`: (x_new, v_new, largest stretch,
+        dashpot power W)."""
+        stretch, power = self.add_spring_forces(body, x, v, forces, None)
+        return *self.advance(update, body, x, v, forces, field, dt, coefficients), stretch, power
 
 
 def default_kernel() -> str:

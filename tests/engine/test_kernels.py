@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab import kernels
+from msdlab import integrators, kernels
 from msdlab.dynamics import Dynamics
 
 RTOL = 1e-12
@@ -99,6 +101,37 @@ def test_accelerations_include_forces_and_subsets(dim: int) -> None:
     assert_close(
         dynamics.acceleration_of(particles, x, v), expected[particles], np.abs(expected).max()
     )
+
+
+def object_update(x: float, v: float, a: float, dt: float) -> tuple[float, float]:
+    """An update numba cannot compile (it builds a Python object): it runs on arrays."""
+    note = {"why": object()}
+    del note
+    return x + dt * v, v + dt * a
+
+
+@pytest.mark.parametrize("threaded", [False, True])
+@pytest.mark.parametrize("update", [integrators.symplectic_euler_update, object_update])
+def test_advance_with_springs_is_forces_then_advance(
+    threaded: bool, update, kernel: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The forces, the update and the stretch and power, bit for bit (the numba kernel adds
+    its threads' partial forces in the update's loop instead of a pass of their own)."""
+    if threaded:
+        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_PARTICLES", 0)
+    body = deformed_body(3, seed=6)
+    x, v, field = body.positions, body.velocities, np.array([0.0, -9.81, 0.0])
+    springs = kernels.make_kernel(kernel)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # numba cannot compile object_update
+        forces = np.zeros_like(x)
+        sums = springs.add_spring_forces(body, x, v, forces, None)
+        expected = springs.advance(update, body, x, v, forces, field, 1e-3, ())
+        fused = springs.advance_with_springs(update, body, x, v, np.zeros_like(x), field, 1e-3, ())
+    np.testing.assert_array_equal(fused[0], expected[0])
+    np.testing.assert_array_equal(fused[1], expected[1])
+    assert fused[2:] == sums
 
 
 def test_kernel_choice(monkeypatch: pytest.MonkeyPatch) -> None:

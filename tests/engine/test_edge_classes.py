@@ -1,0 +1,160 @@
+"""The edge loop's spring classes: a table of the distinct (k, l, c), a small index per spring."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import msdlab as msd
+from msdlab import kernels
+from msdlab.compiled import NumbaKernel
+
+RTOL = 1e-12
+
+
+@pytest.fixture(autouse=True)
+def _once(kernel: str) -> None:
+    """These tests look inside the numba kernel and compare it with the numpy one themselves."""
+    if kernel != "numba":
+        pytest.skip("tests the numba kernel's edge loop")
+
+
+def shuffled_body(seed: int = 0) -> msd.Body:
+    """A shaken, moving 5×4×6 grid whose springs were added in a random order (no gather)."""
+    rng = np.random.default_rng(seed)
+    grid = msd.Body.grid((5, 4, 6), spacing=0.1, stiffness=40.0, neighbours=(1, 2, 3))
+    order = rng.permutation(grid.n_springs)
+    pairs = np.stack([grid.spring_a[order], grid.spring_b[order]], axis=1)
+    body = msd.Body.from_arrays(
+        grid.positions + rng.normal(scale=0.02, size=grid.positions.shape),
+        pairs,
+        velocities=rng.normal(size=grid.positions.shape),
+        stiffness=40.0,
+        rest_lengths=grid.rest_lengths[order],
+    )
+    return body
+
+
+def forces_by(kernel: kernels.SpringKernel, body: msd.Body, springs=None) -> tuple:
+    out = np.zeros_like(body.positions)
+    stretch, power = kernel.add_spring_forces(body, body.positions, body.velocities, out, springs)
+    return out, stretch, power
+
+
+def assert_same(actual: tuple, expected: tuple) -> None:
+    """Bit for bit: the same forces, largest stretch and dashpot power."""
+    np.testing.assert_array_equal(actual[0], expected[0])
+    assert actual[1:] == expected[1:]
+
+
+def assert_close_to_numpy(body: msd.Body, kernel: NumbaKernel, springs=None) -> None:
+    expected = forces_by(kernels.NumpyKernel(), body, springs)
+    actual = forces_by(kernel, body, springs)
+    scale = np.abs(expected[0]).max()
+    np.testing.assert_allclose(actual[0], expected[0], rtol=RTOL, atol=RTOL * scale)
+    assert actual[1] == pytest.approx(expected[1], rel=RTOL)
+    assert actual[2] == pytest.approx(expected[2], rel=RTOL, abs=RTOL * scale)
+
+
+def test_class_table_holds_each_springs_values() -> None:
+    body = shuffled_body()
+    body.spring_damping[::4] = 0.3
+    a, _, kinds, k, rest, c = NumbaKernel()._edge_list(body)
+    assert kinds.dtype == np.uint8 and len(k) == 6  # 3 rest lengths, with and without dashpot
+    assert np.all(np.diff(a.astype(np.int64)) >= 0)  # sorted by the first end
+    order = np.lexsort((body.spring_b, body.spring_a))
+    for table, values in zip((k, rest, c), body.spring_values()):
+        np.testing.assert_array_equal(table[kinds], values[order])
+    assert len({(k[m], rest[m], c[m]) for m in range(len(k))}) == len(k)  # each class once
+
+
+@pytest.mark.parametrize("threaded", [False, True])
+def test_wide_classes_and_no_classes_give_the_same_sums(
+    threaded: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """300 stiffnesses: 16-bit classes; with the limit below that, the values per spring."""
+    if threaded:
+        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
+    body = shuffled_body(1)
+    body.stiffness[:] = np.random.default_rng(1).integers(1, 301, body.n_springs) * 0.5
+    wide = NumbaKernel()
+    assert wide._edge_list(body)[2].dtype == np.uint16
+    assert_close_to_numpy(body, wide)
+    monkeypatch.setattr("msdlab.compiled.SPRING_CLASSES", 256)
+    unclassed = NumbaKernel()
+    assert unclassed._edge_list(body)[2] is None
+    assert_same(forces_by(unclassed, body), forces_by(wide, body))
+
+
+def sorted_body() -> msd.Body:
+    """`shuffled_body` with its springs added sorted by their ends, as the edge loop takes them."""
+    shuffled = shuffled_body(3)
+    order = np.lexsort((shuffled.spring_b, shuffled.spring_a))
+    pairs = np.stack([shuffled.spring_a[order], shuffled.spring_b[order]], axis=1)
+    return msd.Body.from_arrays(
+        shuffled.positions, pairs, rest_lengths=shuffled.rest_lengths[order]
+    )
+
+
+def test_past_the_limit_in_the_bodys_order(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Springs already sorted, more classes than allowed: the loop reads the body's arrays."""
+    body = sorted_body()
+    monkeypatch.setattr("msdlab.compiled.SPRING_CLASSES", 2)
+    kernel = NumbaKernel()
+    _, _, kinds, k, _, _ = kernel._edge_list(body)
+    assert kinds is None and np.shares_memory(k, body.spring_values()[0])
+    held = body.stiffness
+    held[4] = 7.0  # seen without copying
+    assert_close_to_numpy(body, kernel)
+
+
+def test_sorted_springs_with_a_held_view_read_the_bodys_arrays() -> None:
+    """No classes to find again at every step while a view is held: the body's own arrays."""
+    body = sorted_body()
+    kernel = NumbaKernel()
+    classed = forces_by(kernel, body)
+    assert kernel._edge_list(body)[2] is not None
+    held = body.rest_lengths
+    assert kernel._edge_list(body)[2] is None
+    assert_same(forces_by(kernel, body), classed)
+    held[6] *= 1.1
+    assert_close_to_numpy(body, kernel)
+    del held
+    body.spring_damping[2] = 0.1  # no view left, an edit: classes again
+    assert kernel._edge_list(body)[2] is not None
+    assert_close_to_numpy(body, kernel)
+
+
+@pytest.mark.parametrize("threaded", [False, True])
+def test_held_view_edited_between_steps(threaded: bool, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A view of the values kept by the user and written between steps counts at the next step,
+    on the classes and past their limit, as if the body had been built with the new values."""
+    if threaded:
+        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
+    for limit in (65_536, 4):
+        monkeypatch.setattr("msdlab.compiled.SPRING_CLASSES", limit)
+        body = shuffled_body(2)
+        sim = msd.Simulation(body, msd.Verlet(0.01), dt=1e-3, kernel="numba")
+        held, rest, damping = body.stiffness, body.rest_lengths, body.spring_damping
+        for step in range(3):
+            sim.step()
+            held[step] = 90.0 + step  # a new class
+            rest[5 * step] *= 1.25
+            damping[7 * step] = 0.2
+            fresh = NumbaKernel()
+            assert_same(forces_by(sim.dynamics.springs, body), forces_by(fresh, body))
+            assert_close_to_numpy(body, sim.dynamics.springs)
+        body.springs[9].stiffness = 3.0  # and through a Spring object
+        assert_same(forces_by(sim.dynamics.springs, body), forces_by(NumbaKernel(), body))
+
+
+def test_springs_subset_in_the_bodys_order() -> None:
+    body = shuffled_body(4)
+    body.spring_damping[::3] = 0.4
+    kernel = NumbaKernel()
+    forces_by(kernel, body)  # the sorted list and classes are built, and must not be used
+    touching = body.springs_touching(np.array([3, 8, 40]))
+    assert_close_to_numpy(body, kernel, touching)
+    assert_close_to_numpy(body, kernel, touching[::-1])
+    empty = np.zeros(0, dtype=np.int64)
+    assert forces_by(kernel, body, empty)[1:] == (0.0, 0.0)
