@@ -388,7 +388,7 @@ def _push_unit(scratch, pad, columns, shape, rows, triples, rows_of, o2s, values
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _gather_serial(x, v, shape, triples, rows_of, o2s, values, columns, rows, scratch, out):
+def _gather_serial(x, v, shape, triples, rows_of, o2s, values, columns, rows, scratch, out, add):
     """One thread: `_gather_parallel`'s work in the same order, so the same sums."""
     pad = (scratch.shape[1] - len(x)) // 2
     damped = np.any(values[:, :, 2] != 0.0)
@@ -405,16 +405,17 @@ def _gather_serial(x, v, shape, triples, rows_of, o2s, values, columns, rows, sc
             squares[unit], powers[unit] = _push_unit(
                 scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, unit
             )
-    for q in range(x.shape[1]):
+    for q in range(x.shape[1] if add else 0):
         out[:, q] += scratch[6 + q, pad : pad + len(x)]
     return squares, powers
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
-def _gather_parallel(x, v, shape, triples, rows_of, o2s, values, columns, rows, scratch, out):
+def _gather_parallel(x, v, shape, triples, rows_of, o2s, values, columns, rows, scratch, out, add):
     """Add to ``out`` (N, d) the forces of a grid body's springs, each computed once, from
     the particle behind (`_push_unit`); return each unit's largest squared stretch
-    |d|²/l² and dashpot power (W).
+    |d|²/l² and dashpot power (W). Without ``add`` the forces stay in ``scratch``
+    (rows 6 to 8) for the caller to add in a loop of its own (see `_compile_advance`).
 
     The threads push every third unit at once, in three rounds, so no two
     write the same particle.
@@ -436,7 +437,7 @@ def _gather_parallel(x, v, shape, triples, rows_of, o2s, values, columns, rows, 
             squares[unit], powers[unit] = _push_unit(
                 scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, unit
             )
-    for p in numba.prange(len(x)):
+    for p in numba.prange(len(x) if add else 0):
         for q in range(x.shape[1]):
             out[p, q] += scratch[6 + q, p + pad]
     return squares, powers
@@ -610,8 +611,11 @@ def _divide_by_masses(forces, masses, fixed):
 def _compile_advance(update: Callable, threads: bool) -> Callable:
     """A loop over the particles doing a = (F + m·g)/m then ``update`` per coordinate.
 
-    F is ``forces`` plus the threads' partial spring forces ``partial`` (T, N, d)
-    not yet added to it (T = 0 if none), summed as `_spring_forces_parallel` would.
+    F is ``forces`` plus the spring forces not yet added to it, in the order the
+    spring loops would add them: the threads' ``partial`` forces (T, N, d; T = 0
+    if none, see `_spring_forces_parallel`), then the gather's forces by
+    coordinate, particle i at ``by_coordinate[q, pad + i]`` (none if it has no
+    rows, see `_gather_parallel`).
     With ``threads`` the particles are split between the threads (each writes
     only its own rows). numba compiles it at its first call, which raises a
     numba error if it cannot.
@@ -619,13 +623,17 @@ def _compile_advance(update: Callable, threads: bool) -> Callable:
     scalar = numba.njit(update)
 
     @numba.njit(parallel=threads)
-    def advance(x, v, forces, partial, field, masses, fixed, dt, coefficients, x_new, v_new):
+    def advance(x, v, forces, pending, field, masses, fixed, dt, coefficients, x_new, v_new):
+        partial, by_coordinate, pad = pending
+        gathered = len(by_coordinate) > 0
         for i in numba.prange(len(masses)):
             inverse = _inverse_mass(masses[i], not fixed[i])
             for q in range(x.shape[1]):
                 total = forces[i, q]
                 for t in range(len(partial)):
                     total += partial[t, i, q]
+                if gathered:
+                    total += by_coordinate[q, pad + i]
                 a = _acceleration(total + masses[i] * field[q], inverse)
                 x_new[i, q], v_new[i, q] = scalar(x[i, q], v[i, q], a, dt, *coefficients)
 
@@ -654,6 +662,9 @@ def _shared(views: tuple[np.ndarray, ...]) -> bool:
     return any(sys.getrefcount(view.base) > _PRIVATE for view in views)
 
 
+# Spring forces not yet added to the force buffer: the threads' buffers (T, N, d), the
+# gather's forces by coordinate (d, N + 2·pad) and that pad (see `_compile_advance`).
+Pending = tuple[np.ndarray, np.ndarray, int]
 # One compiled loop per update function (threaded or not), for the whole process.
 _ADVANCES: dict[tuple[Callable, bool], Callable] = {}
 _FAILED: set[Callable] = set()  # updates numba cannot compile: they run on arrays
@@ -676,7 +687,7 @@ class NumbaKernel:
         self._version = -1
         self._a = self._b = np.zeros(0, dtype=np.int32)
         self._partial: np.ndarray | None = None
-        self._none = np.zeros((0, 0, 0))  # see `_no_partial`
+        self._none: Pending = (np.zeros((0, 0, 0)), np.zeros((0, 0)), 0)  # see `_no_partial`
         self._threads = 1
         self._stencil_version = -1
         self._stencil: GridStencil | None = None
@@ -716,9 +727,10 @@ class NumbaKernel:
         out: np.ndarray,
         springs: np.ndarray | None,
         reduce: bool,
-    ) -> tuple[float, float, np.ndarray]:
-        """`add_spring_forces`, and the threads' forces (T, N, d) still to add to ``out``:
-        none (T = 0) with ``reduce``, else those of `_spring_forces_parallel`."""
+    ) -> tuple[float, float, Pending]:
+        """`add_spring_forces`, and the spring forces still to add to ``out`` (see
+        `_compile_advance`): none with ``reduce``, else the threads' buffers of
+        `_spring_forces_parallel` or the gather's forces by coordinate."""
         none = self._no_partial(x)
         if springs is None:
             stencil = self.grid_stencil(body)
@@ -729,8 +741,10 @@ class NumbaKernel:
                 triples, _, o2s, rows_of = self._triples
                 columns, rows = self._columns
                 layout = (stencil.shape, triples, rows_of, o2s, self._triple_values, columns, rows)
-                squares, powers = gather(x, v, *layout, self._scratch, out)
-                return math.sqrt(squares.max()), float(powers.sum()), none  # any threads
+                squares, powers = gather(x, v, *layout, self._scratch, out, reduce)
+                stretch, power = math.sqrt(squares.max()), float(powers.sum())  # any threads
+                gathered = (none[0], self._scratch[6 : 6 + x.shape[1]], self._pad)
+                return stretch, power, none if reduce else gathered
         if springs is not None:
             a, b, k, rest, c = (body.spring_a, body.spring_b, *body.spring_values())
             a, b, k, rest, c = (array[springs] for array in (a, b, k, rest, c))
@@ -741,12 +755,12 @@ class NumbaKernel:
         if self._partial is None or self._partial.shape[1:] != x.shape:
             self._partial = np.empty((self._threads - 1, *x.shape))
         sums = _spring_forces_parallel(x, v, *arrays, self._partial, out, reduce)
-        return *sums, none if reduce else self._partial
+        return *sums, none if reduce else (self._partial, none[1], 0)
 
-    def _no_partial(self, x: np.ndarray) -> np.ndarray:
-        """An empty (0, N, d) array: no partial forces (see `_compile_advance`)."""
-        if self._none.shape[1:] != x.shape:
-            self._none = np.zeros((0, *x.shape))
+    def _no_partial(self, x: np.ndarray) -> Pending:
+        """No spring forces pending (see `_compile_advance`)."""
+        if self._none[0].shape[1:] != x.shape:
+            self._none = (np.zeros((0, *x.shape)), np.zeros((0, 0)), 0)
         return self._none
 
     def grid_stencil(self, body: Body) -> GridStencil | None:
@@ -853,10 +867,11 @@ class NumbaKernel:
         coefficients: tuple[float, ...],
     ) -> tuple[np.ndarray, np.ndarray, float, float]:
         """`add_spring_forces` to ``forces``, then `advance`: (x_new, v_new, largest stretch,
-        dashpot power W). The threads' partial spring forces are added to F in the
-        update's loop, not in a pass of their own; ``forces`` then lacks them."""
-        stretch, power, partial = self._spring_forces(body, x, v, forces, None, reduce=False)
-        x_new, v_new = self._advance(update, body, x, v, forces, partial, field, dt, coefficients)
+        dashpot power W). The threads' partial spring forces, or the gather's, are
+        added to F in the update's loop, not in a pass of their own; ``forces``
+        then lacks them."""
+        stretch, power, pending = self._spring_forces(body, x, v, forces, None, reduce=False)
+        x_new, v_new = self._advance(update, body, x, v, forces, pending, field, dt, coefficients)
         return x_new, v_new, stretch, power
 
     def _advance(
@@ -866,12 +881,13 @@ class NumbaKernel:
         x: np.ndarray,
         v: np.ndarray,
         forces: np.ndarray,
-        partial: np.ndarray,
+        pending: Pending,
         field: np.ndarray,
         dt: float,
         coefficients: tuple[float, ...],
     ) -> tuple[np.ndarray, np.ndarray]:
-        """`advance` with F = ``forces`` plus ``partial`` (T, N, d) (see `_compile_advance`)."""
+        """`advance` with F = ``forces`` plus the spring forces ``pending`` (see
+        `_compile_advance`)."""
         threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
         if update in _FAILED:
             compiled = None
@@ -884,7 +900,7 @@ class NumbaKernel:
             try:
                 masses, fixed = body.masses, body.fixed
                 compiled(
-                    x, v, forces, partial, field, masses, fixed, dt, coefficients, x_new, v_new
+                    x, v, forces, pending, field, masses, fixed, dt, coefficients, x_new, v_new
                 )
                 return x_new, v_new
             except numba.core.errors.NumbaError as error:
@@ -895,8 +911,11 @@ class NumbaKernel:
                     RuntimeWarning,
                     stacklevel=5,
                 )
+        partial, by_coordinate, pad = pending
         for part in partial:
             forces = forces + part  # in the order of `_spring_forces_parallel`
+        if len(by_coordinate):
+            forces = forces + by_coordinate[:, pad : pad + len(x)].T
         inverse = equations.inverse_mass(body.masses, ~body.fixed)
         a = equations.acceleration(forces + body.masses[:, None] * field, inverse[:, None])
         return update(x, v, a, dt, *coefficients)

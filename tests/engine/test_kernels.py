@@ -112,17 +112,24 @@ def object_update(x: float, v: float, a: float, dt: float) -> tuple[float, float
 
 @pytest.mark.parametrize("threaded", [False, True])
 @pytest.mark.parametrize("update", [integrators.symplectic_euler_update, object_update])
+@pytest.mark.parametrize(("dim", "uniform"), [(3, False), (3, True), (2, True)])
 def test_advance_with_springs_is_forces_then_advance(
-    threaded: bool, update, kernel: str, monkeypatch: pytest.MonkeyPatch
+    threaded: bool, update, dim: int, uniform: bool, kernel: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """The forces, the update and the stretch and power, bit for bit (the numba kernel adds
-    its threads' partial forces in the update's loop instead of a pass of their own)."""
+    its threads' partial forces, or the grid gather's forces, in the update's loop instead
+    of a pass of their own). With ``uniform`` spring values the numba kernel gathers."""
     if threaded:
         monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
         monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_PARTICLES", 0)
-    body = deformed_body(3, seed=6)
-    x, v, field = body.positions, body.velocities, np.array([0.0, -9.81, 0.0])
+    body = deformed_body(dim, seed=6)
+    if uniform:
+        body.stiffness[:] = 30.0
+        body.spring_damping[:] = 0.3
+    x, v, field = body.positions, body.velocities, np.array([0.0, -9.81, 0.0][:dim])
     springs = kernels.make_kernel(kernel)
+    if kernel == "numba":
+        assert (springs.grid_stencil(body) is not None) == uniform
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # numba cannot compile object_update
         forces = np.zeros_like(x)
