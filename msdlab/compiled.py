@@ -30,8 +30,9 @@ same particle; one thread takes them in the same order, with the same sums.
 `integrators.verlet_update`) into one loop over the particles that computes
 a = F/m (plus gravity's g) and the update together; it is compiled once per
 process and update. When the springs' forces are all the forces
-(`NumbaKernel.advance_with_springs`), the threads' force buffers are added in
-that loop too, not in a pass of their own.
+(`NumbaKernel.advance_with_springs`), the spring forces not yet summed (the
+edge loop's threads' buffers, or the gather's forces by coordinate) are added
+in that loop too, not in a pass of their own.
 
 The spring loops are compiled on first use and cached on disk (``cache=True``),
 so compiling is paid once per machine and numba version. Set the number of
