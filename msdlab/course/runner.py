@@ -49,7 +49,9 @@ def run_checks(
     Returns the report and pytest's output; ``save`` keeps a copy of the JSON
     report, ``points`` gets the points manifest of every check found (`manifest`).
     Hidden checks run only with ``hidden``. Each call into a task file may take
-    ``call_timeout`` seconds, the whole run ``timeout``.
+    ``call_timeout`` seconds, the whole run ``timeout``. The checks run on the
+    numpy kernel, as when graded (their bodies are small: no compiling), unless
+    ``MSDLAB_KERNEL`` says otherwise.
     """
     with tempfile.TemporaryDirectory(prefix="msdlab-check-") as scratch:
         report_path = Path(scratch) / "report.json"
@@ -61,7 +63,7 @@ def run_checks(
             process = subprocess.run(
                 command,
                 cwd=checks,
-                env={**os.environ, "PYTHONDONTWRITEBYTECODE": "1"},
+                env={"MSDLAB_KERNEL": "numpy", **os.environ, "PYTHONDONTWRITEBYTECODE": "1"},
                 capture_output=True,
                 text=True,
                 timeout=timeout,

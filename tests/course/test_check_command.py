@@ -10,7 +10,7 @@ import pytest
 
 from msdlab.cli import main
 from msdlab.commands import check
-from msdlab.course import PROJECT_ROOT, manifest
+from msdlab.course import PROJECT_ROOT, manifest, runner
 from msdlab.course.report import CheckReport
 
 SOLUTIONS = PROJECT_ROOT / "solutions"
@@ -26,6 +26,28 @@ def test_all_checks_of_a_task_pass_on_the_solutions(capsys, tmp_path):
     assert "(hidden)" not in out and "what the failing checks saw" not in out
     saved = CheckReport.read(report)
     assert saved.all_passed and saved.tasks() == [1] and not any(c.hidden for c in saved.checks)
+
+
+@pytest.mark.parametrize(("chosen", "expected"), [(None, "numpy"), ("numba", "numba")])
+def test_checks_run_on_the_graders_kernel_unless_chosen(chosen, expected, monkeypatch, tmp_path):
+    """The grader's kernel (numpy) by default, so a check sees the numbers it sees when
+    graded; a kernel the student chose with MSDLAB_KERNEL is kept."""
+    if chosen is None:
+        monkeypatch.delenv("MSDLAB_KERNEL", raising=False)
+    else:
+        monkeypatch.setenv("MSDLAB_KERNEL", chosen)
+    probe = tmp_path / "checks"
+    probe.mkdir()
+    (probe / "test_probe.py").write_text(
+        "import pytest\n\nimport msdlab as msd\n\n\n"
+        "@pytest.mark.task1\n"
+        "@pytest.mark.points(1)\n"
+        "def test_kernel():\n"
+        "    body = msd.Body.grid((2, 2), neighbours=(1,))\n"
+        f"    assert msd.Simulation(body).dynamics.kernel == {expected!r}\n"
+    )
+    report, output = runner.run_checks(probe, SOLUTIONS)
+    assert report.checks and all(check.passed for check in report.checks), output
 
 
 def test_templates_fail_with_what_to_do_each_said_once(capsys):
