@@ -701,7 +701,7 @@ class NumbaKernel:
         self._values_version = -1
         self._uniform = False
         self._order: np.ndarray | None = None
-        self._sorted_version = -1
+        self._classes_version = -1
         self._classes: tuple[np.ndarray | None, ...] = (None,)  # see `_edge_list`
 
     name = "numba"
@@ -744,8 +744,9 @@ class NumbaKernel:
                 layout = (stencil.shape, triples, rows_of, o2s, self._triple_values, columns, rows)
                 squares, powers = gather(x, v, *layout, self._scratch, out, reduce)
                 stretch, power = math.sqrt(squares.max()), float(powers.sum())  # any threads
-                gathered = (none[0], self._scratch[6 : 6 + x.shape[1]], self._pad)
-                return stretch, power, none if reduce else gathered
+                if reduce:
+                    return stretch, power, none
+                return stretch, power, (none[0], self._scratch[6 : 6 + x.shape[1]], self._pad)
         if springs is not None:
             a, b, k, rest, c = (body.spring_a, body.spring_b, *body.spring_values())
             a, b, k, rest, c = (array[springs] for array in (a, b, k, rest, c))
@@ -943,13 +944,13 @@ class NumbaKernel:
                 ends = tuple(end[order] for end in ends)
             self._a, self._b = (end.astype(index) for end in ends)
             self._version = body.topology_version
-            self._sorted_version = -1
+            self._classes_version = -1
         values = body.spring_values()
         shared = _shared(values)
-        if body.parameters_version != self._sorted_version or shared:
+        if body.parameters_version != self._classes_version or shared:
             # sorted springs and a view held: the body's arrays, not classes to find every step
             self._classes = (None,) if shared and self._order is None else self._classify(values)
-            self._sorted_version = body.parameters_version
+            self._classes_version = body.parameters_version
         if self._classes[0] is None and self._order is None:
             return self._a, self._b, None, *values  # not kept: a reference would look shared
         return self._a, self._b, *self._classes
