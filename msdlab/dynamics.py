@@ -34,6 +34,7 @@ class Dynamics:
         self._pattern: kernels.JacobianPattern | None = None
         self._last_power: tuple[np.ndarray, np.ndarray, float] | None = None
         self._buffer: np.ndarray | None = None
+        self.step_end: kernels.StepEnd | None = None  # for the next `advance`; see there
 
     @property
     def kernel(self) -> str:
@@ -85,6 +86,12 @@ class Dynamics:
         a = F/m + g, g the forces' `Force.uniform_acceleration` (gravity). When every
         force is such a g, F is the springs' alone and the kernel computes it and the
         update in one go (`SpringKernel.advance_with_springs`).
+
+        In a `Simulation` step the loop may also do the end of the step: pin the
+        fixed particles, check the values are finite and find those under the
+        floor (`step_end`, set by the Simulation for the step's first call). The
+        arrays returned are then read-only: return them as they are, or compute
+        new ones from them (``x_new + ...``), which the Simulation then checks.
         """
         if self._buffer is None or self._buffer.shape != x.shape:
             self._buffer = np.empty_like(x)  # the forces, used up within this call
@@ -94,14 +101,20 @@ class Dynamics:
         for g in fields:
             if g is not None:
                 field += g
+        end, self.step_end = self.step_end, None
         if all(g is not None for g in fields):  # the springs' forces only: the kernel sums them
             x_new, v_new, self.max_stretch, power = self.springs.advance_with_springs(
-                update, self.body, x, v, self._buffer, field, dt, coefficients
+                update, self.body, x, v, self._buffer, field, dt, coefficients, end
             )
             self._last_power = (x, v, power)
-            return x_new, v_new
-        self._add_forces(x, v, self._buffer, fields)
-        return self.springs.advance(update, self.body, x, v, self._buffer, field, dt, coefficients)
+        else:
+            self._add_forces(x, v, self._buffer, fields)
+            x_new, v_new = self.springs.advance(
+                update, self.body, x, v, self._buffer, field, dt, coefficients, end
+            )
+        if end is not None and end.arrays:
+            x_new.flags.writeable = v_new.flags.writeable = False
+        return x_new, v_new
 
     def forget_last_state(self) -> None:
         """Drop the dashpot power kept from the last force evaluation (the state changed)."""

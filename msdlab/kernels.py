@@ -15,6 +15,7 @@ from __future__ import annotations
 import os
 import warnings
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
@@ -25,6 +26,24 @@ from .body import Body
 
 KERNELS = ("numba", "numpy")
 Update = Callable[..., tuple[np.ndarray, np.ndarray]]
+
+
+@dataclass
+class StepEnd:
+    """What a `Simulation` does to a step's new (x, v) that an update loop can do as it
+    writes them (`Dynamics.advance`): pin the fixed particles (x kept, v = 0), check
+    that every value is finite, and find the free particles under a floor plane,
+    x·normal < height, for the floor to clamp.
+
+    A kernel that did it sets ``arrays`` to the (x_new, v_new) it did it to and
+    the results; the numpy kernel leaves it to the Simulation's per-array passes.
+    """
+
+    normal: np.ndarray  # (d,) unit normal of the floor, or (0,) for no floor
+    height: float  # of the floor along the normal (m)
+    arrays: tuple[np.ndarray, ...] = ()
+    finite: bool = True
+    under: np.ndarray | None = None  # indices of the particles found
 
 
 def spring_vectors(body: Body, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -225,9 +244,10 @@ class SpringKernel(Protocol):
         field: np.ndarray,
         dt: float,
         coefficients: tuple[float, ...],
+        end: StepEnd | None,
     ) -> tuple[np.ndarray, np.ndarray]:
         """``update(x, v, a, dt, *coefficients)`` with a = (F + m·g)/m, g = ``field`` (d,)
-        in m/s² (0 for fixed particles)."""
+        in m/s² (0 for fixed particles); and ``end``, if given, if the kernel can."""
 
     def advance_with_springs(
         self,
@@ -239,6 +259,7 @@ class SpringKernel(Protocol):
         field: np.ndarray,
         dt: float,
         coefficients: tuple[float, ...],
+        end: StepEnd | None,
     ) -> tuple[np.ndarray, np.ndarray, float, float]:
         """`add_spring_forces` to ``forces``, then `advance`: (x_new, v_new, largest stretch,
         dashpot power W). ``forces`` is left to the kernel (it may hold only part of them)."""
@@ -297,9 +318,10 @@ class NumpyKernel:
         field: np.ndarray,
         dt: float,
         coefficients: tuple[float, ...],
+        end: StepEnd | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
         """``update(x, v, a, dt, *coefficients)`` on whole arrays, a = (F + m·g)/m (0 if
-        fixed), g = ``field`` (d,) in m/s²."""
+        fixed), g = ``field`` (d,) in m/s². ``end`` is left to the Simulation."""
         total = forces + body.masses[:, None] * field if field.any() else forces
         return update(x, v, self.to_acceleration(body, total), dt, *coefficients)
 
@@ -313,6 +335,7 @@ class NumpyKernel:
         field: np.ndarray,
         dt: float,
         coefficients: tuple[float, ...],
+        end: StepEnd | None = None,
     ) -> tuple[np.ndarray, np.ndarray, float, float]:
         """`add_spring_forces` to ``forces``, then `advance`: (x_new, v_new, largest stretch,
         dashpot power W)."""

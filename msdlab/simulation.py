@@ -17,6 +17,7 @@ from .energy import EnergyLedger, kinetic_energy
 from .errors import SimulationDiverged, check_finite_array, check_positive, diagnose_divergence
 from .forces import Force
 from .integrators import Integrator, Verlet
+from .kernels import StepEnd
 
 
 @dataclass
@@ -122,32 +123,68 @@ class Simulation:
 
     # ------------------------------------------------------------------ stepping
     def step(self) -> None:
-        """Advance the body by one step of ``dt``."""
+        """Advance the body by one step of ``dt``.
+
+        The integrator's step, then: pin the fixed particles, apply the constraints,
+        book the energy, check for divergence, and copy the new state into the body.
+        The update loop of `Dynamics.advance` may have done the pinning, the finite
+        check and the floor's search already (`kernels.StepEnd`); the rest is the same.
+        """
         body, dt = self.body, self.dt
         x, v = body.positions, body.velocities
         self.dynamics.forget_last_state()
-        x_new, v_new = self._checked(self.integrator.step(x, v, dt, self.dynamics), x)
+        end = self._step_end()
+        self.dynamics.step_end = end
+        try:
+            result = self.integrator.step(x, v, dt, self.dynamics)
+        except ValueError as error:
+            if "read-only" in str(error) and end.arrays:
+                raise TypeError(
+                    f"{self.integrator!r}.step wrote into a read-only array: in a Simulation "
+                    "the arrays dynamics.advance returns are read-only; return them as they "
+                    "are, or compute new ones (x_new + ..., not x_new += ...)"
+                ) from error
+            raise
+        finally:
+            self.dynamics.step_end = None
+        x_new, v_new = self._checked(result, x)
+        ended = len(end.arrays) == 2 and end.arrays[0] is x_new and end.arrays[1] is v_new
+        if ended:  # the constraints edit them
+            x_new.flags.writeable = v_new.flags.writeable = True
         power = self.dynamics.dashpot_power(x, v) if self.ledger else 0.0
         fixed = body.fixed
-        if fixed.any():
+        if not ended and fixed.any():
             x_new[fixed] = x[fixed]
             v_new[fixed] = 0.0
         energy_of = self._energy_of(x_new, v_new) if self.ledger else _unbooked
         state = StepState(body, x, v, x_new, v_new, self.time + dt, dt, energy_of)
-        removed = [(c.ledger_name, c.apply(state)) for c in self.constraints]
+        removed = []
+        for i, constraint in enumerate(self.constraints):
+            state.under = end.under if ended and i == 0 else None
+            removed.append((constraint.ledger_name, constraint.apply(state)))
         if self.ledger:  # after the constraints: the integrator's damping works at the final v
             booked = self._dissipation(x, v, v_new, power)
             for name, energy in removed:
                 booked[name] = booked.get(name, 0.0) + energy
         else:
             booked = {}
-        self._check_divergence(x, x_new, v_new)
+        floors = 0 if end.under is None else 1  # a floor keeps finite values finite
+        checked = ended and len(self.constraints) == floors  # others may not: check after them
+        self._check_divergence(x, x_new, v_new, end.finite if checked else None)
         x[...] = x_new
         v[...] = v_new
         self.time += dt
         self.step_count += 1
         for name, energy in booked.items():
             self.dissipated[name] += energy
+
+    def _step_end(self) -> StepEnd:
+        """What the step's update loop may do for this step: see `kernels.StepEnd`."""
+        floor = self.constraints[0].floor(self.body) if self.constraints else None
+        if floor is None:
+            return StepEnd(np.zeros(0), 0.0)
+        normal, height = floor
+        return StepEnd(np.asarray(normal, dtype=float), float(height))
 
     def _dissipation(
         self, x: np.ndarray, v: np.ndarray, v_new: np.ndarray, dashpot_power: float
@@ -273,8 +310,13 @@ class Simulation:
 
         return energy
 
-    def _check_divergence(self, x: np.ndarray, x_new: np.ndarray, v_new: np.ndarray) -> None:
-        finite = math.isfinite(float(x_new.sum()) + float(v_new.sum()))
+    def _check_divergence(
+        self, x: np.ndarray, x_new: np.ndarray, v_new: np.ndarray, finite: bool | None = None
+    ) -> None:
+        """Raise `SimulationDiverged` if the new state is not finite (``finite``, if the
+        update loop checked) or a spring is stretched past ``max_stretch``."""
+        if finite is None:
+            finite = math.isfinite(float(x_new.sum()) + float(v_new.sum()))
         stretched = self.max_stretch is not None and self.dynamics.max_stretch > self.max_stretch
         if not finite or stretched:
             diagnosis = diagnose_divergence(

@@ -70,15 +70,26 @@ class Ground(Constraint):
                 f"{body.dim}-D"
             )
 
+    def _heights(self, x: np.ndarray, n: np.ndarray) -> np.ndarray:
+        """x·n of each row (m), summed in the order of the update loop (no matrix product)."""
+        return x[:, 1] if self.normal is None else (x * n).sum(axis=1)
+
+    def floor(self, body: Body) -> tuple[np.ndarray, float] | None:
+        """The plane, for the update loop to find the particles under it (not for subclasses
+        that change `apply`)."""
+        return (self._normal(body), self.height) if type(self).apply is Ground.apply else None
+
     def apply(self, state: StepState) -> float:
         n = self._normal(state.body)
-        up = state.x[:, 1] if self.normal is None else state.x @ n  # y: no matrix product
-        depth = self.height - up
-        below = (depth > 0).nonzero()[0]
-        below = below[~state.body.fixed[below]]  # fixed ones only among the few below
+        if state.under is None:
+            candidates = (self._heights(state.x, n) < self.height).nonzero()[0]
+        else:  # the update loop found them, the same way
+            candidates = state.under
+        below = candidates[~state.body.fixed[candidates]]  # fixed ones only among the few below
         if len(below) == 0:
             return 0.0
-        x = state.x.take(below, axis=0) + depth.take(below)[:, None] * n
+        x = state.x.take(below, axis=0)
+        x = x + (self.height - self._heights(x, n))[:, None] * n  # depth > 0 along n
         v = state.v.take(below, axis=0)
         state.x[below] = x
         landing = v @ n
