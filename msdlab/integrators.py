@@ -62,12 +62,25 @@ class Integrator(ABC):
     def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: Dynamics) -> State:
         """Return (x, v) one step of ``dt`` seconds later."""
 
+    @property
+    def velocity_factor(self) -> float:
+        """The factor the scheme scales the velocity it starts a step from by, before the
+        forces act (damped Verlet, eq. 1.4: 1 - λ); 1 for none."""
+        return 1.0
+
     def dissipated_energy(
         self, v: np.ndarray, masses: np.ndarray, v_new: np.ndarray | None = None
     ) -> float:
         """Energy (J) the scheme removes on purpose in the step from velocities ``v`` to
-        ``v_new`` (see `Verlet`); 0 by default."""
-        return 0.0
+        ``v_new``: the work of the kick (factor - 1)·v of `velocity_factor`
+        (`energy.damping_work`), or (1 - factor²)·½ Σ m v² when ``v_new`` is not given;
+        0 for a factor of 1."""
+        factor = self.velocity_factor
+        if factor == 1.0:
+            return 0.0
+        if v_new is None:
+            return float((1.0 - factor**2) * kinetic_energy(masses, v))
+        return damping_work(masses, v, v_new, factor)
 
     def velocity_at_positions(self, v: np.ndarray, a: np.ndarray, dt: float) -> np.ndarray:
         """The velocity at the time of the positions, for energy measurements; ``v`` here.
@@ -136,16 +149,10 @@ class Verlet(Integrator):
         """v(t) ≈ v(t - dt/2) + ½ a(t) dt: the stored velocity is half a step behind x."""
         return v + 0.5 * dt * a
 
-    def dissipated_energy(
-        self, v: np.ndarray, masses: np.ndarray, v_new: np.ndarray | None = None
-    ) -> float:
-        """Energy λ removes per step: the work of the kick -λ·v (`energy.damping_work`),
-        or (1 - (1 - λ)²)·½ Σ m v² when the step's new velocity ``v_new`` is not given."""
-        if self.damping == 0.0:
-            return 0.0
-        if v_new is None:
-            return float((1.0 - (1.0 - self.damping) ** 2) * kinetic_energy(masses, v))
-        return damping_work(masses, v, v_new, 1.0 - self.damping)
+    @property
+    def velocity_factor(self) -> float:
+        """1 - λ: the damping's kick -λ·v takes out energy (`Integrator.dissipated_energy`)."""
+        return 1.0 - self.damping
 
     def __repr__(self) -> str:
         return f"Verlet(damping={self.damping:g})"

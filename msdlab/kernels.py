@@ -32,8 +32,10 @@ Update = Callable[..., tuple[np.ndarray, np.ndarray]]
 class StepEnd:
     """What a `Simulation` does to a step's new (x, v) that an update loop can do as it
     writes them (`Dynamics.advance`): pin the fixed particles (x kept, v = 0), check
-    that every value is finite, and find the free particles under a floor plane,
-    x·normal < height, for the floor to clamp.
+    that every value is finite, find the free particles under a floor plane,
+    x·normal < height, for the floor to clamp, and, if ``damping``, sum the
+    ledger's work of a velocity factor (`energy.damping_work` with factor 0,
+    ½ Σ m v·(v + v_new)) over the particles not under the floor.
 
     A kernel that did it sets ``arrays`` to the (x_new, v_new) it did it to and
     the results; the numpy kernel leaves it to the Simulation's per-array passes.
@@ -41,9 +43,11 @@ class StepEnd:
 
     normal: np.ndarray  # (d,) unit normal of the floor, or (0,) for no floor
     height: float  # of the floor along the normal (m)
+    damping: bool = False
     arrays: tuple[np.ndarray, ...] = ()
     finite: bool = True
     under: np.ndarray | None = None  # indices of the particles found
+    damping_work: float = 0.0  # J
 
 
 def spring_vectors(body: Body, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -162,15 +162,16 @@ class Simulation:
         for i, constraint in enumerate(self.constraints):
             state.under = end.under if ended and i == 0 else None
             removed.append((constraint.ledger_name, constraint.apply(state)))
+        floors = 0 if end.under is None else 1
+        summed = ended and len(self.constraints) == floors  # no constraint but the floor
         if self.ledger:  # after the constraints: the integrator's damping works at the final v
-            booked = self._dissipation(x, v, v_new, power)
+            booked = self._dissipation(x, v, v_new, power, end if summed else None)
             for name, energy in removed:
                 booked[name] = booked.get(name, 0.0) + energy
         else:
             booked = {}
-        floors = 0 if end.under is None else 1  # a floor keeps finite values finite
-        checked = ended and len(self.constraints) == floors  # others may not: check after them
-        self._check_divergence(x, x_new, v_new, end.finite if checked else None)
+        # a floor keeps finite values finite; other constraints may not: check after them
+        self._check_divergence(x, x_new, v_new, end.finite if summed else None)
         x[...] = x_new
         v[...] = v_new
         self.time += dt
@@ -181,21 +182,34 @@ class Simulation:
     def _step_end(self) -> StepEnd:
         """What the step's update loop may do for this step: see `kernels.StepEnd`."""
         floor = self.constraints[0].floor(self.body) if self.constraints else None
-        if floor is None:
-            return StepEnd(np.zeros(0), 0.0)
-        normal, height = floor
-        return StepEnd(np.asarray(normal, dtype=float), float(height))
+        normal, height = (np.zeros(0), 0.0) if floor is None else floor
+        integrator = self.integrator
+        damping = (
+            self.ledger
+            and integrator.velocity_factor != 1.0
+            and type(integrator).dissipated_energy is Integrator.dissipated_energy
+        )
+        return StepEnd(np.asarray(normal, dtype=float), float(height), damping)
 
     def _dissipation(
-        self, x: np.ndarray, v: np.ndarray, v_new: np.ndarray, dashpot_power: float
+        self,
+        x: np.ndarray,
+        v: np.ndarray,
+        v_new: np.ndarray,
+        dashpot_power: float,
+        end: StepEnd | None = None,
     ) -> dict[str, float]:
         """Energy (J) the dashpots, the integrator's damping and dissipative forces take out
-        in the step from (x, v) to velocities ``v_new``, by source."""
-        dt = self.dt
-        booked = {
-            "dashpot": dashpot_power * dt,
-            "integrator": self.integrator.dissipated_energy(v, self.body.masses, v_new),
-        }
+        in the step from (x, v) to velocities ``v_new``, by source. ``end``: the update
+        loop summed the damping's work but over the particles under the floor."""
+        dt, masses = self.dt, self.body.masses
+        if end is not None and end.damping:
+            rows = end.under if end.under is not None else slice(0)
+            damping = (1.0 - self.integrator.velocity_factor) * end.damping_work
+            damping += self.integrator.dissipated_energy(v[rows], masses[rows], v_new[rows])
+        else:
+            damping = self.integrator.dissipated_energy(v, masses, v_new)
+        booked = {"dashpot": dashpot_power * dt, "integrator": damping}
         for force in self.forces:
             lost = force.dissipated_power(self.body, x, v)
             if lost:

@@ -517,14 +517,15 @@ class RemoteObject:
 class RemoteIntegrator(RemoteObject, Integrator):
     """A submission's `Integrator`: the engine steps it, each step runs in the sandbox.
 
-    Each method call is one round trip. `velocity_at_positions` and `dissipated_energy`
-    that the submission's class takes unchanged from `Integrator` run here, as the
-    engine's own code: the engine calls them at every step, and an answer of the
+    Each method call is one round trip. `velocity_at_positions`, `dissipated_energy`
+    and `velocity_factor` that the submission's class takes unchanged from
+    `Integrator` run here, as the engine's own code: the engine calls them at
+    every step, and an answer of the
     submission's process that they are unchanged when they are not gains it nothing
     it could not have by returning those same numbers.
     """
 
-    ENGINE_DEFAULTS = ("velocity_at_positions", "dissipated_energy")
+    ENGINE_DEFAULTS = ("velocity_at_positions", "dissipated_energy", "velocity_factor")
 
     def __init__(self, sandbox: SandboxProcess, ref: wire.Ref, name: str) -> None:
         super().__init__(sandbox, ref, name)
@@ -539,6 +540,12 @@ class RemoteIntegrator(RemoteObject, Integrator):
         if self._engine_default("dissipated_energy"):
             return Integrator.dissipated_energy(self, v, masses, v_new)
         return self._call_method("dissipated_energy", v, masses, v_new)
+
+    @property
+    def velocity_factor(self) -> float:
+        if self._engine_default("velocity_factor"):
+            return Integrator.velocity_factor.fget(self)
+        return float(self.__getattr__("velocity_factor"))
 
     def velocity_at_positions(self, v: np.ndarray, a: np.ndarray, dt: float) -> np.ndarray:
         if self._engine_default("velocity_at_positions"):

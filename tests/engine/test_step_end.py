@@ -77,11 +77,18 @@ def test_the_loop_ends_the_step_as_the_simulation_does(
     (x, v, booked, ends), (x_ref, v_ref, booked_ref, _) = results
     np.testing.assert_array_equal(x, x_ref)
     np.testing.assert_array_equal(v, v_ref)
+    damping = booked.pop("integrator"), booked_ref.pop("integrator")  # summed in another order
     assert booked == booked_ref
     assert booked["ground"] != 0.0  # the floor acted
     fused = kernel == "numba"  # the loop ended the steps of the first run, not the reference's
     assert searched == [fused] * len(ends) + [False] * len(ends)
     assert any(end.under is not None and len(end.under) for end in ends) == fused
+    if scheme is msd.Verlet:  # λ's work, summed by the loop but under the floor
+        assert damping[0] == pytest.approx(damping[1], rel=1e-12, abs=0.0)
+        assert all(end.damping and (end.damping_work > 0) == fused for end in ends)
+    else:
+        assert damping == (0.0, 0.0)
+        assert not any(end.damping for end in ends)
 
 
 def test_more_constraints_after_the_floor(kernel: str) -> None:
@@ -93,7 +100,7 @@ def test_more_constraints_after_the_floor(kernel: str) -> None:
         results.append((body.positions, body.velocities, dict(sim.dissipated)))
     np.testing.assert_array_equal(results[0][0], results[1][0])
     np.testing.assert_array_equal(results[0][1], results[1][1])
-    assert results[0][2] == results[1][2]
+    assert results[0][2] == results[1][2]  # with drag after it, λ's work is summed afterwards
 
 
 class Poison(msd.Constraint):
@@ -164,3 +171,21 @@ def test_a_floor_with_its_own_apply_is_searched_by_itself() -> None:
     sim, ends = run(msd.Verlet(), body, [SpringyFloor(height=0.1)], steps=150)
     assert all(end.under is None for end in ends)
     assert sim.dissipated["ground"] != 0.0
+
+
+class OwnLedger(msd.Verlet):
+    """A Verlet that books its damping its own way: the loop must not sum it for it."""
+
+    def dissipated_energy(self, v, masses, v_new=None) -> float:
+        return 1.0
+
+
+@pytest.mark.parametrize("ledger", [True, False])
+def test_damping_is_summed_only_for_the_ledger_of_a_velocity_factor(ledger: bool) -> None:
+    for integrator, summed in ((msd.Verlet(0.1), ledger), (OwnLedger(0.1), False)):
+        body = falling_body(3, 4)
+        gravity = msd.Gravity(GRAVITY)
+        sim = msd.Simulation(body, integrator, forces=[gravity], ledger=ledger)
+        assert sim._step_end().damping == summed
+    sim.run(steps=3)
+    assert sim.dissipated.get("integrator", 0.0) == (3.0 if ledger else 0.0)
