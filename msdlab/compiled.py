@@ -153,7 +153,9 @@ def _spring_forces_parallel(x, v, a, b, kinds, k, rest, c, partial, out, reduce)
     """Threads: spring block 0 is summed into ``out``, block t > 0 into ``partial[t - 1]``.
 
     With ``reduce`` the partial buffers are then added to ``out`` particle by
-    particle; else the caller adds them in its own loop (see `_compile_advance`).
+    particle; else ``out`` is cleared first (the thread of block 0 does it while
+    the others clear theirs) and the caller adds them in its own loop (see
+    `_compile_advance`).
     """
     blocks = len(partial) + 1
     count = len(a)
@@ -162,6 +164,8 @@ def _spring_forces_parallel(x, v, a, b, kinds, k, rest, c, partial, out, reduce)
     for t in numba.prange(blocks):
         first, stop = t * count // blocks, (t + 1) * count // blocks
         if t == 0:
+            if not reduce:
+                out[:] = 0.0
             sums = _add_spring_block(x, v, a, b, kinds, k, rest, c, first, stop, out)
         else:
             partial[t - 1] = 0.0
@@ -613,7 +617,7 @@ def _compile_advance(update: Callable, threads: bool) -> Callable:
     """A loop over the particles doing a = (F + m·g)/m then ``update`` per coordinate,
     and the end of the step (`kernels.StepEnd`) if ``floor`` says so.
 
-    F is ``forces`` plus the spring forces not yet added to it, in the order the
+    F is ``forces`` ((0, d): none) plus the spring forces not yet added to it, in the order the
     spring loops would add them: the threads' ``partial`` forces (T, N, d; T = 0
     if none, see `_spring_forces_parallel`), then the gather's forces by
     coordinate, particle i at ``by_coordinate[q, pad + i]`` (none if it has no
@@ -634,6 +638,7 @@ def _compile_advance(update: Callable, threads: bool) -> Callable:
     ):
         partial, by_coordinate, pad = pending
         normal, height, ending, damping = floor
+        loaded = len(forces) > 0
         gathered = len(by_coordinate) > 0
         plane = ending and len(normal) > 0
         bad = 0
@@ -644,7 +649,7 @@ def _compile_advance(update: Callable, threads: bool) -> Callable:
             up = 0.0
             kick = 0.0
             for q in range(x.shape[1]):
-                total = forces[i, q]
+                total = forces[i, q] if loaded else 0.0
                 for t in range(len(partial)):
                     total += partial[t, i, q]
                 if gathered:
@@ -762,7 +767,8 @@ class NumbaKernel:
     ) -> tuple[float, float, Pending]:
         """`add_spring_forces`, and the spring forces still to add to ``out`` (see
         `_compile_advance`): none with ``reduce``, else the threads' buffers of
-        `_spring_forces_parallel` or the gather's forces by coordinate."""
+        `_spring_forces_parallel` or the gather's forces by coordinate; without
+        ``reduce`` ``out`` is scratch: the edge loops clear it, the gather leaves it."""
         none = self._no_partial(x)
         if springs is None:
             stencil = self.grid_stencil(body)
@@ -784,6 +790,8 @@ class NumbaKernel:
             return *_spring_forces_serial(x, v, a, b, None, k, rest, c, out), none
         arrays = self._edge_list(body)
         if not self._parallel(body):
+            if not reduce:
+                out.fill(0.0)
             return *_spring_forces_serial(x, v, *arrays, out), none
         if self._partial is None or self._partial.shape[1:] != x.shape:
             self._partial = np.empty((self._threads - 1, *x.shape))
@@ -900,11 +908,13 @@ class NumbaKernel:
         coefficients: tuple[float, ...],
         end: StepEnd | None = None,
     ) -> tuple[np.ndarray, np.ndarray, float, float]:
-        """`add_spring_forces` to ``forces``, then `advance`: (x_new, v_new, largest stretch,
-        dashpot power W). The threads' partial spring forces, or the gather's, are
-        added to F in the update's loop, not in a pass of their own; ``forces``
-        then lacks them."""
+        """The spring forces, then `advance`: (x_new, v_new, largest stretch, dashpot power W).
+        The threads' partial spring forces, or the gather's, are added to F in the
+        update's loop, not in a pass of their own; ``forces`` is scratch, its content
+        not read (the gather does not touch it, so the loop does not read it)."""
         stretch, power, pending = self._spring_forces(body, x, v, forces, None, reduce=False)
+        if len(pending[1]):  # the gather's forces by coordinate are all of F
+            forces = forces[:0]
         x_new, v_new = self._advance(
             update, body, x, v, forces, pending, field, dt, coefficients, end
         )
@@ -961,6 +971,7 @@ class NumbaKernel:
                     end.under = np.flatnonzero(self._under) if len(end.normal) else None
                 return x_new, v_new
         partial, by_coordinate, pad = pending
+        forces = forces if len(forces) else np.zeros_like(x)
         for part in partial:
             forces = forces + part  # in the order of `_spring_forces_parallel`
         if len(by_coordinate):

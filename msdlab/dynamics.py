@@ -95,7 +95,6 @@ class Dynamics:
         """
         if self._buffer is None or self._buffer.shape != x.shape:
             self._buffer = np.empty_like(x)  # the forces, used up within this call
-        self._buffer.fill(0.0)
         fields = [force.uniform_acceleration(self.body) for force in self.forces]
         field = np.zeros(x.shape[1])
         for g in fields:
@@ -108,6 +107,7 @@ class Dynamics:
             )
             self._last_power = (x, v, power)
         else:
+            self._buffer.fill(0.0)
             self._add_forces(x, v, self._buffer, fields)
             x_new, v_new = self.springs.advance(
                 update, self.body, x, v, self._buffer, field, dt, coefficients, end

@@ -265,8 +265,8 @@ class SpringKernel(Protocol):
         coefficients: tuple[float, ...],
         end: StepEnd | None,
     ) -> tuple[np.ndarray, np.ndarray, float, float]:
-        """`add_spring_forces` to ``forces``, then `advance`: (x_new, v_new, largest stretch,
-        dashpot power W). ``forces`` is left to the kernel (it may hold only part of them)."""
+        """The spring forces, then `advance`: (x_new, v_new, largest stretch, dashpot power W).
+        ``forces`` (N, d) is the kernel's scratch: its content is not read."""
 
 
 class NumpyKernel:
@@ -341,8 +341,9 @@ class NumpyKernel:
         coefficients: tuple[float, ...],
         end: StepEnd | None = None,
     ) -> tuple[np.ndarray, np.ndarray, float, float]:
-        """`add_spring_forces` to ``forces``, then `advance`: (x_new, v_new, largest stretch,
-        dashpot power W)."""
+        """`add_spring_forces` to ``forces`` (cleared first), then `advance`: (x_new, v_new,
+        largest stretch, dashpot power W)."""
+        forces.fill(0.0)
         stretch, power = self.add_spring_forces(body, x, v, forces, None)
         return *self.advance(update, body, x, v, forces, field, dt, coefficients), stretch, power
 
