@@ -61,6 +61,8 @@ if TYPE_CHECKING:
 # Below this many springs (particles for the update) one thread is faster than waking the others.
 PARALLEL_MIN_SPRINGS = 50_000
 PARALLEL_MIN_PARTICLES = 20_000
+# The gather wakes the threads four times a step: it waits for more springs (about 28³ grid).
+PARALLEL_MIN_GATHERED = 250_000
 # Particles a gather block holds (whole grid rows): long inner loops, enough blocks for threads.
 GATHER_BLOCK = 4096
 # At most this many distinct (stiffness, rest length, dashpot) triples are kept as a table
@@ -773,7 +775,8 @@ class NumbaKernel:
         if springs is None:
             stencil = self.grid_stencil(body)
             if stencil is not None:
-                gather = _gather_parallel if self._parallel(body) else _gather_serial
+                threads = self._parallel(body, PARALLEL_MIN_GATHERED)
+                gather = _gather_parallel if threads else _gather_serial
                 if self._scratch.shape != (10, len(x) + 2 * self._pad):
                     self._scratch = np.zeros((10, len(x) + 2 * self._pad))  # 2-D: x2 = v2 = 0
                 triples, _, o2s, rows_of = self._triples
@@ -836,10 +839,12 @@ class NumbaKernel:
                 self._triple_values = _triple_values(self._stencil_values, self._triples[1])
         return self._stencil if self._uniform else None
 
-    def _parallel(self, body: Body) -> bool:
-        """Whether the springs of ``body`` are worth splitting between threads."""
+    def _parallel(self, body: Body, least: int | None = None) -> bool:
+        """Whether the springs of ``body`` are worth splitting between threads: at least
+        ``least`` of them (default `PARALLEL_MIN_SPRINGS`)."""
         self._threads = numba.get_num_threads()
-        return body.n_springs >= PARALLEL_MIN_SPRINGS and self._threads > 1
+        least = PARALLEL_MIN_SPRINGS if least is None else least
+        return body.n_springs >= least and self._threads > 1
 
     def dashpot_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
         """Power (W) the dashpots take out of the body at (x, v), always >= 0."""

@@ -58,7 +58,8 @@ def test_the_loop_ends_the_step_as_the_simulation_does(
     if threads:
         if kernel == "numpy":
             pytest.skip("threads are the numba kernel's")
-        monkeypatch.setattr(compiled, "PARALLEL_MIN_PARTICLES", 10)
+        for limit in ("PARALLEL_MIN_PARTICLES", "PARALLEL_MIN_SPRINGS", "PARALLEL_MIN_GATHERED"):
+            monkeypatch.setattr(compiled, limit, 10)
     normal = None if normal is None else normal[:dim]
     integrator = (lambda cls: cls(0.01)) if scheme is msd.Verlet else (lambda cls: cls())
     searched: list[bool] = []  # did the floor get the particles the loop found?
