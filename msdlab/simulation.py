@@ -186,8 +186,8 @@ class Simulation:
         integrator = self.integrator
         damping = (
             self.ledger
-            and integrator.velocity_factor != 1.0
             and type(integrator).dissipated_energy is Integrator.dissipated_energy
+            and integrator.velocity_factor != 1.0
         )
         return StepEnd(np.asarray(normal, dtype=float), float(height), damping)
 
