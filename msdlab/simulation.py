@@ -182,7 +182,7 @@ class Simulation:
     def _step_end(self) -> StepEnd:
         """What the step's update loop may do for this step: see `kernels.StepEnd`."""
         floor = self.constraints[0].floor(self.body) if self.constraints else None
-        normal, height = (np.zeros(0), 0.0) if floor is None else floor
+        normal, height = (np.zeros(0), 0.0) if floor is None else self._checked_floor(floor)
         integrator = self.integrator
         damping = (
             self.ledger
@@ -190,6 +190,24 @@ class Simulation:
             and integrator.velocity_factor != 1.0
         )
         return StepEnd(np.asarray(normal, dtype=float), float(height), damping)
+
+    def _checked_floor(self, floor: object) -> tuple[np.ndarray, float]:
+        """A constraint's `Constraint.floor` as (unit normal (d,), height), or ValueError."""
+        try:
+            normal, height = floor  # type: ignore[misc]
+            normal, height = np.asarray(normal, dtype=float), float(height)
+        except (TypeError, ValueError):
+            normal, height = np.zeros(0), math.nan
+        if (
+            normal.shape != (self.body.dim,)
+            or not math.isfinite(height)
+            or not abs(math.hypot(*normal) - 1.0) <= 1e-9  # False for NaN
+        ):
+            raise ValueError(
+                f"{self.constraints[0]!r}.floor must return None or (unit normal of "
+                f"{self.body.dim} numbers, height in m), got {floor!r}"
+            )
+        return normal, height
 
     def _dissipation(
         self,

@@ -190,3 +190,25 @@ def test_damping_is_summed_only_for_the_ledger_of_a_velocity_factor(ledger: bool
         assert sim._step_end().damping == summed
     sim.run(steps=3)
     assert sim.dissipated.get("integrator", 0.0) == (3.0 if ledger else 0.0)
+
+
+class BadFloor(msd.Constraint):
+    """A constraint whose floor is not a plane of the body's dimension."""
+
+    def __init__(self, floor) -> None:
+        self.plane = floor
+
+    def floor(self, body):
+        return self.plane
+
+    def apply(self, state) -> float:
+        return 0.0
+
+
+@pytest.mark.parametrize(
+    "floor", [((0.0, 1.0), 0.0), ((0.0, 2.0, 0.0), 0.0), ((0.0, 1.0, 0.0), np.nan), "flat"]
+)
+def test_a_floor_that_is_not_a_plane_is_refused(floor) -> None:
+    sim = msd.Simulation(falling_body(3, 3), msd.Verlet(), forces=[BadFloor(floor)])
+    with pytest.raises(ValueError, match="floor must return None or \\(unit normal of 3 numbers"):
+        sim.step()
