@@ -128,7 +128,8 @@ class Simulation:
         The integrator's step, then: pin the fixed particles, apply the constraints,
         book the energy, check for divergence, and copy the new state into the body.
         The update loop of `Dynamics.advance` may have done the pinning, the finite
-        check and the floor's search already (`kernels.StepEnd`); the rest is the same.
+        check, the floor's search and the sum for the damping's work already
+        (`kernels.StepEnd`); the rest is the same.
         """
         body, dt = self.body, self.dt
         x, v = body.positions, body.velocities
@@ -189,7 +190,7 @@ class Simulation:
             and type(integrator).dissipated_energy is Integrator.dissipated_energy
             and integrator.velocity_factor != 1.0
         )
-        return StepEnd(np.asarray(normal, dtype=float), float(height), damping)
+        return StepEnd(normal, height, damping)
 
     def _checked_floor(self, floor: object) -> tuple[np.ndarray, float]:
         """A constraint's `Constraint.floor` as (unit normal (d,), height), or ValueError."""

@@ -520,9 +520,9 @@ class RemoteIntegrator(RemoteObject, Integrator):
     Each method call is one round trip. `velocity_at_positions`, `dissipated_energy`
     and `velocity_factor` that the submission's class takes unchanged from
     `Integrator` run here, as the engine's own code: the engine calls them at
-    every step, and an answer of the
-    submission's process that they are unchanged when they are not gains it nothing
-    it could not have by returning those same numbers.
+    every step, and an answer of the submission's process that they are
+    unchanged when they are not gains it nothing it could not have by returning
+    those same numbers.
     """
 
     ENGINE_DEFAULTS = ("velocity_at_positions", "dissipated_energy", "velocity_factor")

@@ -29,6 +29,9 @@ class Own(Plain):
 class Patched(Plain):
     def __init__(self):
         self.velocity_at_positions = lambda v, a, dt: 3.0 * v
+
+class Factor(Plain):
+    velocity_factor = 0.5
 """
 
 
@@ -70,3 +73,13 @@ def test_methods_the_submission_replaced_run_in_the_sandbox(remote, name, factor
     v = np.ones((2, 3))
     assert np.array_equal(integrator.velocity_at_positions(v, np.zeros((2, 3)), 0.1), factor * v)
     assert integrator.dissipated_energy(v, np.ones(2), v) == lost
+
+
+def test_the_engines_damping_work_uses_the_submissions_velocity_factor(remote):
+    v, v_new, masses = np.ones((2, 3)), np.full((2, 3), 0.25), np.array([1.0, 2.0])
+    integrator = remote.task(5).Factor()
+    assert integrator.velocity_factor == 0.5
+    expected = msd.energy.damping_work(masses, v, v_new, 0.5)
+    assert expected > 0.0
+    assert integrator.dissipated_energy(v, masses, v_new) == pytest.approx(expected, rel=1e-15)
+    assert remote.task(5).Plain().dissipated_energy(v, masses, v_new) == 0.0
