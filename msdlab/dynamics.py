@@ -88,8 +88,9 @@ class Dynamics:
         update in one go (`SpringKernel.advance_with_springs`).
 
         In a `Simulation` step the loop may also do the end of the step: pin the
-        fixed particles, check the values are finite and find those under the
-        floor (`step_end`, set by the Simulation for the step's first call). The
+        fixed particles, check the values are finite, find those under the floor
+        and sum the damping's work (`step_end`, set by the Simulation for the
+        step's first call; see `kernels.StepEnd`). The
         arrays returned are then read-only: return them as they are, or compute
         new ones from them (``x_new + ...``), which the Simulation then checks.
         """
