@@ -3,6 +3,7 @@
 The layers, lowest first; a module may import its own layer and the layers below:
 
 0. the engine core: the modules directly in ``msdlab/`` (body, equations, kernels, dynamics, ...)
+   and its numba backend ``msdlab.compiled``, which only ``kernels`` loads, when asked to
 1. ``msdlab.analysis`` and ``msdlab.interaction``, built on the core
 2. the package ``msdlab`` itself (its ``__init__`` re-exports 0 and 1)
 3. ``msdlab.scenes`` and ``msdlab.course``
@@ -23,6 +24,7 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parents[2] / "msdlab"
 LAYERS = {
+    "compiled": 0,
     "analysis": 1,
     "interaction": 1,
     "scenes": 3,
@@ -144,3 +146,14 @@ def test_the_core_imports_at_the_top_of_its_modules() -> None:
         if layer(module) == 0 and in_function and (module, target) not in ALLOWED_LOCAL_IMPORTS
     ]
     assert not hidden, "\n".join(hidden)
+
+
+def test_only_the_kernel_choice_loads_the_numba_backend() -> None:
+    """Importing msdlab needs no numba: the backend is loaded by `make_kernel` alone."""
+    loaders = {
+        (module, in_function)
+        for module, targets in GRAPH.items()
+        for target, in_function in targets
+        if target.startswith("msdlab.compiled") and not module.startswith("msdlab.compiled")
+    }
+    assert loaders == {("msdlab.kernels", True)}

@@ -74,13 +74,13 @@ def test_wide_classes_and_no_classes_give_the_same_sums(
 ) -> None:
     """300 stiffnesses: 16-bit classes; with the limit below that, the values per spring."""
     if threaded:
-        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
     body = shuffled_body(1)
     body.stiffness[:] = np.random.default_rng(1).integers(1, 301, body.n_springs) * 0.5
     wide = NumbaKernel()
     assert wide._edge_list(body)[2].dtype == np.uint16
     assert_close_to_numpy(body, wide)
-    monkeypatch.setattr("msdlab.compiled.SPRING_CLASSES", 256)
+    monkeypatch.setattr("msdlab.compiled.kernel.SPRING_CLASSES", 256)
     unclassed = NumbaKernel()
     assert unclassed._edge_list(body)[2] is None
     assert_same(forces_by(unclassed, body), forces_by(wide, body))
@@ -99,7 +99,7 @@ def sorted_body() -> msd.Body:
 def test_past_the_limit_in_the_bodys_order(monkeypatch: pytest.MonkeyPatch) -> None:
     """Springs already sorted, more classes than allowed: the loop reads the body's arrays."""
     body = sorted_body()
-    monkeypatch.setattr("msdlab.compiled.SPRING_CLASSES", 2)
+    monkeypatch.setattr("msdlab.compiled.kernel.SPRING_CLASSES", 2)
     kernel = NumbaKernel()
     _, _, kinds, k, _, _ = kernel._edge_list(body)
     assert kinds is None and np.shares_memory(k, body.spring_values()[0])
@@ -130,9 +130,9 @@ def test_held_view_edited_between_steps(threaded: bool, monkeypatch: pytest.Monk
     """A view of the values kept by the user and written between steps counts at the next step,
     on the classes and past their limit, as if the body had been built with the new values."""
     if threaded:
-        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
     for limit in (65_536, 4):
-        monkeypatch.setattr("msdlab.compiled.SPRING_CLASSES", limit)
+        monkeypatch.setattr("msdlab.compiled.kernel.SPRING_CLASSES", limit)
         body = shuffled_body(2)
         sim = msd.Simulation(body, msd.Verlet(0.01), dt=1e-3, kernel="numba")
         held, rest, damping = body.stiffness, body.rest_lengths, body.spring_damping

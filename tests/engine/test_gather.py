@@ -8,7 +8,7 @@ import pytest
 import msdlab as msd
 from msdlab import kernels
 from msdlab.compiled import NumbaKernel
-from msdlab.stencil import grid_stencil
+from msdlab.compiled.stencil import grid_stencil
 
 RTOL = 1e-12
 
@@ -65,8 +65,8 @@ def test_gather_matches_edge_loop_and_numpy(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     if threaded:
-        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
-        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_GATHERED", 0)
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
     body = shaken_grid(shape, neighbours, damping)
     gather = NumbaKernel()
     assert gather.grid_stencil(body) is not None
@@ -86,8 +86,8 @@ def test_threads_give_the_same_sums_as_one_thread(
 ) -> None:
     body = shaken_grid(shape, neighbours, damping)
     one_thread = forces_by(NumbaKernel(), body)
-    monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
-    monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_GATHERED", 0)
+    monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
+    monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
     threads = forces_by(NumbaKernel(), body)
     np.testing.assert_array_equal(threads[0], one_thread[0])
     assert threads[1:] == one_thread[1:]
@@ -165,9 +165,9 @@ def test_simulation_on_the_gather_follows_the_edge_loop(
     """200 steps of a grid falling onto the ground, SymplecticEuler and damped Verlet
     (threaded: the spring forces and the update, on the gather and on the edge loop)."""
     if threaded:
-        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
-        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_GATHERED", 0)
-        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_PARTICLES", 0)
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_PARTICLES", 0)
     runs = []
     for gathered in (True, False):
         if not gathered:
@@ -191,8 +191,8 @@ def test_shuffled_springs_sorted_for_the_edge_loop(
 ) -> None:
     """Springs in a random order with random values: the sorted edge loop sees every edit."""
     if threaded:
-        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
-        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_GATHERED", 0)
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
     grid = shaken_grid((4, 3, 5), (1, 2, 3), 0.0)
     order = np.random.default_rng(2).permutation(grid.n_springs)
     pairs = np.stack([grid.spring_a[order], grid.spring_b[order]], axis=1)

@@ -57,8 +57,8 @@ def test_kernel_matches_spring_objects(
     if threaded:
         if kernel != "numba":
             pytest.skip("only the numba kernel has threads")
-        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
-        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_GATHERED", 0)
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
     body = deformed_body(dim)
     x, v = body.positions, body.velocities
     springs = kernels.make_kernel(kernel)
@@ -121,9 +121,9 @@ def test_advance_with_springs_is_forces_then_advance(
     its threads' partial forces, or the grid gather's forces, in the update's loop instead
     of a pass of their own). With ``uniform`` spring values the numba kernel gathers."""
     if threaded:
-        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_SPRINGS", 0)
-        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_GATHERED", 0)
-        monkeypatch.setattr("msdlab.compiled.PARALLEL_MIN_PARTICLES", 0)
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_PARTICLES", 0)
     body = deformed_body(dim, seed=6)
     if uniform:
         body.stiffness[:] = 30.0

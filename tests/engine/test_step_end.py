@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab import compiled
+from msdlab.compiled import kernel as numba_kernel
 from msdlab.kernels import StepEnd
 
 GRAVITY = (0.0, -9.81, 0.0)
@@ -59,7 +59,7 @@ def test_the_loop_ends_the_step_as_the_simulation_does(
         if kernel == "numpy":
             pytest.skip("threads are the numba kernel's")
         for limit in ("PARALLEL_MIN_PARTICLES", "PARALLEL_MIN_SPRINGS", "PARALLEL_MIN_GATHERED"):
-            monkeypatch.setattr(compiled, limit, 10)
+            monkeypatch.setattr(numba_kernel, limit, 10)
     normal = None if normal is None else normal[:dim]
     integrator = (lambda cls: cls(0.01)) if scheme is msd.Verlet else (lambda cls: cls())
     searched: list[bool] = []  # did the floor get the particles the loop found?

@@ -1,0 +1,27 @@
+"""The numba spring kernel: the same `msdlab.equations`, compiled into loops.
+
+`kernels.NumpyKernel` applies the equations to (E, d) arrays of all springs,
+then sums them per particle. `NumbaKernel` compiles the same functions
+(`equations`, here) into loops, in one module per loop:
+
+- `edges`: the edge loop over the springs, sorted by their ends, for any body;
+- `gather`: grid bodies (`stencil`) whose springs share their values per
+  offset go by offset instead, with no list of springs;
+- `advance`: an integrator's update function (for example
+  `integrators.verlet_update`) compiled into one loop over the particles that
+  computes a = F/m (plus gravity's g) and the update together; it is compiled
+  once per process and update. When the springs' forces are all the forces
+  (`NumbaKernel.advance_with_springs`), the spring forces not yet summed (the
+  edge loop's threads' buffers, or the gather's forces by coordinate) are
+  added in that loop too, not in a pass of their own;
+- `kernel`: `NumbaKernel`, which keeps what a body needs between calls and
+  picks the loops.
+
+The spring loops are compiled on first use and cached on disk (``cache=True``),
+so compiling is paid once per machine and numba version. Set the number of
+threads with ``NUMBA_NUM_THREADS`` or `numba.set_num_threads`.
+"""
+
+from .kernel import NumbaKernel
+
+__all__ = ["NumbaKernel"]

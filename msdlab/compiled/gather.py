@@ -1,0 +1,254 @@
+"""The grid gather: the spring forces of a grid body by offset, with no list of springs.
+
+Each particle computes its springs to the neighbours ahead of it (half the
+stencil, so each spring once, with the same `equations.spring_force`), adds
+their forces to itself and, in a second loop, their opposites to the
+neighbours. The positions are copied by coordinate so that the inner loops
+walk contiguous memory on vector registers, over whole grid rows (those whose
+neighbour would leave its row masked out), three offsets at a time (a
+particle's position is read and its force written once for three springs).
+The threads take grid planes, every third one at once in three rounds, so
+that no two write the same particle; one thread takes them in the same order,
+with the same sums. The layout these loops read is made in `stencil`.
+"""
+
+import math
+
+import numba
+import numpy as np
+
+from .equations import dashpot_power, spring_force
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _pull(y0, y1, y2, x0, x1, x2, q, there, k, rest):
+    """The spring from a particle at y to particle ``q``, times ``there`` (1, or 0 when
+    that neighbour does not exist): f/|d| of eq. (1.2) (N/m), d = y - x_q (3 components)
+    and |d|² (m²). The force on the particle is (f/|d|)·d, on ``q`` its opposite.
+    """
+    d0, d1, d2 = y0 - x0[q], y1 - x1[q], y2 - x2[q]
+    length_squared = d0 * d0 + d1 * d1 + d2 * d2
+    length = math.sqrt(length_squared)
+    safe = length if length > 0.0 else 1.0  # coincident ends: no direction, no force
+    scale = there * spring_force(k, rest, safe, 0.0, 0.0) / safe
+    scale = scale if length > 0.0 else 0.0
+    return scale, d0, d1, d2, there * length_squared
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _pull_damped(y0, y1, y2, u0, u1, u2, xs, vs, q, there, k, rest, c):
+    """`_pull` with the dashpot c (N·s/m) on velocities u and vs; also returns its power (W)."""
+    x0, x1, x2 = xs
+    v0, v1, v2 = vs
+    d0, d1, d2 = y0 - x0[q], y1 - x1[q], y2 - x2[q]
+    length_squared = d0 * d0 + d1 * d1 + d2 * d2
+    length = math.sqrt(length_squared)
+    safe = length if length > 0.0 else 1.0
+    rate = ((u0 - v0[q]) * d0 + (u1 - v1[q]) * d1 + (u2 - v2[q]) * d2) / safe
+    power = there * dashpot_power(c, rate)
+    scale = there * spring_force(k, rest, safe, c, rate) / safe
+    scale = scale if length > 0.0 else 0.0
+    return scale, d0, d1, d2, there * length_squared, power
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _push_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, values, scales, pad):
+    """Add to particles ``first`` to ``stop - 1`` the forces of their springs to three
+    neighbours, at p + ``shifts[j]``, the same grid row offset apart, and keep each
+    spring's f/|d| in ``scales[j, pad + p - first]`` for `_react`.
+
+    ``xs``, ``vs``, ``fs`` are positions, velocities and forces by coordinate,
+    contiguous, so the loop runs on vector registers; a particle's position
+    is read and its force written once for three springs. ``columns[masks[j], p - first]``
+    is 1 where p has neighbour j, 0 where it would leave p's grid row.
+    ``values[j]`` (3, 4) holds the spring's stiffness, rest length, dashpot and
+    1/rest²; ``squared[p]`` keeps the largest |d|²/l² seen (a running maximum
+    would keep the loop scalar). Returns the dashpot power (W) of these
+    springs; with dashpots the loop stays scalar. Indices are unsigned: numba
+    then needs no negative-index test, which would also keep the loop scalar.
+    """
+    x0, x1, x2 = xs
+    f0, f1, f2 = fs
+    ma, mb, mc = masks  # rows of `columns`
+    sa, sb, sc = shifts
+    ka, ra, ca, wa = values[0, 0], values[0, 1], values[0, 2], values[0, 3]
+    kb, rb, cb, wb = values[1, 0], values[1, 1], values[1, 2], values[1, 3]
+    kc, rc, cc, wc = values[2, 0], values[2, 1], values[2, 2], values[2, 3]
+    kept_a, kept_b, kept_c = scales[0], scales[1], scales[2]
+    power = 0.0
+    if ca == 0.0 and cb == 0.0 and cc == 0.0:  # no sum across springs: vector registers
+        for i in range(first, stop):
+            p, r = numba.uint64(i), numba.uint64(i - first)
+            y0, y1, y2 = x0[p], x1[p], x2[p]
+            qa, qb, qc = numba.uint64(i + sa), numba.uint64(i + sb), numba.uint64(i + sc)
+            a, a0, a1, a2, la = _pull(y0, y1, y2, x0, x1, x2, qa, columns[ma, r], ka, ra)
+            b, b0, b1, b2, lb = _pull(y0, y1, y2, x0, x1, x2, qb, columns[mb, r], kb, rb)
+            c, c0, c1, c2, lc = _pull(y0, y1, y2, x0, x1, x2, qc, columns[mc, r], kc, rc)
+            f0[p] += a * a0 + b * b0 + c * c0
+            f1[p] += a * a1 + b * b1 + c * c1
+            f2[p] += a * a2 + b * b2 + c * c2
+            kept = numba.uint64(i - first + pad)
+            kept_a[kept], kept_b[kept], kept_c[kept] = a, b, c
+            squared[p] = max(squared[p], la * wa, lb * wb, lc * wc)
+        return power
+    v0, v1, v2 = vs
+    for i in range(first, stop):
+        p, r = numba.uint64(i), numba.uint64(i - first)
+        y0, y1, y2, u0, u1, u2 = x0[p], x1[p], x2[p], v0[p], v1[p], v2[p]
+        y, u = (y0, y1, y2), (u0, u1, u2)
+        qa, qb, qc = numba.uint64(i + sa), numba.uint64(i + sb), numba.uint64(i + sc)
+        a, a0, a1, a2, la, pa = _pull_damped(*y, *u, xs, vs, qa, columns[ma, r], ka, ra, ca)
+        b, b0, b1, b2, lb, pb = _pull_damped(*y, *u, xs, vs, qb, columns[mb, r], kb, rb, cb)
+        c, c0, c1, c2, lc, pc = _pull_damped(*y, *u, xs, vs, qc, columns[mc, r], kc, rc, cc)
+        f0[p] += a * a0 + b * b0 + c * c0
+        f1[p] += a * a1 + b * b1 + c * c1
+        f2[p] += a * a2 + b * b2 + c * c2
+        kept = numba.uint64(i - first + pad)
+        kept_a[kept], kept_b[kept], kept_c[kept] = a, b, c
+        squared[p] = max(squared[p], la * wa, lb * wb, lc * wc)
+        power += pa + pb + pc
+    return power
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _react(xs, fs, scales, first, stop, shifts, pad):
+    """Add to each neighbour q = p + ``shifts[j]`` of particles p = ``first`` to ``stop - 1``
+    the opposite of the force its spring exerts on p (eq. 1.1), -(f/|d|)·(x_p - x_q),
+    with f/|d| from ``scales[j, pad + p - first]`` (see `_push_three`).
+
+    One loop over the neighbours q takes the three springs, so q's position is
+    read and its force written once. ``scales`` is 0 in its first and last
+    ``pad`` columns (pad ≥ the spread of the shifts), where q has no spring j;
+    the scratch padding is as wide, so p stays in memory there.
+    """
+    x0, x1, x2 = xs
+    f0, f1, f2 = fs
+    kept_a, kept_b, kept_c = scales[0], scales[1], scales[2]
+    sa, sb, sc = shifts
+    low, high = min(sa, sb, sc), max(sa, sb, sc)
+    scales[:, pad + stop - first :] = 0.0
+    for i in range(first + low, stop + high):
+        q = numba.uint64(i)
+        pa, pb, pc = numba.uint64(i - sa), numba.uint64(i - sb), numba.uint64(i - sc)
+        a = kept_a[numba.uint64(i - sa - first + pad)]
+        b = kept_b[numba.uint64(i - sb - first + pad)]
+        c = kept_c[numba.uint64(i - sc - first + pad)]
+        y0, y1, y2 = x0[q], x1[q], x2[q]
+        f0[q] -= a * (x0[pa] - y0) + b * (x0[pb] - y0) + c * (x0[pc] - y0)
+        f1[q] -= a * (x1[pa] - y1) + b * (x1[pb] - y1) + c * (x1[pc] - y1)
+        f2[q] -= a * (x2[pa] - y2) + b * (x2[pb] - y2) + c * (x2[pc] - y2)
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _push_rows(scratch, pad, columns, shape, triples, rows_of, o2s, values, plane, rows, scales):
+    """Add the forces of the springs from the particles of grid rows ``rows`` (first, stop)
+    of ``plane`` to their neighbours ahead to both ends; return their dashpot power (W).
+
+    ``scratch`` (10, N + 2·pad) holds the positions, velocities and forces by
+    coordinate and the squared stretches, particle p at p + pad (the padding
+    stays zero, so a masked neighbour past either end is still in memory);
+    ``scales`` (3, rows·n_2 + 2·pad) is the room `_push_three` and `_react` share.
+    Triple t joins each particle to its neighbours at the offsets
+    (``triples[t]``, ``o2s[t, j]``), j = 0, 1, 2, with the spring values
+    ``values[t, j]`` (see `stencil.stencil_triples`); for each, the rows whose
+    neighbours exist are consecutive, so the inner loops run over all of them
+    at once, and ``columns[rows_of[t, j]]`` masks the particles whose
+    neighbour would be past the end of their row (see `stencil.column_masks`).
+    """
+    xs = (scratch[0], scratch[1], scratch[2])
+    vs = (scratch[3], scratch[4], scratch[5])
+    fs = (scratch[6], scratch[7], scratch[8])
+    n0, n1, n2 = shape[0], shape[1], shape[2]
+    power = 0.0
+    for t in range(len(triples)):
+        o0, o1 = triples[t, 0], triples[t, 1]
+        lo, hi = max(rows[0], -o1), min(rows[1], n1 - o1)  # rows whose neighbours exist
+        if not (0 <= plane + o0 < n0 and lo < hi):
+            continue
+        shift = (o0 * n1 + o1) * n2
+        first, stop = (plane * n1 + lo) * n2 + pad, (plane * n1 + hi) * n2 + pad
+        masks = (rows_of[t, 0], rows_of[t, 1], rows_of[t, 2])
+        shifts = (shift + o2s[t, 0], shift + o2s[t, 1], shift + o2s[t, 2])
+        power += _push_three(
+            xs, vs, fs, scratch[9], columns, masks, first, stop, shifts, values[t], scales, pad
+        )
+        _react(xs, fs, scales, first, stop, shifts, pad)
+    return power
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _push_unit(scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, unit):
+    """`_push_rows` for a unit of work: grid plane ``unit`` (3-D), or rows ``unit``·rows
+    to (``unit`` + 1)·rows - 1 (2-D), ``rows`` at a time. Returns the largest squared
+    stretch |d|²/l² of the springs from its particles and their dashpot power (W).
+
+    A unit's springs reach the next unit only, and its masked neighbours (whose
+    force is 0) the one after; so units three apart can be pushed at once.
+    """
+    n0, n1, n2 = shape[0], shape[1], shape[2]
+    plane, lo, hi = (unit, 0, n1) if n0 > 1 else (0, unit * rows, min(unit * rows + rows, n1))
+    scales = np.zeros((3, rows * n2 + 2 * pad))
+    power = 0.0
+    for first in range(lo, hi, rows):
+        block = (first, min(first + rows, hi))
+        power += _push_rows(
+            scratch, pad, columns, shape, triples, rows_of, o2s, values, plane, block, scales
+        )
+    start, end = (plane * n1 + lo) * n2 + pad, (plane * n1 + hi) * n2 + pad
+    return scratch[9, start:end].max(), power
+
+
+@numba.njit(cache=True, error_model="numpy")
+def gather_serial(x, v, shape, triples, rows_of, o2s, values, columns, rows, scratch, out, add):
+    """One thread: `gather_parallel`'s work in the same order, so the same sums."""
+    pad = (scratch.shape[1] - len(x)) // 2
+    damped = np.any(values[:, :, 2] != 0.0)
+    scratch[6:, :] = 0.0
+    for q in range(x.shape[1]):
+        scratch[q, pad : pad + len(x)] = x[:, q]
+        if damped:
+            scratch[3 + q, pad : pad + len(x)] = v[:, q]
+    units = shape[0] if shape[0] > 1 else (shape[1] + rows - 1) // rows
+    squares = np.zeros(units)
+    powers = np.zeros(units)
+    for phase in range(3):
+        for unit in range(phase, units, 3):
+            squares[unit], powers[unit] = _push_unit(
+                scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, unit
+            )
+    for q in range(x.shape[1] if add else 0):
+        out[:, q] += scratch[6 + q, pad : pad + len(x)]
+    return squares, powers
+
+
+@numba.njit(cache=True, parallel=True, error_model="numpy")
+def gather_parallel(x, v, shape, triples, rows_of, o2s, values, columns, rows, scratch, out, add):
+    """Add to ``out`` (N, d) the forces of a grid body's springs, each computed once, from
+    the particle behind (`_push_unit`); return each unit's largest squared stretch
+    |d|²/l² and dashpot power (W). Without ``add`` the forces stay in ``scratch``
+    (rows 6 to 8) for the caller to add in a loop of its own (see `advance.compile_advance`).
+
+    The threads push every third unit at once, in three rounds, so no two
+    write the same particle.
+    """
+    pad = (scratch.shape[1] - len(x)) // 2
+    damped = np.any(values[:, :, 2] != 0.0)
+    for p in numba.prange(len(x)):
+        for q in range(x.shape[1]):
+            scratch[q, p + pad] = x[p, q]
+            if damped:
+                scratch[3 + q, p + pad] = v[p, q]
+        scratch[6, p + pad] = scratch[7, p + pad] = scratch[8, p + pad] = scratch[9, p + pad] = 0.0
+    units = shape[0] if shape[0] > 1 else (shape[1] + rows - 1) // rows
+    squares = np.zeros(units)
+    powers = np.zeros(units)
+    for phase in range(3):
+        for u in numba.prange((units - phase + 2) // 3):
+            unit = phase + 3 * u
+            squares[unit], powers[unit] = _push_unit(
+                scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, unit
+            )
+    for p in numba.prange(len(x) if add else 0):
+        for q in range(x.shape[1]):
+            out[p, q] += scratch[6 + q, p + pad]
+    return squares, powers

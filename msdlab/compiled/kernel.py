@@ -1,0 +1,417 @@
+"""`NumbaKernel`: the compiled spring kernel for one body, choosing the gather or the edge loop."""
+
+from __future__ import annotations
+
+import math
+import sys
+import warnings
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+import numba
+import numpy as np
+import scipy.sparse as sp
+
+from .. import equations
+from ..body import Body
+from .advance import compile_advance, divide_by_masses
+from .edges import (
+    dashpot_power_parallel,
+    dashpot_power_serial,
+    elastic_energy_parallel,
+    elastic_energy_serial,
+    jacobian_blocks,
+    spring_classes,
+    spring_forces_parallel,
+    spring_forces_serial,
+)
+from .gather import gather_parallel, gather_serial
+from .stencil import (
+    GridStencil,
+    column_masks,
+    grid_stencil,
+    stencil_triples,
+    triple_values,
+    uniform_blocks,
+)
+
+if TYPE_CHECKING:
+    from ..kernels import JacobianPattern, StepEnd
+
+# Below this many springs (particles for the update) one thread is faster than waking the others.
+PARALLEL_MIN_SPRINGS = 50_000
+PARALLEL_MIN_PARTICLES = 20_000
+
+# The gather wakes the threads four times a step: it waits for more springs (about 28³ grid).
+PARALLEL_MIN_GATHERED = 250_000
+
+# At most this many distinct (stiffness, rest length, dashpot) triples are kept as a table
+# with a class number per spring (uint8 up to 256, else uint16); past it, the values per spring.
+SPRING_CLASSES = 65_536
+
+
+def _references_of_a_private_array() -> int:
+    """How many references the memory of a body's spring array has when only the body
+    and one view of it refer to it (as in `_shared`)."""
+    owner = type("Owner", (), {})()
+    owner.array = np.zeros(2)
+    view = owner.array[:1]
+    return sys.getrefcount(view.base)
+
+
+_PRIVATE = _references_of_a_private_array()
+
+
+def _shared(views: tuple[np.ndarray, ...]) -> bool:
+    """True if anything besides the body and ``views`` refers to the memory of ``views``.
+
+    A view of ``body.stiffness`` kept by the user could be written at any time
+    without touching ``body.parameters_version``; while one exists, the spring
+    values are checked at every step.
+    """
+    return any(sys.getrefcount(view.base) > _PRIVATE for view in views)
+
+
+# Spring forces not yet added to the force buffer: the threads' buffers (T, N, d), the
+# gather's forces by coordinate (d, N + 2·pad) and that pad (see `advance.compile_advance`).
+Pending = tuple[np.ndarray, np.ndarray, int]
+
+# One compiled loop per update function (threaded or not), for the whole process.
+_ADVANCES: dict[tuple[Callable, bool], Callable] = {}
+
+_FAILED: set[Callable] = set()  # updates numba cannot compile: they run on arrays
+
+
+class NumbaKernel:
+    """The compiled spring kernel for one body, with what it needs kept between calls.
+
+    Grid bodies whose springs share their values per offset are gathered by
+    offset (`grid_stencil`); other bodies go through the edge loop, over the
+    springs sorted by their ends (`_edge_list`), with one force buffer per
+    extra thread. What is kept is rebuilt when the springs change
+    (``body.topology_version``) and re-checked when their values may have
+    (``body.parameters_version``, or a view of them kept elsewhere), so edits
+    count at once. ``springs`` (indices) restricts a computation to some
+    springs, on one thread, in the body's order.
+    """
+
+    def __init__(self) -> None:
+        self._version = -1
+        self._a = self._b = np.zeros(0, dtype=np.int32)
+        self._partial: np.ndarray | None = None
+        self._none: Pending = (np.zeros((0, 0, 0)), np.zeros((0, 0)), 0)  # see `_no_partial`
+        self._threads = 1
+        self._stencil_version = -1
+        self._stencil: GridStencil | None = None
+        self._stencil_values = np.zeros((3, 0))
+        self._columns = (np.ones((1, 0)), 1)  # see `stencil.column_masks`
+        self._triples: tuple[np.ndarray, ...] = ()  # see `stencil.stencil_triples`, and mask rows
+        self._triple_values = np.zeros((0, 3, 4))
+        self._scratch = np.zeros((10, 0))  # see `gather.gather_parallel`
+        self._pad = 0
+        self._values_version = -1
+        self._uniform = False
+        self._order: np.ndarray | None = None
+        self._classes_version = -1
+        self._classes: tuple[np.ndarray | None, ...] = (None,)  # see `_edge_list`
+        self._no_floor = np.zeros(0)
+        self._under = np.zeros(0, dtype=bool)  # see `advance.compile_advance`
+
+    name = "numba"
+
+    def add_spring_forces(
+        self,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        out: np.ndarray,
+        springs: np.ndarray | None = None,
+    ) -> tuple[float, float]:
+        """Add the spring and dashpot forces (N) to ``out`` (N, d).
+
+        Returns the largest stretch |d|/l and the power (W) the dashpots take.
+        """
+        return self._spring_forces(body, x, v, out, springs, reduce=True)[:2]
+
+    def _spring_forces(
+        self,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        out: np.ndarray,
+        springs: np.ndarray | None,
+        reduce: bool,
+    ) -> tuple[float, float, Pending]:
+        """`add_spring_forces`, and the spring forces still to add to ``out`` (see
+        `advance.compile_advance`): none with ``reduce``, else the threads' buffers of
+        `edges.spring_forces_parallel` or the gather's forces by coordinate; without
+        ``reduce`` ``out`` is scratch: the edge loops clear it, the gather leaves it."""
+        none = self._no_partial(x)
+        if springs is None:
+            stencil = self.grid_stencil(body)
+            if stencil is not None:
+                threads = self._parallel(body, PARALLEL_MIN_GATHERED)
+                gather = gather_parallel if threads else gather_serial
+                if self._scratch.shape != (10, len(x) + 2 * self._pad):
+                    self._scratch = np.zeros((10, len(x) + 2 * self._pad))  # 2-D: x2 = v2 = 0
+                triples, _, o2s, rows_of = self._triples
+                columns, rows = self._columns
+                layout = (stencil.shape, triples, rows_of, o2s, self._triple_values, columns, rows)
+                squares, powers = gather(x, v, *layout, self._scratch, out, reduce)
+                stretch, power = math.sqrt(squares.max()), float(powers.sum())  # any threads
+                if reduce:
+                    return stretch, power, none
+                return stretch, power, (none[0], self._scratch[6 : 6 + x.shape[1]], self._pad)
+        if springs is not None:
+            a, b, k, rest, c = (body.spring_a, body.spring_b, *body.spring_values())
+            a, b, k, rest, c = (array[springs] for array in (a, b, k, rest, c))
+            return *spring_forces_serial(x, v, a, b, None, k, rest, c, out), none
+        arrays = self._edge_list(body)
+        if not self._parallel(body):
+            if not reduce:
+                out.fill(0.0)
+            return *spring_forces_serial(x, v, *arrays, out), none
+        if self._partial is None or self._partial.shape[1:] != x.shape:
+            self._partial = np.empty((self._threads - 1, *x.shape))
+        sums = spring_forces_parallel(x, v, *arrays, self._partial, out, reduce)
+        return *sums, none if reduce else (self._partial, none[1], 0)
+
+    def _no_partial(self, x: np.ndarray) -> Pending:
+        """No spring forces pending (see `advance.compile_advance`)."""
+        if self._none[0].shape[1:] != x.shape:
+            self._none = (np.zeros((0, *x.shape)), np.zeros((0, 0)), 0)
+        return self._none
+
+    def grid_stencil(self, body: Body) -> GridStencil | None:
+        """The body's grid stencil if its forces can be gathered by offset now, else None.
+
+        The stencil is found once per topology (``body.topology_version``); that
+        each of its blocks has one stiffness, rest length and dashpot is checked
+        at every call (one read of the spring values, stopping at the first
+        difference), so edits of single springs switch to the edge loop at once.
+        """
+        if self._stencil_version != body.topology_version:
+            self._stencil = grid_stencil(body)
+            blocks = 0 if self._stencil is None else len(self._stencil.offsets)
+            if self._stencil is not None:
+                self._columns = column_masks(self._stencil.shape, self._stencil.offsets)
+                triples, members, o2s = stencil_triples(self._stencil.offsets)
+                reach = int(np.abs(o2s).max(initial=0))
+                self._pad = 2 * reach  # the padding of the scratch (see `gather`)
+                no_spring = len(self._columns[0]) - 1  # the all-zero mask
+                rows_of = np.where(members >= 0, o2s + reach, no_spring)
+                self._triples = (triples, members, o2s, rows_of)
+            self._stencil_values = np.zeros((3, blocks))
+            self._stencil_version = body.topology_version
+            self._values_version = -1
+        if self._stencil is None:
+            return None
+        values = body.spring_values()
+        if body.parameters_version != self._values_version or _shared(values):
+            self._uniform = uniform_blocks(*values, self._stencil.starts, self._stencil_values)
+            self._values_version = body.parameters_version
+            if self._uniform:
+                self._triple_values = triple_values(self._stencil_values, self._triples[1])
+        return self._stencil if self._uniform else None
+
+    def _parallel(self, body: Body, least: int | None = None) -> bool:
+        """Whether the springs of ``body`` are worth splitting between threads: at least
+        ``least`` of them (default `PARALLEL_MIN_SPRINGS`)."""
+        self._threads = numba.get_num_threads()
+        least = PARALLEL_MIN_SPRINGS if least is None else least
+        return body.n_springs >= least and self._threads > 1
+
+    def dashpot_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
+        """Power (W) the dashpots take out of the body at (x, v), always >= 0."""
+        a, b, damping = body.spring_a, body.spring_b, body.spring_values()[2]
+        if not self._parallel(body):
+            return dashpot_power_serial(x, v, a, b, damping)
+        return dashpot_power_parallel(x, v, a, b, damping, self._threads)
+
+    def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
+        """Energy (J) stored in the springs (or in the given ones) at positions x."""
+        arrays = (body.spring_a, body.spring_b, *body.spring_values()[:2])
+        if springs is not None:
+            return elastic_energy_serial(x, *(array[springs] for array in arrays))
+        if not self._parallel(body):
+            return elastic_energy_serial(x, *arrays)
+        return elastic_energy_parallel(x, *arrays, self._threads)
+
+    @staticmethod
+    def jacobians(
+        body: Body, x: np.ndarray, pattern: JacobianPattern
+    ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """∂F/∂x and ∂F/∂v of the springs on ``pattern``, as `kernels.spring_jacobians`,
+        with the blocks computed spring by spring."""
+        values = body.spring_values()
+        dim = x.shape[1]
+        stiff = np.empty((body.n_springs, dim, dim))
+        damp = np.empty((body.n_springs if values[2].any() else 0, dim, dim))
+        jacobian_blocks(x, body.spring_a, body.spring_b, *values, stiff, damp)
+        return pattern.jacobians(stiff, damp if len(damp) else None)
+
+    @staticmethod
+    def to_acceleration(body: Body, forces: np.ndarray) -> np.ndarray:
+        """Turn forces (N, d) into accelerations a = F/m in place (0 for fixed); return them."""
+        divide_by_masses(forces, body.masses, body.fixed)
+        return forces
+
+    def advance(
+        self,
+        update: Callable,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        forces: np.ndarray,
+        field: np.ndarray,
+        dt: float,
+        coefficients: tuple[float, ...],
+        end: StepEnd | None = None,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """``update(x, v, a, dt, *coefficients)`` with a = (F + m·g)/m (0 if fixed),
+        g = ``field`` (d,) in m/s², in one loop, which also does ``end`` if given.
+
+        An update numba cannot compile warns once and runs on whole arrays.
+        """
+        pending = self._no_partial(x)
+        return self._advance(update, body, x, v, forces, pending, field, dt, coefficients, end)
+
+    def advance_with_springs(
+        self,
+        update: Callable,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        forces: np.ndarray,
+        field: np.ndarray,
+        dt: float,
+        coefficients: tuple[float, ...],
+        end: StepEnd | None = None,
+    ) -> tuple[np.ndarray, np.ndarray, float, float]:
+        """The spring forces, then `advance`: (x_new, v_new, largest stretch, dashpot power W).
+        The threads' partial spring forces, or the gather's, are added to F in the
+        update's loop, not in a pass of their own; ``forces`` is scratch, its content
+        not read (the gather does not touch it, so the loop does not read it)."""
+        stretch, power, pending = self._spring_forces(body, x, v, forces, None, reduce=False)
+        if len(pending[1]):  # the gather's forces by coordinate are all of F
+            forces = forces[:0]
+        x_new, v_new = self._advance(
+            update, body, x, v, forces, pending, field, dt, coefficients, end
+        )
+        return x_new, v_new, stretch, power
+
+    def _advance(
+        self,
+        update: Callable,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        forces: np.ndarray,
+        pending: Pending,
+        field: np.ndarray,
+        dt: float,
+        coefficients: tuple[float, ...],
+        end: StepEnd | None,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """`advance` with F = ``forces`` plus the spring forces ``pending`` (see
+        `advance.compile_advance`)."""
+        threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
+        if update in _FAILED:
+            compiled = None
+        elif (update, threads) not in _ADVANCES:
+            compiled = _ADVANCES[update, threads] = compile_advance(update, threads)
+        else:
+            compiled = _ADVANCES[update, threads]
+        if compiled is not None:
+            x_new, v_new = np.empty_like(x), np.empty_like(v)
+            if end is None:
+                floor = (self._no_floor, 0.0, False, False)
+            else:
+                floor = (end.normal, end.height, True, end.damping)
+                if len(self._under) != len(x):
+                    self._under = np.zeros(len(x), dtype=bool)
+                self._under[:] = False
+            try:
+                masses, fixed = body.masses, body.fixed
+                bad, work = compiled(
+                    x, v, forces, pending, field, masses, fixed, dt, coefficients, floor,
+                    x_new, v_new, self._under,
+                )  # fmt: skip
+            except numba.core.errors.NumbaError as error:
+                _FAILED.add(update)
+                warnings.warn(
+                    f"numba cannot compile {update.__qualname__} ({type(error).__name__}); "
+                    "it runs on whole numpy arrays instead, with the same result, more slowly",
+                    RuntimeWarning,
+                    stacklevel=5,
+                )
+            else:
+                if end is not None:
+                    end.arrays, end.finite, end.damping_work = (x_new, v_new), bad == 0, work / 2
+                    end.under = np.flatnonzero(self._under) if len(end.normal) else None
+                return x_new, v_new
+        partial, by_coordinate, pad = pending
+        forces = forces if len(forces) else np.zeros_like(x)
+        for part in partial:
+            forces = forces + part  # in the order of `edges.spring_forces_parallel`
+        if len(by_coordinate):
+            forces = forces + by_coordinate[:, pad : pad + len(x)].T
+        inverse = equations.inverse_mass(body.masses, ~body.fixed)
+        a = equations.acceleration(forces + body.masses[:, None] * field, inverse[:, None])
+        return update(x, v, a, dt, *coefficients)
+
+    def _edge_list(self, body: Body) -> tuple[np.ndarray | None, ...]:
+        """Ends a, b of all springs sorted by (a, b), each one's class (or None) and the
+        stiffness, rest length and dashpot of each class (or of each spring).
+
+        In that order consecutive springs share or neighbour their particles,
+        so the edge loop reads and writes memory it has just used, whatever
+        order the springs were added in (a shuffled 60³ grid: several times
+        faster). The ends (uint32: half the memory traffic of int64) and the
+        order are kept per topology; the classes (`edges.spring_classes`) are found
+        again when the values may have changed (see `grid_stencil`). Past
+        `SPRING_CLASSES` distinct values the loop reads them per spring: the
+        body's arrays, or copies in the sorted order.
+        """
+        if self._version != body.topology_version:
+            index = np.uint32 if body.n_particles < 2**32 else np.uint64
+            order = np.lexsort((body.spring_b, body.spring_a))
+            self._order = None if np.array_equal(order, np.arange(len(order))) else order
+            ends = (body.spring_a, body.spring_b)
+            if self._order is not None:
+                ends = tuple(end[order] for end in ends)
+            self._a, self._b = (end.astype(index) for end in ends)
+            self._version = body.topology_version
+            self._classes_version = -1
+        values = body.spring_values()
+        shared = _shared(values)
+        if body.parameters_version != self._classes_version or shared:
+            # sorted springs and a view held: the body's arrays, not classes to find every step
+            self._classes = (None,) if shared and self._order is None else self._classify(values)
+            self._classes_version = body.parameters_version
+        if self._classes[0] is None and self._order is None:
+            return self._a, self._b, None, *values  # not kept: a reference would look shared
+        return self._a, self._b, *self._classes
+
+    def _classify(self, values: tuple[np.ndarray, ...]) -> tuple[np.ndarray | None, ...]:
+        """Each sorted spring's class (uint8 or uint16) and the stiffness (N/m), rest length
+        (m) and dashpot (N·s/m) of each class; (None,) past `SPRING_CLASSES` classes,
+        with the values in the sorted order if they are not in the body's.
+
+        The classes are found in the body's order (`edges.spring_classes`, reading memory
+        in order), then put in the sorted order: one small array to permute, not three.
+        """
+        most = min(len(values[0]), SPRING_CLASSES)
+        slots = np.zeros(1 << max(4, (2 * most).bit_length()), np.int32)
+        kinds = np.empty(len(values[0]), np.uint16)
+        table = np.empty((most, 3), np.int64)
+        classes = spring_classes(*(array.view(np.int64) for array in values), slots, kinds, table)
+        if classes < 0:
+            if self._order is None:
+                return (None,)
+            return None, *(array[self._order] for array in values)
+        table = table[:classes].view(np.float64)
+        kinds = kinds.astype(np.uint8) if classes <= 256 else kinds
+        if self._order is not None:
+            kinds = kinds[self._order]
+        return kinds, *(np.ascontiguousarray(column) for column in table.T)
