@@ -16,6 +16,9 @@ import numpy as np
 
 from ..body import Body
 
+# Particles a gather block holds (whole grid rows): long inner loops, enough blocks for threads.
+GATHER_BLOCK = 4096
+
 
 @dataclass(frozen=True)
 class GridStencil:
@@ -65,10 +68,6 @@ def grid_stencil(body: Body) -> GridStencil | None:
         offsets.append(offset)
         starts.append(stop)
     return GridStencil(np.array(padded), np.array(offsets, dtype=np.int64), np.array(starts))
-
-
-# Particles a gather block holds (whole grid rows): long inner loops, enough blocks for threads.
-GATHER_BLOCK = 4096
 
 
 def stencil_triples(offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
