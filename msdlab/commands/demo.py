@@ -39,13 +39,12 @@ def run(args: argparse.Namespace) -> int:
     sim = scene.build(size=args.size)
     limit = max_stable_dt(sim.body, sim.integrator)
     print(f"jelly cube: {sim.body}, {sim.integrator!r}, dt = {sim.dt:g} (stable below {limit:.3g})")
-    bar = ProgressBar(args.steps, "jelly cube")
-    trajectory = sim.run(
-        steps=args.steps,
-        record_every=max(1, args.steps // 120),
-        callback=lambda s: bar(s.step_count),
-    )
-    bar.close()
+    with ProgressBar(args.steps, "jelly cube") as bar:
+        trajectory = sim.run(
+            steps=args.steps,
+            record_every=max(1, args.steps // 120),
+            callback=lambda s: bar(s.step_count),
+        )
     print(trajectory.energies.table(rows=8))
     args.out.mkdir(parents=True, exist_ok=True)
     animation = save_animation(

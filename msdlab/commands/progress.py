@@ -3,21 +3,34 @@
 from __future__ import annotations
 
 import sys
+import threading
 import time
+from types import TracebackType
 from typing import TextIO
+
+# What a wait for the first step usually is (the loops are cached on disk after that).
+STARTING = "starting: a first run on a machine also compiles msdlab's loops (about 10 s)"
 
 
 class ProgressBar:
     """Call with the number of steps done; draws ``[#####.....] 50%`` once ``delay`` s have passed.
 
-    Quick runs print nothing. `close` ends the line if a bar was drawn. The time
-    left is estimated from the pace since the first call, so a slow first step
-    (loading or compiling kernels) does not inflate it; until the steps have
-    moved on from there, no estimate is shown.
+    Quick runs print nothing. `close` (or leaving a ``with`` block) ends the line
+    if a bar was drawn. The time left is estimated from the pace since the first
+    call, so a slow first step (loading or compiling kernels) does not inflate
+    it; until the steps have moved on from there, no estimate is shown. If no
+    call has come after ``starting_after`` s (a first step that compiles: 5-20 s;
+    loading the compiled loops takes up to 1.5 s), the bar says it is starting
+    and why that may take a while.
     """
 
     def __init__(
-        self, total: int, label: str = "", stream: TextIO | None = None, delay: float = 0.5
+        self,
+        total: int,
+        label: str = "",
+        stream: TextIO | None = None,
+        delay: float = 0.5,
+        starting_after: float | None = 2.0,
     ) -> None:
         self.total = max(int(total), 1)
         self.label = label
@@ -28,8 +41,36 @@ class ProgressBar:
         self.shown = False
         self.first: tuple[float, int] | None = None  # (time, steps done) at the first call
         self.width = 0  # of the longest line drawn
+        self._lock = threading.Lock()  # the timer's thread and the caller's draw in turn
+        self._starting = None
+        if starting_after is not None:
+            self._starting = threading.Timer(starting_after, self._no_step_yet)
+            self._starting.daemon = True
+            self._starting.start()
+
+    def __enter__(self) -> ProgressBar:
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        error: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> None:
+        self.close()
+
+    def _no_step_yet(self) -> None:
+        """Called ``starting_after`` s after the start: if no step has been done, say so."""
+        with self._lock:
+            if self.first is None:
+                self.shown = True
+                self._draw(f"{self.label} [{'.' * 30}]   0%  {STARTING}")
 
     def __call__(self, done: int) -> None:
+        with self._lock:
+            self._update(done)
+
+    def _update(self, done: int) -> None:
         now = time.perf_counter()
         if self.first is None:
             self.first = (now, done)
@@ -46,13 +87,18 @@ class ProgressBar:
         else:
             left = "time left unknown yet"
         bar = "#" * filled + "." * (30 - filled)
-        line = f"{self.label} [{bar}] {100 * fraction:3.0f}%  {elapsed:5.1f} s, {left}"
+        self._draw(f"{self.label} [{bar}] {100 * fraction:3.0f}%  {elapsed:5.1f} s, {left}")
+
+    def _draw(self, line: str) -> None:
         self.stream.write(f"\r{line:<{self.width}}")  # blank out a longer line drawn before
         self.width = max(self.width, len(line))
         self.stream.flush()
 
     def close(self) -> None:
+        if self._starting is not None:
+            self._starting.cancel()
         if self.shown:
             self(self.total)
             self.stream.write("\n")
             self.stream.flush()
+            self.shown = False  # a second close writes nothing

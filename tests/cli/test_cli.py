@@ -4,13 +4,14 @@ import io
 import os
 import subprocess
 import sys
+import time
 
 import pytest
 from matplotlib.animation import FFMpegWriter
 from PIL import Image
 
 from msdlab.cli import main
-from msdlab.commands.progress import ProgressBar
+from msdlab.commands.progress import STARTING, ProgressBar
 from msdlab.scenes import SCENES
 
 
@@ -146,6 +147,25 @@ def test_progress_bar_estimates_the_time_left_from_the_pace_after_the_first_step
     assert stream.getvalue().endswith("time left unknown yet")
     bar(101)  # at 3 s: 100 steps in 1 s since then, 899 to go
     assert stream.getvalue().rstrip().endswith("~ 9.0 s left")
+
+
+def test_progress_bar_says_why_the_first_step_takes_long():
+    """No step after ``starting_after`` s (compiling on a first run): the bar says so."""
+    stream = io.StringIO()
+    with ProgressBar(100, "run", stream=stream, starting_after=0.05) as bar:
+        time.sleep(0.5)
+        assert stream.getvalue() == f"\rrun [{'.' * 30}]   0%  {STARTING}"
+        bar(1)
+    lines = stream.getvalue().split("\r")
+    assert lines[-1].startswith("run [##############################] 100%")
+    assert lines[-1].endswith("\n") and len(lines[-1]) > len(STARTING)  # the long line blanked
+    quick = ProgressBar(100, "quick", stream=stream, starting_after=0.2)
+    quick(100)
+    quick.close()
+    quick.close()
+    time.sleep(0.4)
+    assert "quick" not in stream.getvalue()  # done before the delay: nothing, not even later
+    assert stream.getvalue().count("\n") == 1
 
 
 def test_quick_start_demo_in_a_real_process(tmp_path):
