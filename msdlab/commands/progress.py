@@ -8,8 +8,10 @@ import time
 from types import TracebackType
 from typing import TextIO
 
-# What a wait for the first step usually is (the loops are cached on disk after that).
+# What a wait for the first step usually is (the loops are cached on disk after that), and
+# how long a first step may take without it (loading the cached loops takes up to 1.5 s).
 STARTING = "starting: a first run on a machine also compiles msdlab's loops (about 10 s)"
+FIRST_STEP_WAIT = 2.0
 
 
 class ProgressBar:
@@ -18,10 +20,10 @@ class ProgressBar:
     Quick runs print nothing. `close` (or leaving a ``with`` block) ends the line
     if a bar was drawn. The time left is estimated from the pace since the first
     call, so a slow first step (loading or compiling kernels) does not inflate
-    it; until the steps have moved on from there, no estimate is shown. If no
-    call has come after ``starting_after`` s (a first step that compiles: 5-20 s;
-    loading the compiled loops takes up to 1.5 s), the bar says it is starting
-    and why that may take a while.
+    it; until the steps have moved on from there, no estimate is shown. With
+    ``starting_after`` (for bars called after every step: `FIRST_STEP_WAIT`), if
+    no call has come by then, the bar says it is starting and why that may take
+    a while (a first step that compiles the loops: 5-20 s).
     """
 
     def __init__(
@@ -30,7 +32,7 @@ class ProgressBar:
         label: str = "",
         stream: TextIO | None = None,
         delay: float = 0.5,
-        starting_after: float | None = 2.0,
+        starting_after: float | None = None,
     ) -> None:
         self.total = max(int(total), 1)
         self.label = label
@@ -42,7 +44,7 @@ class ProgressBar:
         self.first: tuple[float, int] | None = None  # (time, steps done) at the first call
         self.width = 0  # of the longest line drawn
         self._lock = threading.Lock()  # the timer's thread and the caller's draw in turn
-        self._starting = None
+        self._starting: threading.Timer | None = None
         if starting_after is not None:
             self._starting = threading.Timer(starting_after, self._no_step_yet)
             self._starting.daemon = True

@@ -23,7 +23,7 @@ from ..integrators import (
 from ..scenes import SCENES, Scene, get_scene, sweep
 from ..scenes.trampoline import EXPERIMENTS, experiment_table, run_experiment
 from ..simulation import Simulation, Trajectory
-from .progress import ProgressBar
+from .progress import FIRST_STEP_WAIT, ProgressBar
 
 INTEGRATORS: dict[str, type[Integrator]] = {
     "explicit-euler": ExplicitEuler,
@@ -180,7 +180,7 @@ def _build(scene: Scene, settings: dict[str, object], args: argparse.Namespace) 
 
 def _run(sim: Simulation, steps: int, label: str) -> Trajectory | None:
     """Run with a progress bar; on a blow-up print the diagnosis and return None."""
-    bar = ProgressBar(steps, label)
+    bar = ProgressBar(steps, label, starting_after=FIRST_STEP_WAIT)
     try:
         return sim.run(
             steps=steps,
