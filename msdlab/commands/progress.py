@@ -43,6 +43,7 @@ class ProgressBar:
         self.shown = False
         self.first: tuple[float, int] | None = None  # (time, steps done) at the first call
         self.width = 0  # of the longest line drawn
+        self.closed = False
         self._lock = threading.Lock()  # the timer's thread and the caller's draw in turn
         self._starting: threading.Timer | None = None
         if starting_after is not None:
@@ -64,7 +65,7 @@ class ProgressBar:
     def _no_step_yet(self) -> None:
         """Called ``starting_after`` s after the start: if no step has been done, say so."""
         with self._lock:
-            if self.first is None:
+            if self.first is None and not self.closed:
                 self.shown = True
                 self._draw(f"{self.label} [{'.' * 30}]   0%  {STARTING}")
 
@@ -97,10 +98,13 @@ class ProgressBar:
         self.stream.flush()
 
     def close(self) -> None:
+        """End the bar's line at 100% if it was drawn; later calls of the timer or of
+        `close` write nothing."""
         if self._starting is not None:
-            self._starting.cancel()
-        if self.shown:
-            self(self.total)
-            self.stream.write("\n")
-            self.stream.flush()
-            self.shown = False  # a second close writes nothing
+            self._starting.cancel()  # if it is running already, the lock orders us
+        with self._lock:
+            if self.shown and not self.closed:
+                self._update(self.total)
+                self.stream.write("\n")
+                self.stream.flush()
+            self.closed = True

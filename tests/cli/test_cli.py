@@ -166,6 +166,10 @@ def test_progress_bar_says_why_the_first_step_takes_long():
     time.sleep(0.4)
     assert "quick" not in stream.getvalue()  # done before the delay: nothing, not even later
     assert stream.getvalue().count("\n") == 1
+    idle = ProgressBar(100, "idle", stream=stream, starting_after=60.0)
+    idle.close()  # no step at all, and the timer's call comes after the close
+    idle._no_step_yet()
+    assert "idle" not in stream.getvalue()
 
 
 def test_quick_start_demo_in_a_real_process(tmp_path):
