@@ -25,6 +25,7 @@ from matplotlib.figure import Figure
 from PIL import Image
 
 from ..simulation import Trajectory
+from .upright import resolve_up
 from .view import BodyView, check_colour, new_axes, rim_height, sags, strains
 
 FORMATS = (".gif", ".mp4", ".html")
@@ -116,7 +117,7 @@ def animate(
     max_frames: int = 60,
     fps: float = 15.0,
     view: Sequence[float] | None = None,
-    up: str = "z",
+    up: str | None = None,
     time_unit: str = "s",
     energy_unit: str = "J",
     title: str = "",
@@ -140,7 +141,7 @@ def to_html(
     max_frames: int = 60,
     fps: float = 15.0,
     view: Sequence[float] | None = None,
-    up: str = "z",
+    up: str | None = None,
     time_unit: str = "s",
     energy_unit: str = "J",
     title: str = "",
@@ -173,7 +174,7 @@ def save_animation(
     dpi: int = 80,
     max_frames: int = 60,
     view: Sequence[float] | None = None,
-    up: str = "z",
+    up: str | None = None,
     time_unit: str = "s",
     energy_unit: str = "J",
     title: str = "",
@@ -261,7 +262,7 @@ def _build(
     max_frames: int,
     fps: float,
     view: Sequence[float] | None,
-    up: str,
+    up: str | None,
     time_unit: str,
     energy_unit: str,
     title: str,
@@ -269,6 +270,7 @@ def _build(
     colour: str,
 ) -> _Movie:
     check_colour(colour, trajectory.body)
+    up = resolve_up(up, trajectory, trajectory.body.dim)
     picks = np.unique(np.linspace(0, len(trajectory) - 1, max(1, max_frames)).astype(int))
     frames = trajectory.positions[picks]
     body = trajectory.body

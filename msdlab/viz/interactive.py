@@ -21,6 +21,7 @@ from matplotlib.patches import Rectangle
 from ..errors import SimulationDiverged
 from ..interaction import Grab, Walls
 from ..simulation import Simulation
+from .upright import resolve_up
 from .view import BodyView, new_axes, spheres_of
 
 CATCH_UP = 0.25  # s of simulation a paced live view may step in one frame after a slow one
@@ -50,7 +51,7 @@ class Dragger:
         steps_per_second: float | None = None,
         interval: int = 30,
         view: Sequence[float] | None = None,
-        up: str = "z",
+        up: str | None = None,
     ) -> None:
         self.sim = sim
         self.steps_per_frame = int(steps_per_frame)
@@ -64,7 +65,7 @@ class Dragger:
             sim.body,
             strain_limit=LIVE_STRAIN_LIMIT,
             view=view,
-            up=up,
+            up=resolve_up(up, sim, sim.body.dim),
             spheres=spheres_of(sim),
         )
         self._show_box()

@@ -4,7 +4,7 @@
 plots, animations and the interactive window share one drawing. 3-D views take
 the report's (MATLAB) angles: azimuth in the xy-plane from the -y axis,
 elevation above the xy-plane; ``up`` names the vertical axis ("y" for the
-brief's cube, whose floor is y = 0).
+brief's cube, whose floor is y = 0), by default the one `upright` finds.
 """
 
 from __future__ import annotations
@@ -25,8 +25,7 @@ from ..body import Body
 from ..interaction import SphereContact
 from ..simulation import Simulation
 from .lines import SpringLines, SpringLines3D
-
-UPS = ("x", "y", "z")
+from .upright import UPS, resolve_up
 COLOURINGS = ("strain", "sag")  # what the springs' colour shows
 BALL_COLOUR = "tab:green"  # not on the coolwarm scale of the springs
 _U, _V = np.meshgrid(np.linspace(0, 2 * np.pi, 13), np.linspace(0, np.pi, 7))
@@ -95,11 +94,12 @@ class BodyView:
         *,
         strain_limit: float | None = None,
         view: Sequence[float] | None = None,
-        up: str = "z",
+        up: str | None = None,
         spheres: Sequence[tuple[int, float]] = (),
         colorbar: bool = True,
         colour: str = "strain",
     ) -> None:
+        up = resolve_up(up, None, body.dim)
         if up not in UPS:
             raise ValueError(f"unknown vertical axis {up!r}; choose one of {', '.join(UPS)}")
         check_colour(colour, body)
@@ -221,12 +221,12 @@ class BodyView:
 
 
 def plot_body(
-    body: Body,
+    body: Body | Simulation,
     positions: np.ndarray | None = None,
     ax: Axes | None = None,
     *,
     view: Sequence[float] | None = None,
-    up: str = "z",
+    up: str | None = None,
     spheres: Sequence[tuple[int, float]] = (),
     strain_limit: float | None = None,
     title: str | None = None,
@@ -235,7 +235,9 @@ def plot_body(
 ) -> Figure:
     """Plot ``body`` (at ``positions``, default its own) with springs coloured by strain
     (or ``colour="sag"``, see `BodyView`); return the figure, also written to ``save``
-    (.png, .pdf, .svg) if given."""
+    (.png, .pdf, .svg) if given. Given a simulation, "up" is against its gravity (`upright`)."""
+    if isinstance(body, Simulation):
+        up, body = resolve_up(up, body, body.body.dim), body.body
     ax = ax or new_axes(body)
     BodyView(
         ax,
