@@ -26,6 +26,7 @@ from ..interaction import SphereContact
 from ..simulation import Simulation
 from .lines import SpringLines, SpringLines3D
 from .upright import UPS, resolve_up
+
 COLOURINGS = ("strain", "sag")  # what the springs' colour shows
 BALL_COLOUR = "tab:green"  # not on the coolwarm scale of the springs
 _U, _V = np.meshgrid(np.linspace(0, 2 * np.pi, 13), np.linspace(0, np.pi, 7))
