@@ -3,20 +3,22 @@
 from msdlab import viz
 viz.plot_body(sim.body)                        # springs coloured by strain
 viz.plot_energy(trajectory.energies)
-viz.save_animation(trajectory, "run.gif")      # or .mp4 (needs ffmpeg), .html
+viz.save_animation(trajectory, "run.gif")      # or .mp4 (needs ffmpeg), .html (a replay page)
 HTML(viz.to_html(trajectory))                  # in Jupyter: inline, with play controls
-viz.show(sim)                                  # window: drag particles with the mouse
+viz.show(sim)                                  # live: drag particles (notebook or window)
 """
 
 from .animation import FORMATS, animate, save_animation, to_html
 from .energy import plot_energy
 from .interactive import Dragger, show
 from .view import BodyView, new_axes, plot_body, spheres_of, strains
+from .widget import LiveView
 
 __all__ = [
     "FORMATS",
     "BodyView",
     "Dragger",
+    "LiveView",
     "animate",
     "new_axes",
     "plot_body",

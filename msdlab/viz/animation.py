@@ -4,9 +4,10 @@ Frames are drawn once on a still background (blitting: only the body and the
 title are redrawn) and kept as palette images sharing one palette of 255
 colours, made from five frames spread over the animation, so a 100-frame
 animation saves in about two seconds and stays small. GIF needs pillow (a
-dependency), MP4 needs ffmpeg on the PATH, HTML is a self-contained page:
-frames embedded as PNG, a player with play, step and a slider, and no
-external address.
+dependency), MP4 needs ffmpeg on the PATH. An .html file is a replay page
+holding the positions, drawn by the live view's front end (`replay`); `to_html`
+(inline in Jupyter) is a player of PNG frames with play, step and a slider.
+Neither needs an external address.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from matplotlib.figure import Figure
 from PIL import Image
 
 from ..simulation import Trajectory
+from .replay import replay_page
 from .upright import resolve_up
 from .view import BodyView, check_colour, new_axes, rim_height, sags, strains
 
@@ -183,21 +185,35 @@ def save_animation(
 ) -> Path:
     """Write an animation of ``trajectory`` to ``path`` (.gif, .mp4 or .html); return the path.
 
-    At the default ``dpi`` = 80 a frame is 640 px wide.
+    At the default ``dpi`` = 80 a frame is 640 px wide. An .html file is a replay page
+    holding the positions, drawn in the browser by the live view's front end (`replay`):
+    it plays, pauses, scrubs and orbits offline (``dpi`` and ``colour`` do not apply).
     """
     path = Path(path)
     suffix = check_format(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if suffix == ".html":
+        picks = _picks(trajectory, max_frames)
+        page = replay_page(
+            trajectory,
+            picks,
+            fps=fps,
+            up=resolve_up(up, trajectory, trajectory.body.dim),
+            view=view,
+            strain_limit=strain_scale(trajectory.body, trajectory.positions[picks]),
+            spheres=spheres,
+            time_unit=time_unit,
+            title=title,
+        )
+        path.write_text(page, "utf-8")
+        return path
     import matplotlib.pyplot as plt
 
     movie = _build(
         trajectory, max_frames, fps, view, up, time_unit, energy_unit, title, spheres, colour
     )
-    path.parent.mkdir(parents=True, exist_ok=True)
     try:
-        if suffix == ".html":
-            page = html_player([_png(image) for image in movie.images(dpi)], fps)
-            path.write_text(f"<!DOCTYPE html>\n<html><body>\n{page}\n</body></html>\n", "utf-8")
-        elif suffix == ".gif":
+        if suffix == ".gif":
             first, *rest = movie.images(dpi)
             first.save(path, save_all=True, append_images=rest, duration=1000.0 / fps, loop=0)
         else:
@@ -257,6 +273,11 @@ def _png(image: Image.Image) -> bytes:
     return buffer.getvalue()
 
 
+def _picks(trajectory: Trajectory, max_frames: int) -> np.ndarray:
+    """At most ``max_frames`` evenly spaced frame numbers of ``trajectory``."""
+    return np.unique(np.linspace(0, len(trajectory) - 1, max(1, max_frames)).astype(int))
+
+
 def _build(
     trajectory: Trajectory,
     max_frames: int,
@@ -271,7 +292,7 @@ def _build(
 ) -> _Movie:
     check_colour(colour, trajectory.body)
     up = resolve_up(up, trajectory, trajectory.body.dim)
-    picks = np.unique(np.linspace(0, len(trajectory) - 1, max(1, max_frames)).astype(int))
+    picks = _picks(trajectory, max_frames)
     frames = trajectory.positions[picks]
     body = trajectory.body
     ax = new_axes(body)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import textwrap
 from collections.abc import Sequence
 from time import perf_counter
+from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -22,10 +23,12 @@ from ..errors import SimulationDiverged
 from ..interaction import Grab, Walls
 from ..simulation import Simulation
 from .upright import resolve_up
-from .view import BodyView, new_axes, spheres_of
+from .view import LIVE_STRAIN_LIMIT, BodyView, new_axes, spheres_of
+
+if TYPE_CHECKING:
+    from .widget import LiveView
 
 CATCH_UP = 0.25  # s of simulation a paced live view may step in one frame after a slow one
-LIVE_STRAIN_LIMIT = 0.3  # strain drawn at full colour: what a drag or a fall reaches
 INSTRUCTIONS_2D = "drag a particle with the left mouse button · close the window (or q) to quit"
 INSTRUCTIONS_3D = "left button: drag a particle · right button: turn · q or close: quit"
 _running: list[Dragger] = []  # live views started by `show`, stopped when a new one starts
@@ -199,10 +202,20 @@ def check_display() -> None:
         )
 
 
-def show(sim: Simulation, **options) -> Dragger:
-    """Open a window running ``sim`` with mouse dragging (blocks until it is closed, except
-    in Jupyter). A live view started earlier by `show` is stopped first, so re-running a
-    notebook cell leaves one simulation running."""
+def show(sim: Simulation, **options) -> Dragger | LiveView:
+    """Run ``sim`` live with mouse dragging: in a notebook as a `widget.LiveView` (the
+    browser draws), elsewhere in a matplotlib window (blocks until it is closed). A live
+    view started earlier by `show` is stopped first, so re-running a notebook cell leaves
+    one simulation running. ``options``: ``view``, ``up``, ``steps_per_second``."""
+    from .widget import in_notebook, live
+
+    if in_notebook():
+        from IPython.display import display
+
+        paced = {k: v for k, v in options.items() if k in ("view", "up", "steps_per_second")}
+        widget = live(sim, **paced)
+        display(widget)
+        return widget
     import matplotlib.pyplot as plt
 
     check_display()

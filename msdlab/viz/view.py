@@ -28,6 +28,7 @@ from .lines import SpringLines, SpringLines3D
 from .upright import UPS, resolve_up
 
 COLOURINGS = ("strain", "sag")  # what the springs' colour shows
+LIVE_STRAIN_LIMIT = 0.3  # strain drawn at full colour in live views: what a drag or fall reaches
 BALL_COLOUR = "tab:green"  # not on the coolwarm scale of the springs
 _U, _V = np.meshgrid(np.linspace(0, 2 * np.pi, 13), np.linspace(0, np.pi, 7))
 _UNIT_SPHERE = np.stack([np.cos(_U) * np.sin(_V), np.sin(_U) * np.sin(_V), np.cos(_V)])

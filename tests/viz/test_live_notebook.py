@@ -1,42 +1,25 @@
-"""The gallery's live view driven as a person would in Jupyter: JupyterLab with ipympl in
-headless Chromium runs the gallery notebook's dragging cell, the mouse presses on a particle,
-drags it and holds still; the particle follows the mouse.
+"""The matplotlib live view (`Dragger`) driven as a person would in Jupyter: JupyterLab with
+ipympl in headless Chromium runs a cell dragging the gallery's mesh, the mouse presses on a
+particle, drags it and holds still; the particle follows the mouse. (`viz.show` in a
+notebook is the widget, tested in test_widget_browser.py.)
 
-The notebook made for the test holds the gallery's import cell, its dragging cell and a
-cell that writes, ten times a second, where the particles are on the figure (pixels) and
-which one is held to ``state.json`` beside it.
+The notebook made for the test holds the mesh's dragging cell and a cell that writes, ten
+times a second, where the particles are on the figure (pixels) and which one is held to
+``state.json`` beside it.
 """
 
-import importlib.util
 import json
-import os
-import shutil
-import socket
-import subprocess
-import sys
 import time
-import urllib.request
 from pathlib import Path
 
 import nbformat
 import numpy as np
 import pytest
+from browser import CHROMIUM, jupyterlab_server, needs, wait_until
 
 GALLERY = Path(__file__).resolve().parents[2] / "notebooks" / "scene_gallery.ipynb"
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-PACKAGES = [
-    name for name in ("jupyterlab", "ipympl", "playwright") if not importlib.util.find_spec(name)
-]
 
-pytestmark = [
-    pytest.mark.skipif(
-        CHROMIUM is None, reason="needs Chromium for the page (apt-get install chromium)"
-    ),
-    pytest.mark.skipif(
-        bool(PACKAGES), reason=f"needs {', '.join(PACKAGES)} (pip install -e '.[test]')"
-    ),
-    pytest.mark.timeout(120),
-]
+pytestmark = [*needs("jupyterlab", "ipympl", "playwright"), pytest.mark.timeout(120)]
 
 REPORTER = """\
 import json
@@ -59,96 +42,30 @@ reporter.start()
 """
 
 
+DRAGGING = """\
+%matplotlib widget
+from msdlab import viz
+from msdlab.scenes import gallery
+
+# ipympl shows the figure as it is made
+dragger = viz.Dragger(gallery.mesh(), steps_per_second=60).start()  # the page's pace
+"""
+
+
 def drag_notebook(folder: Path) -> Path:
-    """The gallery's import and dragging cells plus the reporter, as ``folder/drag.ipynb``."""
+    """The dragging cell and the reporter, as ``folder/drag.ipynb``."""
     gallery = nbformat.read(GALLERY, as_version=4)
-    code = [cell.source for cell in gallery.cells if cell.cell_type == "code"]
-    imports = next(source for source in code if "import msdlab as msd" in source)
-    dragging = next(source for source in code if "viz.show(" in source)
     notebook = nbformat.v4.new_notebook(metadata=gallery.metadata)
-    notebook.cells = [nbformat.v4.new_code_cell(s) for s in (imports, dragging, REPORTER)]
+    notebook.cells = [nbformat.v4.new_code_cell(s) for s in (DRAGGING, REPORTER)]
     path = folder / "drag.ipynb"
     nbformat.write(notebook, path)
     return path
 
 
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
-def wait_until(condition, seconds: float, what: str):
-    """Poll ``condition()`` until it returns something true; its value."""
-    deadline = time.monotonic() + seconds
-    while time.monotonic() < deadline:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.1)
-    raise TimeoutError(f"{what} did not happen in {seconds} s")
-
-
 @pytest.fixture
 def jupyterlab(tmp_path):
-    """A JupyterLab server of this Python on a free local port, serving ``tmp_path``."""
-    port, token = free_port(), "msdlab-test"
-    env = {
-        **os.environ,
-        "JUPYTER_CONFIG_DIR": str(tmp_path / "config"),
-        "JUPYTER_RUNTIME_DIR": str(tmp_path / "runtime"),
-        "IPYTHONDIR": str(tmp_path / "ipython"),
-    }
-    env.pop("MPLBACKEND", None)  # the kernel picks ipympl itself
-    page_config = tmp_path / "config" / "labconfig" / "page_config.json"
-    page_config.parent.mkdir(parents=True)
-    no_news = {"@jupyterlab/apputils-extension:announcements": True}  # no pop-up over the page
-    page_config.write_text(json.dumps({"disabledExtensions": no_news}))
-    log = (tmp_path / "jupyterlab.log").open("w")
-    server = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "jupyterlab",
-            "--no-browser",
-            "--ip=127.0.0.1",
-            f"--port={port}",
-            f"--IdentityProvider.token={token}",
-            f"--ServerApp.root_dir={tmp_path}",
-            "--LabApp.expose_app_in_browser=True",  # window.jupyterapp runs the cells
-            "--allow-root",  # CI runs as root
-        ],
-        env=env,
-        stdout=log,
-        stderr=subprocess.STDOUT,
-    )
-    url = f"http://127.0.0.1:{port}"
-
-    def started() -> bool:
-        if server.poll() is not None:
-            log.flush()
-            output = (tmp_path / "jupyterlab.log").read_text()
-            raise RuntimeError(f"JupyterLab stopped:\n{output}")
-        return answers(f"{url}/api/status?token={token}")
-
-    try:
-        wait_until(started, 60, "JupyterLab starting")
-        yield url, token
-    finally:
-        server.terminate()
-        try:
-            server.wait(timeout=15)
-        except subprocess.TimeoutExpired:
-            server.kill()
-        log.close()
-
-
-def answers(url: str) -> bool:
-    try:
-        with urllib.request.urlopen(url, timeout=2) as response:
-            return response.status == 200
-    except OSError:
-        return False
+    with jupyterlab_server(tmp_path) as server:
+        yield server
 
 
 def read_state(path: Path) -> dict | None:

@@ -1,0 +1,529 @@
+// msdlab's live view and replay player: a mass-spring body drawn on a canvas.
+//
+// The page draws at its own frame rate (requestAnimationFrame) from the latest
+// positions it has; it never waits for Python. 2-D bodies are drawn as they are;
+// 3-D ones through an orbit camera (orthographic: left-drag on empty space or
+// right-drag turns, the wheel zooms). Springs are coloured by strain on the
+// colour table the scene brings (matplotlib's coolwarm in 64 levels).
+
+const LEVELS = 64;
+const PICK_RADIUS = 25; // px: how near the mouse a particle must be to be taken
+const HISTORY = 600; // points of the energy plot
+
+/** A typed array of `Type` over a DataView, ArrayBuffer or typed array. */
+function typed(data, Type) {
+  if (data instanceof Type) return data;
+  const buffer = data.buffer ?? data;
+  const offset = data.byteOffset ?? 0;
+  const length = (data.byteLength ?? buffer.byteLength) / Type.BYTES_PER_ELEMENT;
+  return new Type(buffer, offset, length);
+}
+
+/** Bytes of a base64 string (the replay page's arrays). */
+export function fromBase64(text, Type) {
+  const bytes = Uint8Array.from(atob(text), (c) => c.charCodeAt(0));
+  return new Type(bytes.buffer);
+}
+
+function element(tag, attributes = {}, parent = null) {
+  const node = Object.assign(document.createElement(tag), attributes);
+  if (parent) parent.appendChild(node);
+  return node;
+}
+
+/** Where the camera looks from: azimuth about the up axis, elevation, zoom. */
+class Camera {
+  constructor(scene, width, height) {
+    this.dim = scene.dim;
+    this.up = scene.up; // index of the vertical axis
+    this.centre = scene.centre;
+    this.span = scene.span; // the largest extent to show (length units)
+    this.azimuth = (scene.view[0] * Math.PI) / 180;
+    this.elevation = (scene.view[1] * Math.PI) / 180;
+    this.zoom = 1;
+    this.resize(width, height);
+  }
+
+  resize(width, height) {
+    this.width = width;
+    this.height = height;
+  }
+
+  get scale() {
+    return (this.zoom * 0.9 * Math.min(this.width, this.height)) / this.span;
+  }
+
+  /** Unit vectors (world, 3-D) of the screen's right, up and towards the viewer. */
+  axes() {
+    const [ca, sa] = [Math.cos(this.azimuth), Math.sin(this.azimuth)];
+    const [ce, se] = [Math.cos(this.elevation), Math.sin(this.elevation)];
+    const u = this.up, a = (u + 1) % 3, b = (u + 2) % 3; // (a, b, up) right-handed
+    const right = [0, 0, 0], top = [0, 0, 0], toward = [0, 0, 0];
+    // the report's convention: azimuth 0 looks from -b towards +b, with +a to the right
+    right[a] = ca; right[b] = sa;
+    top[a] = -se * sa; top[b] = se * ca; top[u] = ce;
+    toward[a] = ce * sa; toward[b] = -ce * ca; toward[u] = se;
+    return [right, top, toward];
+  }
+
+  /** Screen x, y (px) of `n` points of `positions` into `out` (2n), depths into `depth`. */
+  project(positions, n, out, depth) {
+    const s = this.scale, cx = this.width / 2, cy = this.height / 2, c = this.centre;
+    if (this.dim === 2) {
+      for (let i = 0; i < n; i++) {
+        out[2 * i] = cx + s * (positions[2 * i] - c[0]);
+        out[2 * i + 1] = cy - s * (positions[2 * i + 1] - c[1]);
+      }
+      return;
+    }
+    const [r, t, f] = this.axes();
+    for (let i = 0; i < n; i++) {
+      const x = positions[3 * i] - c[0], y = positions[3 * i + 1] - c[1];
+      const z = positions[3 * i + 2] - c[2];
+      out[2 * i] = cx + s * (r[0] * x + r[1] * y + r[2] * z);
+      out[2 * i + 1] = cy - s * (t[0] * x + t[1] * y + t[2] * z);
+      depth[i] = f[0] * x + f[1] * y + f[2] * z;
+    }
+  }
+
+  /** The world point under screen (px, py) at `depth` towards the viewer (3-D). */
+  unproject(px, py, depth) {
+    const s = this.scale, c = this.centre;
+    const u = (px - this.width / 2) / s, v = (this.height / 2 - py) / s;
+    if (this.dim === 2) return [c[0] + u, c[1] + v];
+    const [r, t, f] = this.axes();
+    return [0, 1, 2].map((k) => c[k] + u * r[k] + v * t[k] + depth * f[k]);
+  }
+}
+
+/** Draws the body, its floor, walls and balls on a 2-D canvas. */
+class Painter {
+  constructor(canvas, scene, springs, rest, fixed) {
+    this.canvas = canvas;
+    this.context = canvas.getContext("2d", { alpha: false });
+    this.scene = scene;
+    this.springs = springs;
+    this.rest = rest;
+    this.fixed = fixed;
+    this.n = fixed.length;
+    this.screen = new Float32Array(2 * this.n);
+    this.depth = new Float32Array(this.n);
+    this.levels = new Uint8Array(rest.length);
+    this.order = new Uint32Array(rest.length);
+    this.counts = new Uint32Array(LEVELS + 1);
+    this.dense = rest.length > 2000;
+  }
+
+  draw(camera, positions, held) {
+    const g = this.context, { width, height } = this.canvas;
+    g.fillStyle = "#fff";
+    g.fillRect(0, 0, width, height);
+    camera.project(positions, this.n, this.screen, this.depth);
+    this.drawWorld(g, camera);
+    this.sortByStrain(positions);
+    this.drawSprings(g);
+    this.drawParticles(g, held);
+    this.drawBalls(g, camera);
+  }
+
+  /** Each spring's colour level, and the springs in level order (a counting sort). */
+  sortByStrain(x) {
+    const { springs, rest, levels, order, counts } = this;
+    const d = this.scene.dim, limit = this.scene.strain_limit;
+    counts.fill(0);
+    for (let e = 0; e < rest.length; e++) {
+      const a = d * springs[2 * e], b = d * springs[2 * e + 1];
+      let sum = 0;
+      for (let k = 0; k < d; k++) sum += (x[a + k] - x[b + k]) ** 2;
+      const strain = Math.sqrt(sum) / rest[e] - 1;
+      const level = Math.floor(((strain + limit) / (2 * limit)) * LEVELS);
+      levels[e] = level < 0 ? 0 : level >= LEVELS ? LEVELS - 1 : level;
+      counts[levels[e] + 1]++;
+    }
+    for (let l = 1; l <= LEVELS; l++) counts[l] += counts[l - 1];
+    const next = counts.slice(0, LEVELS);
+    for (let e = 0; e < rest.length; e++) order[next[levels[e]]++] = e;
+  }
+
+  drawSprings(g) {
+    const { springs, order, counts, screen } = this;
+    g.lineWidth = this.dense ? 0.6 : 1.5;
+    g.globalAlpha = this.dense ? 0.7 : 1;
+    for (let l = 0; l < LEVELS; l++) {
+      if (counts[l] === counts[l + 1]) continue;
+      g.beginPath();
+      for (let i = counts[l]; i < counts[l + 1]; i++) {
+        const a = 2 * springs[2 * order[i]], b = 2 * springs[2 * order[i] + 1];
+        g.moveTo(screen[a], screen[a + 1]);
+        g.lineTo(screen[b], screen[b + 1]);
+      }
+      g.strokeStyle = this.scene.colours[l];
+      g.stroke();
+    }
+    g.globalAlpha = 1;
+  }
+
+  drawParticles(g, held) {
+    const { screen, fixed, n } = this;
+    const size = n > 500 ? 2 : 4;
+    g.fillStyle = "#262626";
+    g.beginPath();
+    for (let i = 0; i < n; i++) {
+      if (!fixed[i]) g.rect(screen[2 * i] - size / 2, screen[2 * i + 1] - size / 2, size, size);
+    }
+    g.fill();
+    g.fillStyle = "#000";
+    for (let i = 0; i < n; i++) {
+      if (fixed[i]) g.fillRect(screen[2 * i] - 3, screen[2 * i + 1] - 3, 6, 6);
+    }
+    if (held !== null) {
+      g.strokeStyle = "#e8a317";
+      g.lineWidth = 3;
+      g.beginPath();
+      g.arc(screen[2 * held], screen[2 * held + 1], 8, 0, 2 * Math.PI);
+      g.stroke();
+    }
+  }
+
+  drawBalls(g, camera) {
+    g.fillStyle = "rgba(44, 160, 44, 0.6)";
+    for (const [particle, radius] of this.scene.spheres) {
+      g.beginPath();
+      g.arc(this.screen[2 * particle], this.screen[2 * particle + 1],
+        radius * camera.scale, 0, 2 * Math.PI);
+      g.fill();
+    }
+  }
+
+  /** The scene's walls (a box) and floor (a grid on its plane). */
+  drawWorld(g, camera) {
+    const world = this.scene.world;
+    g.strokeStyle = "#4d4d4d";
+    g.lineWidth = 2;
+    for (const [from, to] of world.edges) {
+      const ends = new Float32Array([...from, ...to]);
+      const px = new Float32Array(4), depth = new Float32Array(2);
+      camera.project(ends, 2, px, depth);
+      g.beginPath();
+      g.moveTo(px[0], px[1]);
+      g.lineTo(px[2], px[3]);
+      g.stroke();
+    }
+  }
+}
+
+/** PhET-style bars of the energy now, and the total against time. */
+class EnergyPanel {
+  constructor(parent, unit) {
+    this.canvas = element("canvas", { width: 260, height: 480 }, parent);
+    this.canvas.className = "msdlab-energy";
+    this.unit = unit;
+    this.history = [];
+    this.bars = {};
+  }
+
+  update(energy) {
+    if (!energy) return;
+    const bars = { kinetic: energy.kinetic, elastic: energy.elastic,
+      gravitational: energy.gravitational };
+    if (energy.other) bars["other potential"] = energy.other;
+    for (const [name, value] of Object.entries(energy.dissipated)) bars[name] = value;
+    const sum = Object.values(bars).reduce((s, v) => s + v, 0);
+    const top = Math.max(...Object.values(bars).map(Math.abs));
+    for (const name of Object.keys(energy.dissipated)) {
+      if (Math.abs(bars[name]) <= 1e-9 * top) delete bars[name]; // nothing taken out yet
+    }
+    this.bars = bars;
+    this.total = sum;
+    this.canvas.dataset.bars = JSON.stringify(bars);
+    this.canvas.dataset.total = String(sum);
+    this.history.push([energy.time, sum, energy.kinetic + energy.elastic + energy.gravitational
+      + (energy.other || 0)]);
+    if (this.history.length > HISTORY) this.history.shift();
+  }
+
+  draw() {
+    const g = this.canvas.getContext("2d"), { width, height } = this.canvas;
+    g.fillStyle = "#fafafa";
+    g.fillRect(0, 0, width, height);
+    const entries = [...Object.entries(this.bars), ["total", this.total ?? 0]];
+    const top = Math.max(1e-12, ...entries.map(([, v]) => Math.abs(v)));
+    const barHeight = 300 / Math.max(entries.length, 1);
+    const colours = { kinetic: "#2ca02c", elastic: "#1f77b4", gravitational: "#9467bd",
+      total: "#333" };
+    g.font = "11px sans-serif";
+    entries.forEach(([name, value], i) => {
+      const y = 8 + i * barHeight, w = (Math.abs(value) / top) * (width - 20);
+      g.fillStyle = colours[name] ?? "#d62728";
+      g.globalAlpha = value < 0 ? 0.4 : 1;
+      g.fillRect(10, y + 13, w, barHeight - 18);
+      g.globalAlpha = 1;
+      g.fillStyle = "#000";
+      g.fillText(`${name} ${value.toPrecision(3)} ${this.unit}`, 10, y + 10);
+    });
+    this.drawHistory(g, width, height);
+  }
+
+  drawHistory(g, width, height) {
+    const top = 330, bottom = height - 20, points = this.history;
+    g.fillStyle = "#000";
+    g.fillText("total (black), in the body (grey) vs time", 10, top - 4);
+    if (points.length < 2) return;
+    const t0 = points[0][0], t1 = points[points.length - 1][0] || t0 + 1;
+    const values = points.flatMap((p) => [p[1], p[2]]);
+    const least = Math.min(...values), most = Math.max(...values);
+    const pad = Math.max(0.1 * (most - least), 1e-6 * Math.abs(most), 1e-12);
+    const low = least - pad, high = most + pad;
+    for (const [column, colour] of [[1, "#000"], [2, "#999"]]) {
+      g.strokeStyle = colour;
+      g.beginPath();
+      points.forEach((p, i) => {
+        const x = 10 + ((p[0] - t0) / (t1 - t0 || 1)) * (width - 20);
+        const y = bottom - ((p[column] - low) / (high - low)) * (bottom - top);
+        if (i === 0) g.moveTo(x, y);
+        else g.lineTo(x, y);
+      });
+      g.stroke();
+    }
+  }
+}
+
+/** What a view counted (for benchmarks and tests): frames (requestAnimationFrame calls),
+ * frames drawn with positions, and delays (ms) from a mouse move to the held particle
+ * arriving where it was sent. Each view is listed in `window.msdlabViews`. */
+function newStats() {
+  return { frames: 0, drawn: 0, delays: [], pending: null };
+}
+
+/** A body view: canvas, camera, mouse and the drawing loop. `source` hands it
+ * positions (`latest()`) and takes the user's grabs (`grab/move/release`). */
+export function mountView(el, scene, arrays, source) {
+  const root = element("div", { className: "msdlab-live" }, el);
+  root.style.cssText = "font: 12px sans-serif; display: inline-block";
+  const row = element("div", {}, root);
+  row.style.display = "flex";
+  const canvas = element("canvas", { width: scene.width, height: scene.height }, row);
+  canvas.className = "msdlab-canvas";
+  canvas.style.cssText = "cursor: crosshair; border: 1px solid #ccc";
+  const energy = scene.energy ? new EnergyPanel(row, scene.energy_unit) : null;
+  const status = element("div", { className: "msdlab-status" }, root);
+  const camera = new Camera(scene, canvas.width, canvas.height);
+  const painter = new Painter(canvas, scene, arrays.springs, arrays.rest, arrays.fixed);
+  const stats = newStats();
+  const view = { root, canvas, status, energy, camera, painter, stats, held: null, alive: true };
+  window.msdlabViews = window.msdlabViews || [];
+  window.msdlabViews.push(view);
+  mouse(view, painter, source);
+  let last = null;
+  const frame = () => {
+    if (!view.alive) return;
+    const positions = source.latest();
+    if (positions) {
+      painter.draw(camera, positions, view.held);
+      stats.drawn++;
+      if (positions !== last) checkDelay(stats, positions, scene.dim);
+      last = positions;
+    }
+    if (energy) energy.draw();
+    stats.frames++;
+    requestAnimationFrame(frame);
+  };
+  requestAnimationFrame(frame);
+  return view;
+}
+
+/** Time from a mouse move to the first frame with the held particle where it was sent. */
+function checkDelay(stats, x, d) {
+  if (!stats.pending) return;
+  const [time, particle, target] = stats.pending;
+  let miss = 0;
+  for (let k = 0; k < d; k++) miss = Math.max(miss, Math.abs(x[d * particle + k] - target[k]));
+  if (miss <= 1e-3 * (1 + Math.abs(target[0]))) {
+    stats.delays.push(performance.now() - time);
+    stats.pending = null;
+  }
+}
+
+function mouse(view, painter, source) {
+  const { canvas, camera, stats } = view;
+  let turning = null, depth = 0;
+  const at = (event) => {
+    const box = canvas.getBoundingClientRect();
+    return [(event.clientX - box.left) * (canvas.width / box.width),
+      (event.clientY - box.top) * (canvas.height / box.height)];
+  };
+  canvas.addEventListener("contextmenu", (event) => event.preventDefault());
+  canvas.addEventListener("mousedown", (event) => {
+    const [px, py] = at(event);
+    const nearest = event.button === 0 && source.grab ? pick(painter, px, py) : null;
+    if (nearest === null) {
+      turning = camera.dim === 3 ? [px, py, camera.azimuth, camera.elevation] : null;
+      return;
+    }
+    view.held = nearest;
+    depth = painter.depth[nearest];
+    const target = camera.unproject(px, py, depth);
+    stats.pending = [performance.now(), nearest, target];
+    source.grab(nearest, target);
+  });
+  window.addEventListener("mousemove", (event) => {
+    const [px, py] = at(event);
+    if (view.held !== null) {
+      const target = camera.unproject(px, py, depth);
+      stats.pending = [performance.now(), view.held, target];
+      source.move(target);
+    } else if (turning) {
+      camera.azimuth = turning[2] - (px - turning[0]) * 0.01;
+      const elevation = turning[3] + (py - turning[1]) * 0.01;
+      camera.elevation = Math.max(-1.55, Math.min(1.55, elevation));
+    }
+  });
+  window.addEventListener("mouseup", () => {
+    if (view.held !== null) source.release();
+    view.held = null;
+    turning = null;
+  });
+  canvas.addEventListener("wheel", (event) => {
+    event.preventDefault();
+    camera.zoom *= Math.exp(-event.deltaY * 0.001);
+  }, { passive: false });
+}
+
+/** The free particle nearest to screen (px, py), within PICK_RADIUS, or null. */
+function pick(painter, px, py) {
+  let best = null, nearest = PICK_RADIUS ** 2;
+  for (let i = 0; i < painter.n; i++) {
+    const d = (painter.screen[2 * i] - px) ** 2 + (painter.screen[2 * i + 1] - py) ** 2;
+    if (d < nearest) [best, nearest] = [i, d];
+  }
+  return best;
+}
+
+/** A button in `parent` calling `act`. */
+function button(parent, label, title, act) {
+  const node = element("button", { textContent: label, title }, parent);
+  node.addEventListener("click", act);
+  return node;
+}
+
+/** A labelled slider; `change(value)` on release of the handle. */
+function slider(parent, setting, change) {
+  const label = element("label", {}, parent);
+  label.style.cssText = "display: inline-block; margin: 2px 10px 2px 0";
+  const name = element("span", { textContent: setting.label + " " }, label);
+  const input = element("input", { type: "range", min: setting.min, max: setting.max,
+    step: setting.step, value: setting.value }, label);
+  input.dataset.setting = setting.name;
+  input.style.verticalAlign = "middle";
+  const format = (value) => Number(value).toPrecision(3);
+  const shown = element("span", { textContent: format(setting.value) }, label);
+  name.title = setting.rebuild ? "changing this rebuilds the scene" : "applied between steps";
+  input.addEventListener("input", () => (shown.textContent = format(input.value)));
+  input.addEventListener("change", () => change(Number(input.value)));
+  return input;
+}
+
+/** anywidget's entry: the live view of a running simulation. */
+function render({ model, el }) {
+  const scene = model.get("scene");
+  const arrays = {
+    springs: typed(model.get("springs"), Int32Array),
+    rest: typed(model.get("rest"), Float32Array),
+    fixed: typed(model.get("fixed"), Uint8Array),
+  };
+  let positions = typed(model.get("positions"), Float32Array);
+  const send = (message) => model.send(message);
+  const source = {
+    latest: () => positions,
+    grab: (particle, target) => send({ type: "grab", particle, target }),
+    move: (target) => send({ type: "move", target }),
+    release: () => send({ type: "release" }),
+  };
+  const view = mountView(el, scene, arrays, source);
+  const onPositions = () => (positions = typed(model.get("positions"), Float32Array));
+  const onEnergy = () => view.energy && view.energy.update(model.get("energy"));
+  const onStatus = () => {
+    const error = model.get("error");
+    view.status.textContent = error ? `stopped: ${error}` : model.get("status");
+    view.status.style.color = error ? "#b00" : "#333";
+  };
+  model.on("change:positions", onPositions);
+  model.on("change:energy", onEnergy);
+  model.on("change:status", onStatus);
+  model.on("change:error", onStatus);
+  controls(view.root, model, send);
+  onEnergy();
+  onStatus();
+  return () => {
+    view.alive = false;
+    model.off("change:positions", onPositions);
+    model.off("change:energy", onEnergy);
+    model.off("change:status", onStatus);
+    model.off("change:error", onStatus);
+  };
+}
+
+/** Pause, step, reset, speed and the scene's settings. */
+function controls(parent, model, send) {
+  const bar = element("div", { className: "msdlab-controls" }, parent);
+  const play = button(bar, "", "pause / run", () => {
+    model.set("running", !model.get("running"));
+    model.save_changes();
+  });
+  const label = () => (play.textContent = model.get("running") ? "❚❚ pause" : "▶ run");
+  model.on("change:running", label);
+  label();
+  button(bar, "▶❚ step", "one step", () => send({ type: "step" }));
+  button(bar, "↺ reset", "back to the start", () => send({ type: "reset" }));
+  const speed = { name: "speed", label: "speed ×", min: 0.1, max: 4, step: 0.1,
+    value: model.get("speed") };
+  slider(bar, speed, (value) => {
+    model.set("speed", value);
+    model.save_changes();
+  });
+  const sliders = element("div", {}, parent);
+  for (const setting of model.get("settings")) {
+    slider(sliders, setting, (value) => send({ type: "set", name: setting.name, value }));
+  }
+}
+
+/** The replay page's player: recorded frames, play / pause, a scrubber, orbiting. */
+export function replay(el, data) {
+  const scene = data.scene;
+  const arrays = {
+    springs: fromBase64(data.springs, Int32Array),
+    rest: fromBase64(data.rest, Float32Array),
+    fixed: fromBase64(data.fixed, Uint8Array),
+  };
+  const frames = fromBase64(data.frames, Float32Array);
+  const size = arrays.fixed.length * scene.dim, count = data.times.length;
+  let index = 0, playing = true, start = performance.now();
+  const frameAt = (i) => frames.subarray(i * size, (i + 1) * size);
+  const view = mountView(el, scene, arrays, { latest: () => frameAt(index) });
+  const bar = element("div", { className: "msdlab-controls" }, view.root);
+  const play = button(bar, "❚❚ pause", "play / pause", () => {
+    playing = !playing;
+    start = performance.now() - (index * 1000) / data.fps;
+    play.textContent = playing ? "❚❚ pause" : "▶ play";
+  });
+  const scrub = element("input", { type: "range", min: 0, max: count - 1, value: 0 }, bar);
+  scrub.style.cssText = "width: 50%; vertical-align: middle";
+  scrub.className = "msdlab-scrub";
+  scrub.addEventListener("input", () => {
+    playing = false;
+    play.textContent = "▶ play";
+    index = Number(scrub.value);
+  });
+  const tick = () => {
+    if (playing) index = Math.floor(((performance.now() - start) * data.fps) / 1000) % count;
+    scrub.value = index;
+    view.status.textContent = `t = ${data.times[index].toPrecision(4)} ${data.unit}`
+      + `   frame ${index + 1} / ${count}`;
+    view.status.dataset.frame = String(index);
+    requestAnimationFrame(tick);
+  };
+  requestAnimationFrame(tick);
+  return view;
+}
+
+export default { render };

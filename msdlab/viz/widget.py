@@ -1,0 +1,275 @@
+"""The live view in a notebook: an anywidget whose page draws while Python steps.
+
+The browser (``live.js``) draws at its own frame rate from the latest positions
+it has and never waits for Python. Python steps the simulation in a background
+thread at the scene's pace (``steps_per_second`` × ``speed``: 60 a second for
+the gallery, real time, 1/dt a second, for physical scenes) and, up to
+`FRAME_RATE` times a second, sends the positions as a float32 buffer and the
+energies as JSON. A thread rather than an asyncio task: the kernel's event loop
+stops while a cell runs, and a thread also runs outside Jupyter (tests,
+scripts); the kernel sends comm messages from any thread. What the page asks
+(grab, move, release, step, reset, a slider) arrives on the kernel's main
+thread and is queued, to be done by the stepping thread between two steps.
+"""
+
+from __future__ import annotations
+
+import queue
+import threading
+import time
+from collections.abc import Callable, Sequence
+
+import anywidget
+import numpy as np
+import traitlets
+
+from ..energy import kinetic_energy
+from ..errors import SimulationDiverged
+from ..forces import Gravity
+from ..interaction import Grab
+from ..scenes.registry import Scene
+from ..simulation import Simulation
+from . import frontend, settings
+from .upright import resolve_up
+from .view import LIVE_STRAIN_LIMIT, spheres_of
+
+FRAME_RATE = 60.0  # most frames sent a second
+BUDGET = 0.5 / FRAME_RATE  # s of stepping between two frames sent, at most
+_running: list[LiveView] = []  # views started by `show`, stopped when a new one starts
+
+
+def energies(sim: Simulation, taken_at_start: dict[str, float]) -> dict:
+    """The ledger's energies of ``sim`` now (as `Simulation.run` records them, J):
+    kinetic, elastic, gravitational, other potential, and what each mechanism took out
+    since the view started; the time (s)."""
+    x, v = sim.body.positions, sim.body.velocities
+    if sim.step_count > 0:  # the velocity at the positions' time, as the ledger takes it
+        v = sim.integrator.velocity_at_positions(v, sim.dynamics.acceleration(x, v), sim.dt)
+    gravitational = sum(
+        f.potential_energy(sim.body, x) for f in sim.forces if isinstance(f, Gravity)
+    )
+    potential = sum(f.potential_energy(sim.body, x) for f in sim.forces)
+    return {
+        "time": sim.time,
+        "kinetic": kinetic_energy(sim.body, v),
+        "elastic": sim.dynamics.elastic_energy(x),
+        "gravitational": gravitational,
+        "other": potential - gravitational,
+        "dissipated": {
+            name: value - taken_at_start.get(name, 0.0) for name, value in sim.dissipated.items()
+        },
+    }
+
+
+class LiveView(anywidget.AnyWidget):
+    """A simulation running in a notebook: drag particles, orbit (3-D), pause, step,
+    reset, change settings with sliders, watch the energy bars.
+
+    ``scene`` (a registered `Scene`) adds its build settings as sliders that rebuild it.
+    ``steps_per_second`` defaults to real time (1/dt); ``view`` is (azimuth, elevation) in
+    degrees and ``up`` the vertical axis (by default against gravity, `upright`).
+    """
+
+    _esm = frontend.ESM
+    scene = traitlets.Dict().tag(sync=True)
+    springs = traitlets.Bytes().tag(sync=True)
+    rest = traitlets.Bytes().tag(sync=True)
+    fixed = traitlets.Bytes().tag(sync=True)
+    positions = traitlets.Bytes().tag(sync=True)
+    energy = traitlets.Dict().tag(sync=True)
+    settings = traitlets.List().tag(sync=True)
+    status = traitlets.Unicode().tag(sync=True)
+    error = traitlets.Unicode().tag(sync=True)
+    running = traitlets.Bool(True).tag(sync=True)
+    speed = traitlets.Float(1.0).tag(sync=True)
+
+    def __init__(
+        self,
+        sim: Simulation,
+        *,
+        scene: Scene | None = None,
+        steps_per_second: float | None = None,
+        view: Sequence[float] | None = None,
+        up: str | None = None,
+        energy_unit: str = "J",
+    ) -> None:
+        super().__init__()
+        self.scene_entry, self.pace = scene, steps_per_second
+        self._look = (view, up, energy_unit)
+        self._commands: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._values: dict[str, float] = {}
+        self.attach(sim)
+        self.on_msg(self._on_message)
+
+    # ------------------------------------------------------------------ the simulation
+    def attach(self, sim: Simulation) -> None:
+        """Show ``sim`` from now on (at the start, and after a rebuild)."""
+        self.sim = sim
+        self.grab = Grab()
+        sim.constraints.append(self.grab)
+        self._start = settings.start_of(sim)
+        self._initial = (sim.body.positions.copy(), sim.body.velocities.copy())
+        self._taken = dict(sim.dissipated)
+        self._owed, self._clock = 0.0, time.perf_counter()
+        view, up, energy_unit = self._look
+        live = settings.live_settings(sim)
+        rebuild = (
+            []
+            if self.scene_entry is None
+            else settings.scene_settings(self.scene_entry, {s.name for s in live})
+        )
+        for setting in rebuild:
+            setting.value = self._values.get(setting.name, setting.value)
+        with self.hold_sync():
+            self.scene = frontend.describe(
+                sim,
+                up=resolve_up(up, sim, sim.body.dim),
+                view=view,
+                strain_limit=LIVE_STRAIN_LIMIT,
+                spheres=spheres_of(sim),
+                energy_unit=energy_unit,
+            )
+            for name, data in frontend.body_arrays(sim.body).items():
+                setattr(self, name, data)
+            self.settings = [s.as_dict() for s in (*live, *rebuild)]
+            self.error = ""
+            self.publish()
+
+    @property
+    def steps_per_second(self) -> float:
+        """The pace at speed 1: ``steps_per_second`` as given, or real time."""
+        return self.pace if self.pace is not None else 1.0 / self.sim.dt
+
+    def publish(self) -> None:
+        """Send the positions (float32 buffer), the energies and the status line."""
+        sim = self.sim
+        with self.hold_sync():
+            self.positions = sim.body.positions.astype(np.float32).tobytes()
+            self.energy = energies(sim, self._taken)
+            self.status = f"t = {sim.time:.4g}   steps {sim.step_count}"
+
+    def advance(self, seconds: float, budget: float = BUDGET) -> int:
+        """Step for ``seconds`` of wall-clock time at the pace (at most ``budget`` s of
+        stepping: a slow engine runs slower than real time rather than falling behind);
+        stop with the diagnosis on a blow-up. The number of steps done."""
+        self._owed += seconds * self.steps_per_second * self.speed
+        done, start = 0, time.perf_counter()
+        try:
+            while self._owed >= 1.0 and time.perf_counter() - start < budget:
+                self.sim.step()
+                self._owed -= 1.0
+                done += 1
+        except SimulationDiverged as error:
+            self.running, self.error = False, str(error)
+        self._owed = min(self._owed, 1.0)  # what was not done in time is dropped
+        return done
+
+    def do_pending(self) -> None:
+        """Do what the page asked since the last call (grabs, slider moves, ...)."""
+        while True:
+            try:
+                command = self._commands.get_nowait()
+            except queue.Empty:
+                return
+            command()
+
+    def frame(self) -> None:
+        """One round of the stepping thread: the page's requests, steps, a frame sent."""
+        now = time.perf_counter()
+        elapsed, self._clock = now - self._clock, now
+        self.do_pending()
+        if self.running and not self.error:
+            self.advance(elapsed)
+        self.publish()
+
+    # ------------------------------------------------------------------ the page's requests
+    def _on_message(self, _widget: object, content: dict, buffers: list) -> None:
+        """A request from the page, queued for the stepping thread (or done now if none)."""
+        handlers = {
+            "grab": lambda: self.grab.hold(self.sim.body, content["particle"], content["target"]),
+            "move": lambda: self.grab.particle is not None and self.grab.move(content["target"]),
+            "release": self.grab_release,
+            "step": self.step_once,
+            "reset": self.reset,
+            "set": lambda: self.set(content["name"], content["value"]),
+        }
+        command = handlers.get(content.get("type"))
+        if command is not None:
+            self._commands.put(command)
+            if self._thread is None:
+                self.do_pending()
+
+    def grab_release(self) -> None:
+        self.grab.release()
+
+    def step_once(self) -> None:
+        """One step, paused or not."""
+        self.running = False
+        self._owed = 1.0
+        self.advance(0.0)
+
+    def reset(self) -> None:
+        """Back to the positions and velocities at the start; the clock and ledger too."""
+        self.grab.release()
+        x, v = self._initial
+        self.sim.body.positions[...] = x
+        self.sim.body.velocities[...] = v
+        self.sim.time, self.sim.step_count = 0.0, 0
+        self._taken = dict(self.sim.dissipated)
+        self.error = ""
+
+    def set(self, name: str, value: float) -> None:
+        """Apply a slider: in place between steps, or by rebuilding the scene."""
+        rebuild = {s["name"] for s in self.settings if s["rebuild"]}
+        if name in rebuild and self.scene_entry is not None:
+            self._values[name] = value
+            built = {n: v for n, v in self._values.items() if n in rebuild}
+            kinds = self.scene_entry.settings()
+            built = {n: type(kinds[n])(v) for n, v in built.items()}
+            self.attach(self.scene_entry.build(**built))
+        else:
+            settings.apply(self.sim, name, value, self._start)
+
+    # ------------------------------------------------------------------ the thread
+    def start(self) -> LiveView:
+        """Start stepping in a background thread."""
+        if self._thread is None:
+            self._stop.clear()
+            self._clock = time.perf_counter()
+            self._thread = threading.Thread(target=self._loop, name="msdlab-live", daemon=True)
+            self._thread.start()
+        return self
+
+    def stop(self) -> None:
+        """Stop stepping (the page keeps drawing the last frame)."""
+        self._stop.set()
+        if self._thread is not None and self._thread is not threading.current_thread():
+            self._thread.join(timeout=5)
+        self._thread = None
+
+    def _loop(self) -> None:
+        while not self._stop.is_set():
+            began = time.perf_counter()
+            self.frame()
+            self._stop.wait(max(0.0, 1.0 / FRAME_RATE - (time.perf_counter() - began)))
+
+
+def in_notebook() -> bool:
+    """Whether this runs in a Jupyter kernel (where the widget shows)."""
+    try:
+        from IPython import get_ipython
+    except ImportError:
+        return False
+    shell = get_ipython()
+    return shell is not None and hasattr(shell, "kernel")
+
+
+def live(sim: Simulation, **options) -> LiveView:
+    """Start a `LiveView` of ``sim`` (stopping the one started before) and return it."""
+    while _running:
+        _running.pop().stop()
+    widget = LiveView(sim, **options).start()
+    _running.append(widget)
+    return widget

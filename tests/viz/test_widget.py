@@ -1,0 +1,137 @@
+"""The live widget's model without a browser: what it sends, what the page's requests do."""
+
+import re
+import time
+
+import numpy as np
+import pytest
+
+import msdlab as msd
+from msdlab import viz
+from msdlab.scenes import SCENES, gallery
+from msdlab.viz.widget import LiveView, energies
+
+
+def ask(view: LiveView, **content) -> None:
+    """A request from the page (done at once: no stepping thread runs)."""
+    view._on_message(view, content, [])
+
+
+def test_the_page_gets_the_body_and_float32_positions():
+    sim = gallery.mesh()
+    view = LiveView(sim)
+    assert view.scene["dim"] == 2 and len(view.scene["colours"]) == 64
+    np.testing.assert_array_equal(
+        np.frombuffer(view.positions, np.float32).reshape(-1, 2), sim.body.positions
+    )
+    pairs = np.frombuffer(view.springs, np.int32).reshape(-1, 2)
+    np.testing.assert_array_equal(pairs[:, 0], sim.body.spring_a)
+    assert len(view.scene["world"]["edges"]) == 4  # the gallery's walls
+
+
+def test_a_3d_scene_stands_on_its_floor_with_y_up():
+    view = LiveView(SCENES["jelly-cube"].build(size=3))
+    assert view.scene["up"] == 1  # gravity along -y
+    assert len(view.scene["world"]["edges"]) == 18  # the floor's grid
+
+
+def test_the_pace_is_the_scenes_and_the_speed_scales_it():
+    view = LiveView(gallery.two_particles(), steps_per_second=60)
+    assert view.advance(0.5, budget=60) == 30
+    view.speed = 2.0
+    assert view.advance(0.5, budget=60) == 60
+    physical = LiveView(msd.Simulation(msd.Body.from_arrays([[0.0, 0.0]], []), dt=0.01))
+    assert physical.advance(0.1, budget=60) == 10  # real time: 1/dt steps a second
+
+
+def test_grab_move_release_keeps_the_hands_velocity():
+    sim = gallery.mesh(gravity=0.0)
+    view = LiveView(sim, steps_per_second=60)
+    start = sim.body.positions[0].copy()
+    ask(view, type="grab", particle=0, target=start.tolist())
+    ask(view, type="move", target=(start + (10.0, 0.0)).tolist())
+    view.advance(1 / 60)
+    np.testing.assert_allclose(sim.body.positions[0], start + (10.0, 0.0))
+    ask(view, type="release")
+    assert view.grab.particle is None and not sim.body.fixed[0]
+    np.testing.assert_allclose(sim.body.velocities[0], (10.0, 0.0))  # px per frame
+
+
+def test_sliders_change_what_the_engine_uses_between_steps():
+    sim = gallery.mesh()
+    view = LiveView(sim)
+    names = [s["name"] for s in view.settings]
+    assert names == ["stiffness", "damping", "gravity", "dt"]
+    ask(view, type="set", name="stiffness", value=0.2)
+    np.testing.assert_allclose(sim.body.stiffness, 0.2)
+    ask(view, type="set", name="gravity", value=0.3)
+    np.testing.assert_allclose(sim.forces[0].g, (0.0, -0.3))
+    ask(view, type="set", name="damping", value=0.0)
+    ask(view, type="set", name="dt", value=0.5)
+    assert sim.dt == 0.5
+    assert next(c for c in sim.constraints if isinstance(c, msd.Drag)).rate == 0.0
+
+
+def test_a_scene_setting_rebuilds_the_scene_and_says_so():
+    view = LiveView(SCENES["mesh"].build(), scene=SCENES["mesh"])
+    spacing = next(s for s in view.settings if s["name"] == "spacing")
+    assert spacing["rebuild"] and "rebuilds" in spacing["label"]
+    old = view.sim
+    ask(view, type="set", name="spacing", value=40.0)
+    assert view.sim is not old
+    assert np.ptp(view.sim.body.positions[:, 0]) == pytest.approx(9 * 40.0)
+    assert next(s for s in view.settings if s["name"] == "spacing")["value"] == 40.0
+
+
+def test_the_energy_in_the_body_is_the_ledgers_total():
+    sim = SCENES["jelly-cube"].build(size=3)
+    view = LiveView(sim)
+    for _ in range(5):
+        view.advance(0.01)
+    energy = energies(sim, {})
+    in_body = energy["kinetic"] + energy["elastic"] + energy["gravitational"] + energy["other"]
+    assert in_body == pytest.approx(sim.run(steps=0).energies.total[0], rel=1e-12)
+    assert set(energy["dissipated"]) == set(sim.dissipated)
+
+
+def test_a_blow_up_stops_the_view_with_the_diagnosis():
+    sim = gallery.mesh()
+    view = LiveView(sim, steps_per_second=60)
+    ask(view, type="set", name="stiffness", value=50.0)
+    view.advance(1.0, budget=60)
+    assert not view.running
+    assert "diverged" in view.error.lower() or "stretch" in view.error.lower()
+    steps = sim.step_count
+    view.frame()
+    assert sim.step_count == steps  # stopped
+
+
+def test_step_pauses_and_reset_goes_back_to_the_start():
+    sim = gallery.mesh()
+    view = LiveView(sim)
+    start = sim.body.positions.copy()
+    ask(view, type="step")
+    assert not view.running and sim.step_count == 1
+    ask(view, type="reset")
+    np.testing.assert_array_equal(sim.body.positions, start)
+    assert sim.step_count == 0 and sim.time == 0.0
+
+
+def test_the_thread_steps_at_its_own_pace_and_stops():
+    view = viz.widget.live(gallery.mesh(), steps_per_second=60)
+    try:
+        time.sleep(0.5)
+    finally:
+        view.stop()
+    steps = view.sim.step_count
+    assert 5 <= steps <= 40
+    time.sleep(0.1)
+    assert view.sim.step_count == steps
+
+
+def test_the_replay_page_holds_positions_and_asks_the_network_for_nothing(tmp_path):
+    run = gallery.mesh().run(steps=60, record_every=10)
+    page = viz.save_animation(run, tmp_path / "mesh.html", time_unit="frames").read_text()
+    assert "data:image/png" not in page
+    assert not re.search(r"(src|href)=\"?https?:", page)
+    assert '"frames": "' in page and "export function replay" in page
