@@ -9,6 +9,7 @@
 const LEVELS = 64;
 const PICK_RADIUS = 25; // px: how near the mouse a particle must be to be taken
 const HISTORY = 600; // points of the energy plot
+const DENSE = 3000; // springs from which lines are written as pixels (`Pixels`)
 
 /** A typed array of `Type` over a DataView, ArrayBuffer or typed array. */
 function typed(data, Type) {
@@ -96,6 +97,57 @@ class Camera {
   }
 }
 
+/** A canvas's pixels as 32-bit words, for drawing many 1-px lines fast. */
+class Pixels {
+  constructor(canvas, colours) {
+    this.width = canvas.width;
+    this.height = canvas.height;
+    this.context = canvas.getContext("2d");
+    this.image = this.context.createImageData(this.width, this.height);
+    this.words = new Uint32Array(this.image.data.buffer);
+    // the springs' colours, 70 % over white as the matplotlib views draw dense bodies
+    this.colours = colours.map((hex) => this.word(hex, 0.7));
+    this.dark = this.word("#4d4d4d", 1);
+    this.dotColour = this.word("#262626", 0.8);
+  }
+
+  /** The 32-bit word (little-endian RGBA) of `hex` drawn with `alpha` over white. */
+  word(hex, alpha) {
+    const [r, g, b] = [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16));
+    const over = (c) => Math.round(alpha * c + (1 - alpha) * 255);
+    return ((255 << 24) | (over(b) << 16) | (over(g) << 8) | over(r)) >>> 0;
+  }
+
+  clear() {
+    this.words.fill(0xffffffff);
+  }
+
+  /** A 1-px line (a DDA: one pixel per step along the longer axis). */
+  line(x0, y0, x1, y1, colour) {
+    const steps = Math.ceil(Math.max(Math.abs(x1 - x0), Math.abs(y1 - y0)));
+    const dx = (x1 - x0) / (steps || 1), dy = (y1 - y0) / (steps || 1);
+    const { width, height, words } = this;
+    let x = x0 + 0.5, y = y0 + 0.5;
+    for (let i = 0; i <= steps; i++, x += dx, y += dy) {
+      if (x >= 0 && y >= 0 && x < width && y < height) words[(y | 0) * width + (x | 0)] = colour;
+    }
+  }
+
+  /** A dot of `size` × `size` pixels (1 or 2). */
+  dot(x, y, colour, size) {
+    const { width, height, words } = this;
+    const i = Math.floor(x), j = Math.floor(y);
+    if (i < 0 || j < 0 || i + 1 >= width || j + 1 >= height) return;
+    words[j * width + i] = colour;
+    if (size > 1) words[j * width + i + 1] = words[(j + 1) * width + i] = colour;
+    if (size > 1) words[(j + 1) * width + i + 1] = colour;
+  }
+
+  show() {
+    this.context.putImageData(this.image, 0, 0);
+  }
+}
+
 /** Draws the body, its floor, walls and balls on a 2-D canvas. */
 class Painter {
   constructor(canvas, scene, springs, rest, fixed) {
@@ -111,19 +163,57 @@ class Painter {
     this.levels = new Uint8Array(rest.length);
     this.order = new Uint32Array(rest.length);
     this.counts = new Uint32Array(LEVELS + 1);
-    this.dense = rest.length > 2000;
+    this.dense = rest.length > DENSE;
+    if (this.dense) this.pixels = new Pixels(canvas, scene.colours);
   }
 
   draw(camera, positions, held) {
     const g = this.context, { width, height } = this.canvas;
-    g.fillStyle = "#fff";
-    g.fillRect(0, 0, width, height);
     camera.project(positions, this.n, this.screen, this.depth);
-    this.drawWorld(g, camera);
-    this.sortByStrain(positions);
-    this.drawSprings(g);
-    this.drawParticles(g, held);
+    if (this.dense) {
+      this.drawDense(camera, positions);
+    } else {
+      g.fillStyle = "#fff";
+      g.fillRect(0, 0, width, height);
+      this.drawWorld(g, camera);
+      this.sortByStrain(positions);
+      this.drawSprings(g);
+      this.drawParticles(g);
+    }
+    this.drawHeld(g, held);
     this.drawBalls(g, camera);
+  }
+
+  /** Thousands of springs: 1-px lines written into the pixels, one pass, no paths. */
+  drawDense(camera, x) {
+    const { springs, rest, screen, pixels } = this;
+    const d = this.scene.dim, limit = this.scene.strain_limit;
+    pixels.clear();
+    for (const [from, to] of this.scene.world.edges) {
+      const px = new Float32Array(4);
+      camera.project(new Float32Array([...from, ...to]), 2, px, new Float32Array(2));
+      pixels.line(px[0], px[1], px[2], px[3], pixels.dark);
+    }
+    for (let e = 0; e < rest.length; e++) {
+      const a = springs[2 * e], b = springs[2 * e + 1];
+      let sum = 0;
+      for (let k = 0; k < d; k++) sum += (x[d * a + k] - x[d * b + k]) ** 2;
+      const level = Math.floor(((Math.sqrt(sum) / rest[e] - 1 + limit) / (2 * limit)) * LEVELS);
+      const colour = pixels.colours[level < 0 ? 0 : level >= LEVELS ? LEVELS - 1 : level];
+      pixels.line(screen[2 * a], screen[2 * a + 1], screen[2 * b], screen[2 * b + 1], colour);
+    }
+    const size = this.n > 2000 ? 1 : 2; // a dense body: its springs show between the dots
+    for (let i = 0; i < this.n; i++) pixels.dot(screen[2 * i], screen[2 * i + 1], pixels.dotColour, size);
+    pixels.show();
+  }
+
+  drawHeld(g, held) {
+    if (held === null) return;
+    g.strokeStyle = "#e8a317";
+    g.lineWidth = 3;
+    g.beginPath();
+    g.arc(this.screen[2 * held], this.screen[2 * held + 1], 8, 0, 2 * Math.PI);
+    g.stroke();
   }
 
   /** Each spring's colour level, and the springs in level order (a counting sort). */
@@ -147,8 +237,7 @@ class Painter {
 
   drawSprings(g) {
     const { springs, order, counts, screen } = this;
-    g.lineWidth = this.dense ? 0.6 : 1.5;
-    g.globalAlpha = this.dense ? 0.7 : 1;
+    g.lineWidth = 1.5;
     for (let l = 0; l < LEVELS; l++) {
       if (counts[l] === counts[l + 1]) continue;
       g.beginPath();
@@ -160,12 +249,11 @@ class Painter {
       g.strokeStyle = this.scene.colours[l];
       g.stroke();
     }
-    g.globalAlpha = 1;
   }
 
-  drawParticles(g, held) {
+  drawParticles(g) {
     const { screen, fixed, n } = this;
-    const size = n > 500 ? 2 : 4;
+    const size = n > 300 ? 2 : 4;
     g.fillStyle = "#262626";
     g.beginPath();
     for (let i = 0; i < n; i++) {
@@ -175,13 +263,6 @@ class Painter {
     g.fillStyle = "#000";
     for (let i = 0; i < n; i++) {
       if (fixed[i]) g.fillRect(screen[2 * i] - 3, screen[2 * i + 1] - 3, 6, 6);
-    }
-    if (held !== null) {
-      g.strokeStyle = "#e8a317";
-      g.lineWidth = 3;
-      g.beginPath();
-      g.arc(screen[2 * held], screen[2 * held + 1], 8, 0, 2 * Math.PI);
-      g.stroke();
     }
   }
 
@@ -289,10 +370,10 @@ class EnergyPanel {
 }
 
 /** What a view counted (for benchmarks and tests): frames (requestAnimationFrame calls),
- * frames drawn with positions, and delays (ms) from a mouse move to the held particle
+ * frames drawn with positions, new positions received (updates), and delays (ms) from a mouse move to the held particle
  * arriving where it was sent. Each view is listed in `window.msdlabViews`. */
 function newStats() {
-  return { frames: 0, drawn: 0, delays: [], pending: null };
+  return { frames: 0, drawn: 0, updates: 0, delays: [], pending: null };
 }
 
 /** A body view: canvas, camera, mouse and the drawing loop. `source` hands it
@@ -321,7 +402,10 @@ export function mountView(el, scene, arrays, source) {
     if (positions) {
       painter.draw(camera, positions, view.held);
       stats.drawn++;
-      if (positions !== last) checkDelay(stats, positions, scene.dim);
+      if (positions !== last) {
+        stats.updates++;
+        checkDelay(stats, positions, scene.dim);
+      }
       last = positions;
     }
     if (energy) energy.draw();

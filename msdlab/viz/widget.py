@@ -26,34 +26,49 @@ import traitlets
 from ..energy import kinetic_energy
 from ..errors import SimulationDiverged
 from ..forces import Gravity
-from ..interaction import Grab
+from ..interaction import Grab, Ground, Walls
 from ..scenes.registry import Scene
 from ..simulation import Simulation
 from . import frontend, settings
-from .upright import resolve_up
+from .upright import UPS, resolve_up
 from .view import LIVE_STRAIN_LIMIT, spheres_of
 
 FRAME_RATE = 60.0  # most frames sent a second
+ENERGY_EVERY = 4  # frames sent per energy update (15 a second)
 BUDGET = 0.5 / FRAME_RATE  # s of stepping between two frames sent, at most
 _running: list[LiveView] = []  # views started by `show`, stopped when a new one starts
 
 
-def energies(sim: Simulation, taken_at_start: dict[str, float]) -> dict:
+def ground_level(sim: Simulation, up: int) -> float:
+    """The height (along axis ``up``) gravitational energy is counted from, as PhET does:
+    the floor's, or the walls' bottom, else the lowest particle's now."""
+    for item in sim.constraints:
+        if isinstance(item, Ground):
+            return item.height / item._normal(sim.body)[up]
+        if isinstance(item, Walls) and np.isfinite(item.lower[up]):
+            return float(item.lower[up])
+    return float(sim.body.positions[:, up].min())
+
+
+def energies(sim: Simulation, taken_at_start: dict[str, float], level: float = 0.0) -> dict:
     """The ledger's energies of ``sim`` now (as `Simulation.run` records them, J):
-    kinetic, elastic, gravitational, other potential, and what each mechanism took out
-    since the view started; the time (s)."""
+    kinetic, elastic, gravitational (counted from height ``level`` along gravity; ``zero``
+    is the ledger's gravitational energy at that height), other potential, and what each
+    mechanism took out since the view started; the time (s)."""
     x, v = sim.body.positions, sim.body.velocities
     if sim.step_count > 0:  # the velocity at the positions' time, as the ledger takes it
         v = sim.integrator.velocity_at_positions(v, sim.dynamics.acceleration(x, v), sim.dt)
-    gravitational = sum(
-        f.potential_energy(sim.body, x) for f in sim.forces if isinstance(f, Gravity)
-    )
+    gravities = [f for f in sim.forces if isinstance(f, Gravity)]
+    gravitational = sum(f.potential_energy(sim.body, x) for f in gravities)
     potential = sum(f.potential_energy(sim.body, x) for f in sim.forces)
+    g = sum((f.g for f in gravities), np.zeros(sim.body.dim))
+    zero = -float(np.sum(sim.body.masses)) * level * float(g[int(np.argmax(np.abs(g)))])
     return {
         "time": sim.time,
         "kinetic": kinetic_energy(sim.body, v),
         "elastic": sim.dynamics.elastic_energy(x),
-        "gravitational": gravitational,
+        "gravitational": gravitational - zero,
+        "zero": zero,
         "other": potential - gravitational,
         "dissipated": {
             name: value - taken_at_start.get(name, 0.0) for name, value in sim.dissipated.items()
@@ -100,6 +115,7 @@ class LiveView(anywidget.AnyWidget):
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._values: dict[str, float] = {}
+        self._frames = 0
         self.attach(sim)
         self.on_msg(self._on_message)
 
@@ -112,8 +128,10 @@ class LiveView(anywidget.AnyWidget):
         self._start = settings.start_of(sim)
         self._initial = (sim.body.positions.copy(), sim.body.velocities.copy())
         self._taken = dict(sim.dissipated)
+        up = resolve_up(self._look[1], sim, sim.body.dim)
+        self._level = ground_level(sim, UPS.index(up))
         self._owed, self._clock = 0.0, time.perf_counter()
-        view, up, energy_unit = self._look
+        view, _, energy_unit = self._look
         live = settings.live_settings(sim)
         rebuild = (
             []
@@ -125,7 +143,7 @@ class LiveView(anywidget.AnyWidget):
         with self.hold_sync():
             self.scene = frontend.describe(
                 sim,
-                up=resolve_up(up, sim, sim.body.dim),
+                up=up,
                 view=view,
                 strain_limit=LIVE_STRAIN_LIMIT,
                 spheres=spheres_of(sim),
@@ -142,12 +160,15 @@ class LiveView(anywidget.AnyWidget):
         """The pace at speed 1: ``steps_per_second`` as given, or real time."""
         return self.pace if self.pace is not None else 1.0 / self.sim.dt
 
-    def publish(self) -> None:
-        """Send the positions (float32 buffer), the energies and the status line."""
+    def publish(self, energy: bool = True) -> None:
+        """Send the positions (float32 buffer), the status line and, if ``energy``, the
+        energies (they cost a force evaluation: the thread sends them every
+        `ENERGY_EVERY` frames)."""
         sim = self.sim
         with self.hold_sync():
             self.positions = sim.body.positions.astype(np.float32).tobytes()
-            self.energy = energies(sim, self._taken)
+            if energy:
+                self.energy = energies(sim, self._taken, self._level)
             self.status = f"t = {sim.time:.4g}   steps {sim.step_count}"
 
     def advance(self, seconds: float, budget: float = BUDGET) -> int:
@@ -182,7 +203,8 @@ class LiveView(anywidget.AnyWidget):
         self.do_pending()
         if self.running and not self.error:
             self.advance(elapsed)
-        self.publish()
+        self._frames += 1
+        self.publish(energy=self._frames % ENERGY_EVERY == 0 or not self.running)
 
     # ------------------------------------------------------------------ the page's requests
     def _on_message(self, _widget: object, content: dict, buffers: list) -> None:

@@ -27,13 +27,11 @@
 # bounce that keeps its energy.
 
 # %%
-import importlib.util
 from collections.abc import Callable
 
 import matplotlib.pyplot as plt
 import numpy as np
-from IPython import get_ipython
-from IPython.display import HTML, display
+from IPython.display import HTML
 from scipy.optimize import curve_fit
 
 import msdlab as msd
@@ -141,14 +139,22 @@ HTML(viz.to_html(run, max_frames=60, time_unit="frames"))
 # ## Dragging
 #
 # On the page you grab the nearest particle and drag it. `viz.show(sim)` does
-# the same in a matplotlib window, and in Jupyter with
-# [ipympl](https://matplotlib.org/ipympl/) (`pip install ipympl`, then restart
-# the kernel): the next cell opens the mesh for dragging where ipympl is
-# installed. Without it, the cell plays a drag by script: the top-right corner
-# of the mesh is taken in hand, pulled 150 px to the left, and let go. It uses
-# the same `msd.Grab` as the mouse: while held, the particle follows the hand;
-# let go, it keeps the hand's velocity, not the spring forces it held against
-# (the page set the position only, so a released particle flung away).
+# the same here: the browser draws the mesh at its own frame rate while Python
+# steps it at the page's pace (60 frames a second) in the background. Press near
+# a particle and drag; let go and it keeps the hand's velocity, not the spring
+# forces it held against (the page set the position only, so a released particle
+# flung away). The buttons pause, step and reset it; the sliders change the
+# stiffness, the damping, gravity and $\Delta t$ between two steps; the bars on
+# the right are the energy ledger as it runs (kinetic, elastic, gravitational
+# from the floor, and what the drag and the walls took out). It works offline in
+# JupyterLab and in VS Code's notebooks.
+
+# %%
+live = viz.show(gallery.mesh(), steps_per_second=60)  # the page's pace
+
+# %% [markdown]
+# The same drag by script: the top-right corner of the mesh is taken in hand,
+# pulled 150 px to the left, and let go, with the same `msd.Grab` as the mouse.
 
 
 # %%
@@ -173,14 +179,9 @@ def drag_corner(
 
 
 sim = gallery.mesh()
-if importlib.util.find_spec("ipympl"):
-    get_ipython().run_line_magic("matplotlib", "widget")
-    dragger = viz.show(sim, steps_per_second=60)  # the page's pace
-else:
-    hand = drag_corner(sim, np.array([-150.0, 0.0]), frames=60)
-    run = sim.run(steps=240, record_every=3, callback=hand)
-    print("ipympl is not installed: a scripted drag instead of the mouse")
-    display(HTML(viz.to_html(run, max_frames=60, time_unit="frames")))
+hand = drag_corner(sim, np.array([-150.0, 0.0]), frames=60)
+run = sim.run(steps=240, record_every=3, callback=hand)
+HTML(viz.to_html(run, max_frames=60, time_unit="frames"))
 
 # %% [markdown]
 # ## Why a dragged mesh can fold, and how to prevent it

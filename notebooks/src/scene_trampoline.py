@@ -161,3 +161,14 @@ print(f"velocity Verlet: predicted largest stable dt {1e3 * limit:.1f} ms (the r
 # %%
 viz.plot_energy(control.energies)
 plt.show()
+
+# %% [markdown]
+# ## Live: the ball on the net
+#
+# The control case running live: the browser draws the net and the ball while
+# Python steps them in real time. Drag the ball or a point of the net, turn the
+# view with the empty space or the right button, zoom with the wheel; the bars
+# show where the ball's energy goes as the dashpots and the drag take it out.
+
+# %%
+live = viz.show(trampoline(), view=(15, 12))

@@ -1,0 +1,153 @@
+"""Frames per second of the live widget, counted in the page, and the delay of a drag.
+
+Runs JupyterLab and headless Chromium (as tests/viz/test_widget_browser.py does), shows
+each case with `viz.show` in a fresh notebook and counts, over ``--seconds``, the frames
+the page drew (requestAnimationFrame callbacks) and the new positions it received from
+Python. For the mesh it then presses on a particle and moves the mouse 15 px every 0.3 s:
+the delay is the time from a mouse move to the first frame showing the held particle where
+that move put it (the page's request, the kernel, a step, the positions back, a draw).
+Beside it, the matplotlib view measured on the Agg canvas alone: the time of one frame
+(the steps of a frame and a full redraw), an upper bound of ipympl's frame rate, which
+then encodes a PNG per frame and sends it over the websocket.
+
+    python benchmarks/live_view.py [--seconds 10] [--cases mesh,cube10,cube20]
+
+Headless Chromium with --disable-gpu draws on the CPU and paces requestAnimationFrame at
+the display's 60 Hz at most, so 60 fps is the ceiling here.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+import urllib.request
+from pathlib import Path
+from tempfile import TemporaryDirectory
+
+import nbformat
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "viz"))
+from browser import jupyterlab_server, launch, run_notebook
+
+KERNEL = {"name": "python3", "display_name": "Python 3 (ipykernel)", "language": "python"}
+CASES = {
+    "mesh": ("gallery mesh (2-D, 100 particles)", "SCENES['mesh'].build()", 60),
+    "cube10": ("jelly cube 10³ (3-D)", "SCENES['jelly-cube'].build(size=10)", None),
+    "cube20": ("jelly cube 20³ (3-D)", "SCENES['jelly-cube'].build(size=20)", None),
+}
+CELL = """\
+from msdlab import viz
+from msdlab.scenes import SCENES
+
+live = viz.show({build}, steps_per_second={pace})
+"""
+COUNTS = "() => {const v = window.msdlabViews.at(-1); return [v.stats.frames, v.stats.updates, \
+performance.now()];}"
+
+
+def page_rate(page, seconds: float) -> tuple[float, float]:
+    """(frames drawn, position updates) a second in the page over ``seconds``."""
+    frames0, updates0, t0 = page.evaluate(COUNTS)
+    time.sleep(seconds)
+    frames1, updates1, t1 = page.evaluate(COUNTS)
+    elapsed = (t1 - t0) / 1000
+    return (frames1 - frames0) / elapsed, (updates1 - updates0) / elapsed
+
+
+def drag_delays(page, moves: int = 12) -> list[float]:
+    """Delays (ms) from mouse moves to the held particle's move on the page."""
+    canvas = page.locator(".msdlab-canvas")
+    box = canvas.bounding_box()
+    screen = np.array(
+        page.evaluate("() => Array.from(window.msdlabViews.at(-1).painter.screen)")
+    ).reshape(-1, 2) + (box["x"] + 1, box["y"] + 1)
+    particle = screen[int(np.argmax(screen[:, 0] - screen[:, 1]))]
+    page.mouse.move(*particle)
+    page.mouse.down()
+    time.sleep(0.5)
+    for i in range(1, moves + 1):
+        page.mouse.move(particle[0] - 15 * i, particle[1] - 5 * i)
+        time.sleep(0.3)
+    page.mouse.up()
+    return page.evaluate("() => window.msdlabViews.at(-1).stats.delays")
+
+
+def shut_down_kernels(url: str, token: str) -> None:
+    """Stop every kernel of the server: a case's stepping thread must not slow the next."""
+    with urllib.request.urlopen(f"{url}/api/kernels?token={token}") as answer:
+        kernels = json.load(answer)
+    for kernel in kernels:
+        request = urllib.request.Request(
+            f"{url}/api/kernels/{kernel['id']}?token={token}", method="DELETE"
+        )
+        urllib.request.urlopen(request).close()
+
+
+def agg_frame_time(build: str, pace: float | None, frames: int = 10) -> float:
+    """Seconds per frame of the matplotlib view on Agg: a frame's steps and a full draw."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from msdlab import viz
+    from msdlab.scenes import SCENES  # noqa: F401  (used by ``build``)
+
+    sim = eval(build)
+    dragger = viz.Dragger(sim, steps_per_second=pace or 1.0 / sim.dt)
+    dragger.advance()  # compiles
+    dragger.ax.figure.canvas.draw()
+    start = time.perf_counter()
+    for _ in range(frames):
+        time.sleep(1 / 60)  # a frame's worth of steps are due
+        dragger.advance()
+        dragger.ax.figure.canvas.draw()
+    return (time.perf_counter() - start) / frames - 1 / 60
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seconds", type=float, default=10.0)
+    parser.add_argument("--cases", default=",".join(CASES))
+    args = parser.parse_args()
+    from playwright.sync_api import sync_playwright
+
+    rows = []
+    with TemporaryDirectory() as folder, sync_playwright() as playwright:
+        tmp = Path(folder)
+        with jupyterlab_server(tmp) as (url, token):
+            browser = launch(playwright)
+            for key in args.cases.split(","):
+                label, build, pace = CASES[key]
+                notebook = nbformat.v4.new_notebook(metadata={"kernelspec": KERNEL})
+                notebook.cells = [nbformat.v4.new_code_cell(CELL.format(build=build, pace=pace))]
+                nbformat.write(notebook, tmp / f"{key}.ipynb")
+                page = browser.new_page(viewport={"width": 1300, "height": 1000})
+                page.set_default_timeout(120_000)
+                run_notebook(page, url, token, f"{key}.ipynb")
+                page.wait_for_function("() => window.msdlabViews?.at(-1)?.stats.updates > 20")
+                time.sleep(2)
+                fps, updates = page_rate(page, args.seconds)
+                delays = drag_delays(page) if key == "mesh" else []
+                page.screenshot(path=f"/tmp/live_view_{key}.png")
+                page.close()
+                shut_down_kernels(url, token)
+                agg = agg_frame_time(build, pace)
+                rows.append((label, fps, updates, delays, agg))
+                print(
+                    f"{label}: page {fps:.1f} fps, {updates:.1f} updates/s; "
+                    f"matplotlib on Agg {1000 * agg:.0f} ms/frame = {1 / agg:.1f} fps",
+                    flush=True,
+                )
+                if delays:
+                    print(
+                        f"  drag delay: median {np.median(delays):.0f} ms, "
+                        f"max {np.max(delays):.0f} ms over {len(delays)} moves",
+                        flush=True,
+                    )
+            browser.close()
+
+
+if __name__ == "__main__":
+    main()

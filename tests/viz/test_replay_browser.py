@@ -1,0 +1,60 @@
+"""The replay page in headless Chromium, offline, from file://: it draws, plays, scrubs and
+orbits, and asks the network for nothing."""
+
+import time
+
+import pytest
+from browser import launch, needs
+
+import msdlab as msd
+from msdlab import viz
+
+pytestmark = [*needs("playwright"), pytest.mark.timeout(120)]
+
+
+@pytest.fixture(scope="module")
+def replay_file(tmp_path_factory):
+    body = msd.Body.grid((4, 4, 4), spacing=0.1, stiffness=800.0)
+    body.positions += (0.0, 0.3, 0.0)
+    gravity = [msd.Gravity((0.0, -9.81, 0.0)), msd.Ground(0.0)]
+    run = msd.Simulation(body, msd.Verlet(0.01), dt=2e-3, forces=gravity).run(
+        steps=300, record_every=10
+    )
+    return viz.save_animation(run, tmp_path_factory.mktemp("replay") / "cube.html", fps=30)
+
+
+def test_the_replay_page_plays_scrubs_and_orbits_offline(replay_file):
+    from playwright.sync_api import sync_playwright
+
+    requests: list[str] = []
+    with sync_playwright() as playwright:
+        browser = launch(playwright)
+        try:
+            context = browser.new_context()
+            context.set_offline(True)
+            page = context.new_page()
+            page.on("request", lambda request: requests.append(request.url))
+            errors: list[str] = []
+            page.on("pageerror", lambda error: errors.append(str(error)))
+            page.goto(replay_file.as_uri())
+            status = page.locator(".msdlab-status")
+            page.wait_for_function("() => window.msdlabViews?.[0]?.stats.drawn > 5")
+            first = int(status.get_attribute("data-frame"))
+            time.sleep(0.5)
+            assert int(status.get_attribute("data-frame")) != first  # it plays
+            page.get_by_text("❚❚ pause").click()
+            scrub = page.locator(".msdlab-scrub")
+            scrub.evaluate("(s) => { s.value = 7; s.dispatchEvent(new Event('input')); }")
+            time.sleep(0.2)
+            assert status.get_attribute("data-frame") == "7"  # scrubbed, and paused there
+            azimuth = page.evaluate("() => window.msdlabViews[0].camera.azimuth")
+            box = page.locator(".msdlab-canvas").bounding_box()
+            page.mouse.move(box["x"] + 5, box["y"] + 5)  # a corner: no particle there
+            page.mouse.down()
+            page.mouse.move(box["x"] + 105, box["y"] + 5, steps=5)
+            page.mouse.up()
+            assert page.evaluate("() => window.msdlabViews[0].camera.azimuth") != azimuth
+        finally:
+            browser.close()
+    assert not errors
+    assert all(url.startswith(("file:", "blob:", "data:")) for url in requests), requests
