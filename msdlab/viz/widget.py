@@ -113,6 +113,7 @@ class LiveView(anywidget.AnyWidget):
         self._look = (view, up, energy_unit)
         self._commands: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
         self._stop = threading.Event()
+        self._wake = threading.Event()  # set by the page's requests and by `stop`
         self._thread: threading.Thread | None = None
         self._values: dict[str, float] = {}
         self._frames = 0
@@ -222,6 +223,7 @@ class LiveView(anywidget.AnyWidget):
             self._commands.put(command)
             if self._thread is None:
                 self.do_pending()
+            self._wake.set()  # a frame now: the hand should not wait for the next one
 
     def grab_release(self) -> None:
         self.grab.release()
@@ -267,6 +269,7 @@ class LiveView(anywidget.AnyWidget):
     def stop(self) -> None:
         """Stop stepping (the page keeps drawing the last frame)."""
         self._stop.set()
+        self._wake.set()
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(timeout=5)
         self._thread = None
@@ -274,8 +277,9 @@ class LiveView(anywidget.AnyWidget):
     def _loop(self) -> None:
         while not self._stop.is_set():
             began = time.perf_counter()
+            self._wake.clear()
             self.frame()
-            self._stop.wait(max(0.0, 1.0 / FRAME_RATE - (time.perf_counter() - began)))
+            self._wake.wait(max(0.0, 1.0 / FRAME_RATE - (time.perf_counter() - began)))
 
 
 def in_notebook() -> bool:
