@@ -1,9 +1,10 @@
 """Frames per second of the live widget, counted in the page, and the delay of a drag.
 
 Runs JupyterLab and headless Chromium (as tests/viz/test_widget_browser.py does), shows
-each case with `viz.show` in a fresh notebook and counts, over ``--seconds``, the frames
-the page drew (requestAnimationFrame callbacks) and the new positions it received from
-Python. For the mesh it then presses on a particle and moves the mouse 15 px every 0.3 s:
+each case with `viz.show` in a fresh notebook, at 60 steps a second (the gallery's frames;
+the template cube's steps of dt = 0.4, whose real time would be 2.5 steps a second), and
+counts, over ``--seconds``, the frames the page drew (requestAnimationFrame callbacks)
+and the new positions it received from Python. For the mesh it then presses on a particle and moves the mouse 15 px every 0.3 s:
 the delay is the time from a mouse move to the first frame showing the held particle where
 that move put it (the page's request, the kernel, a step, the positions back, a draw).
 Beside it, the matplotlib view measured on the Agg canvas alone: the time of one frame
@@ -35,8 +36,8 @@ from browser import jupyterlab_server, launch, run_notebook
 KERNEL = {"name": "python3", "display_name": "Python 3 (ipykernel)", "language": "python"}
 CASES = {
     "mesh": ("gallery mesh (2-D, 100 particles)", "SCENES['mesh'].build()", 60),
-    "cube10": ("jelly cube 10³ (3-D)", "SCENES['jelly-cube'].build(size=10)", None),
-    "cube20": ("jelly cube 20³ (3-D)", "SCENES['jelly-cube'].build(size=20)", None),
+    "cube10": ("jelly cube 10³ (3-D)", "SCENES['jelly-cube'].build(size=10)", 60),
+    "cube20": ("jelly cube 20³ (3-D)", "SCENES['jelly-cube'].build(size=20)", 60),
 }
 CELL = """\
 from msdlab import viz

@@ -162,15 +162,15 @@ class LiveView(anywidget.AnyWidget):
         return self.pace if self.pace is not None else 1.0 / self.sim.dt
 
     def publish(self, energy: bool = True) -> None:
-        """Send the positions (float32 buffer), the status line and, if ``energy``, the
-        energies (they cost a force evaluation: the thread sends them every
-        `ENERGY_EVERY` frames)."""
+        """Send the positions (float32 buffer) and, if ``energy``, the energies and the
+        status line (the energies cost a force evaluation, the line a layout of the page:
+        the thread sends them every `ENERGY_EVERY` frames)."""
         sim = self.sim
         with self.hold_sync():
             self.positions = sim.body.positions.astype(np.float32).tobytes()
             if energy:
                 self.energy = energies(sim, self._taken, self._level)
-            self.status = f"t = {sim.time:.4g}   steps {sim.step_count}"
+                self.status = f"t = {sim.time:.4g}   steps {sim.step_count}"
 
     def advance(self, seconds: float, budget: float = BUDGET) -> int:
         """Step for ``seconds`` of wall-clock time at the pace (at most ``budget`` s of
