@@ -3,10 +3,11 @@
 Runs JupyterLab and headless Chromium (as tests/viz/test_widget_browser.py does), shows
 each case with `viz.show` in a fresh notebook, at 60 steps a second (the gallery's frames;
 the template cube's steps of dt = 0.4, whose real time would be 2.5 steps a second), and
-counts, over ``--seconds``, the frames the page drew (requestAnimationFrame callbacks)
-and the new positions it received from Python. For the mesh it then presses on a particle and moves the mouse 15 px every 0.3 s:
-the delay is the time from a mouse move to the first frame showing the held particle where
-that move put it (the page's request, the kernel, a step, the positions back, a draw).
+counts, over ``--seconds``, the frames the page drew (requestAnimationFrame callbacks) and
+the new positions it received from Python. For the mesh it then presses on a particle and
+moves the mouse 15 px every 0.3 s: the delay is the time from a mouse move to the first
+frame showing the held particle where that move put it (the page's request, the kernel, a
+step, the positions back, a draw).
 Beside it, the matplotlib view measured on the Agg canvas alone: the time of one frame
 (the steps of a frame and a full redraw), an upper bound of ipympl's frame rate, which
 then encodes a PNG per frame and sends it over the websocket.
