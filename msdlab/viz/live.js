@@ -10,6 +10,7 @@ const LEVELS = 64;
 const PICK_RADIUS = 25; // px: how near the mouse a particle must be to be taken
 const HISTORY = 600; // points of the energy plot
 const DENSE = 3000; // springs from which lines are written as pixels (`Pixels`)
+const SURFACE_ONLY = 30000; // springs from which a 3-D body is drawn by its surface
 
 /** A typed array of `Type` over a DataView, ArrayBuffer or typed array. */
 function typed(data, Type) {
@@ -97,6 +98,21 @@ class Camera {
   }
 }
 
+/** The springs and particles to draw: all, or (`outside`) those on the body's surface,
+ * whose particles have fewer springs than the most any has: inside a very dense 3-D body
+ * nothing shows, and its springs would cost most of a frame. */
+function surface(springs, n, outside) {
+  const all = (count) => Uint32Array.from({ length: count }, (_, i) => i);
+  if (!outside) return { springs: all(springs.length / 2), particles: all(n) };
+  const degree = new Uint32Array(n);
+  for (const p of springs) degree[p]++;
+  const most = degree.reduce((a, b) => Math.max(a, b), 0);
+  const particles = all(n).filter((i) => degree[i] < most);
+  const kept = all(springs.length / 2).filter(
+    (e) => degree[springs[2 * e]] < most && degree[springs[2 * e + 1]] < most);
+  return { springs: kept, particles };
+}
+
 /** A canvas's pixels as 32-bit words, for drawing many 1-px lines fast. */
 class Pixels {
   constructor(canvas, colours) {
@@ -165,6 +181,7 @@ class Painter {
     this.counts = new Uint32Array(LEVELS + 1);
     this.dense = rest.length > DENSE;
     if (this.dense) this.pixels = new Pixels(canvas, scene.colours);
+    this.shown = surface(springs, this.n, scene.dim === 3 && rest.length > SURFACE_ONLY);
   }
 
   draw(camera, positions, held) {
@@ -194,8 +211,9 @@ class Painter {
       camera.project(new Float32Array([...from, ...to]), 2, px, new Float32Array(2));
       pixels.line(px[0], px[1], px[2], px[3], pixels.dark);
     }
-    for (let e = 0; e < rest.length; e++) {
-      const a = springs[2 * e], b = springs[2 * e + 1];
+    const { springs: shown, particles } = this.shown;
+    for (let s = 0; s < shown.length; s++) {
+      const e = shown[s], a = springs[2 * e], b = springs[2 * e + 1];
       let sum = 0;
       for (let k = 0; k < d; k++) sum += (x[d * a + k] - x[d * b + k]) ** 2;
       const level = Math.floor(((Math.sqrt(sum) / rest[e] - 1 + limit) / (2 * limit)) * LEVELS);
@@ -203,7 +221,7 @@ class Painter {
       pixels.line(screen[2 * a], screen[2 * a + 1], screen[2 * b], screen[2 * b + 1], colour);
     }
     const size = this.n > 2000 ? 1 : 2; // a dense body: its springs show between the dots
-    for (let i = 0; i < this.n; i++) pixels.dot(screen[2 * i], screen[2 * i + 1], pixels.dotColour, size);
+    for (const i of particles) pixels.dot(screen[2 * i], screen[2 * i + 1], pixels.dotColour, size);
     pixels.show();
   }
 
