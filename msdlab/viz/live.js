@@ -21,10 +21,24 @@ function typed(data, Type) {
   return new Type(buffer, offset, length);
 }
 
-/** Bytes of a base64 string (the replay page's arrays). */
-export function fromBase64(text, Type) {
+/** An array of `Type` from deflated bytes in base64 (the replay page's arrays). */
+async function inflate(text, Type) {
   const bytes = Uint8Array.from(atob(text), (c) => c.charCodeAt(0));
-  return new Type(bytes.buffer);
+  const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("deflate"));
+  return new Type(await new Response(stream).arrayBuffer());
+}
+
+/** Positions (float32) from 16-bit steps above `low` (per axis), each frame of
+ * `frameSize` numbers stored as its change from the frame before (mod 2^16). */
+function positionsOf(changes, frameSize, low, step) {
+  const d = low.length, out = new Float32Array(changes.length);
+  const level = new Uint16Array(frameSize);
+  for (let i = 0; i < changes.length; i++) {
+    const k = i % frameSize;
+    level[k] += changes[i]; // wraps as the differences did
+    out[i] = low[k % d] + level[k] * step[k % d];
+  }
+  return out;
 }
 
 function element(tag, attributes = {}, parent = null) {
@@ -590,15 +604,15 @@ function controls(parent, model, send) {
 }
 
 /** The replay page's player: recorded frames, play / pause, a scrubber, orbiting. */
-export function replay(el, data) {
+export async function replay(el, data) {
   const scene = data.scene;
   const arrays = {
-    springs: fromBase64(data.springs, Int32Array),
-    rest: fromBase64(data.rest, Float32Array),
-    fixed: fromBase64(data.fixed, Uint8Array),
+    springs: await inflate(data.springs, Int32Array),
+    rest: await inflate(data.rest, Float32Array),
+    fixed: await inflate(data.fixed, Uint8Array),
   };
-  const frames = fromBase64(data.frames, Float32Array);
   const size = arrays.fixed.length * scene.dim, count = data.times.length;
+  const frames = positionsOf(await inflate(data.frames, Uint16Array), size, data.low, data.step);
   let index = 0, playing = true, start = performance.now();
   const frameAt = (i) => frames.subarray(i * size, (i + 1) * size);
   const view = mountView(el, scene, arrays, { latest: () => frameAt(index) });

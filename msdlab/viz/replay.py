@@ -1,8 +1,9 @@
 """A recorded run as a self-contained HTML page drawn by the live view's front end.
 
-The page holds the positions (float32, base64) and the body's springs, not
-pictures, and the front end (``live.js``) itself: it plays, pauses, scrubs
-and, in 3-D, orbits and zooms, with no network. The module is loaded from its
+The page holds the positions (16-bit steps across the run's box, frame to frame
+differences, deflated, in base64) and the body's springs, not pictures, and the
+front end (``live.js``) itself: it plays, pauses, scrubs and, in 3-D, orbits and
+zooms, with no network. The module is loaded from its
 own text in the page (a blob: URL), so the page also works from file://.
 """
 
@@ -10,6 +11,7 @@ from __future__ import annotations
 
 import base64
 import json
+import zlib
 from collections.abc import Sequence
 from html import escape
 
@@ -31,16 +33,27 @@ const text = document.getElementById("msdlab-module").textContent;
 const url = URL.createObjectURL(new Blob([text], {{ type: "text/javascript" }}));
 const {{ replay }} = await import(url);
 const data = JSON.parse(document.getElementById("msdlab-data").textContent);
-replay(document.getElementById("msdlab-replay"), data);
+await replay(document.getElementById("msdlab-replay"), data);
 </script>
 </body>
 </html>
 """
 
 
-def _base64(array: np.ndarray | bytes) -> str:
-    data = array if isinstance(array, bytes) else np.ascontiguousarray(array).tobytes()
-    return base64.b64encode(data).decode("ascii")
+def _packed(data: bytes) -> str:
+    """``data`` deflated (zlib) and in base64: the page inflates it (DecompressionStream)."""
+    return base64.b64encode(zlib.compress(data, 9)).decode("ascii")
+
+
+def quantised(frames: np.ndarray) -> tuple[bytes, list[float], list[float]]:
+    """Positions (F, N, d) as uint16 steps of (high - low) / 65535 per axis above ``low``,
+    each frame as its difference from the one before (mod 2¹⁶: small numbers, which deflate
+    well); the bytes, ``low`` and the step. A 20-unit cube is kept to 0.3 thousandths."""
+    low, high = frames.min(axis=(0, 1)), frames.max(axis=(0, 1))
+    step = np.where(high > low, (high - low) / 65535, 1.0)
+    levels = np.round((frames - low) / step).astype(np.uint16)
+    changes = np.concatenate([levels[:1], np.diff(levels, axis=0)])  # wraps mod 2¹⁶
+    return changes.tobytes(), low.tolist(), step.tolist()
 
 
 def replay_page(
@@ -69,10 +82,13 @@ def replay_page(
     )
     scene["span"] = float(np.max(np.ptp(frames.reshape(-1, body.dim), axis=0))) * 1.1 or 1.0
     scene["centre"] = (0.5 * (frames.min(axis=(0, 1)) + frames.max(axis=(0, 1)))).tolist()
+    changes, low, step = quantised(frames)
     data = {
         "scene": scene,
-        **{name: _base64(value) for name, value in frontend.body_arrays(body).items()},
-        "frames": _base64(frames),
+        **{name: _packed(value) for name, value in frontend.body_arrays(body).items()},
+        "frames": _packed(changes),
+        "low": low,
+        "step": step,
         "times": trajectory.times[picks].tolist(),
         "fps": fps,
         "unit": time_unit,

@@ -213,7 +213,7 @@ class LiveView(anywidget.AnyWidget):
         handlers = {
             "grab": lambda: self.grab.hold(self.sim.body, content["particle"], content["target"]),
             "move": lambda: self.grab.particle is not None and self.grab.move(content["target"]),
-            "release": self.grab_release,
+            "release": lambda: self.grab.release(),
             "step": self.step_once,
             "reset": self.reset,
             "set": lambda: self.set(content["name"], content["value"]),
@@ -224,9 +224,6 @@ class LiveView(anywidget.AnyWidget):
             if self._thread is None:
                 self.do_pending()
             self._wake.set()  # a frame now: the hand should not wait for the next one
-
-    def grab_release(self) -> None:
-        self.grab.release()
 
     def step_once(self) -> None:
         """One step, paused or not."""

@@ -4,6 +4,7 @@ import base64
 import json
 import re
 import shutil
+import zlib
 
 import numpy as np
 import pytest
@@ -39,8 +40,11 @@ def test_html_is_a_self_contained_replay_of_positions(rope_run, tmp_path):
     assert '<script type="module">' in page and "data:image/png" not in page
     assert "http" not in page  # no icons or scripts from the web: it plays offline
     data = json.loads(re.search(r'id="msdlab-data">(.*?)</script>', page).group(1))
-    frames = np.frombuffer(base64.b64decode(data["frames"]), np.float32)
-    np.testing.assert_allclose(frames.reshape(4, -1, 2)[-1], rope_run.positions[-1], rtol=1e-6)
+    changes = np.frombuffer(zlib.decompress(base64.b64decode(data["frames"])), np.uint16)
+    levels = np.cumsum(changes.reshape(4, -1, 2), axis=0, dtype=np.uint16)  # mod 2¹⁶
+    last = data["low"] + levels[-1] * np.array(data["step"])
+    span = np.ptp(rope_run.positions, axis=(0, 1))
+    np.testing.assert_allclose(last, rope_run.positions[-1], atol=float(span.max()) / 65535)
 
 
 def test_to_html_is_inline_html_and_leaves_no_figure_open(rope_run):

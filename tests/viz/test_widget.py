@@ -137,4 +137,4 @@ def test_the_replay_page_holds_positions_and_asks_the_network_for_nothing(tmp_pa
     page = viz.save_animation(run, tmp_path / "mesh.html", time_unit="frames").read_text()
     assert "data:image/png" not in page
     assert not re.search(r"(src|href)=\"?https?:", page)
-    assert '"frames": "' in page and "export function replay" in page
+    assert '"frames": "' in page and "export async function replay" in page
