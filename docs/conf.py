@@ -23,6 +23,7 @@ release = "0.1.0"
 extensions = [
     "myst_nb",
     "sphinx.ext.autodoc",
+    "sphinx.ext.autosummary",
     "sphinx.ext.mathjax",
     "sphinx_gallery.gen_gallery",
     "architecture",
@@ -87,6 +88,13 @@ def copy_mathjax() -> None:
 copy_mathjax()
 html_static_path = ["_static", str(LOCAL_MATHJAX)]
 mathjax_path = "mathjax/MathJax.js?config=TeX-AMS_CHTML"
+# MathJax 2 reads these class names (myst-nb marks its pages for MathJax 3's names).
+mathjax2_config = {
+    "tex2jax": {
+        "processClass": "tex2jax_process|mathjax_process|math|output_area",
+        "ignoreClass": "tex2jax_ignore|mathjax_ignore",
+    }
+}
 
 sphinx_gallery_conf = {
     "examples_dirs": "scenes",
@@ -99,8 +107,12 @@ sphinx_gallery_conf = {
     "show_signature": False,
     "within_subsection_order": "FileNameSortKey",
     "write_computation_times": False,
+    "capture_repr": (),
 }
 
+# The API reference: one page per module (docs/api/index.md lists them), made at build time.
+autosummary_generate = True
+templates_path = ["_templates"]
 autodoc_default_options = {"members": True, "show-inheritance": True}
 autodoc_member_order = "bysource"
 autodoc_typehints = "description"
@@ -110,7 +122,6 @@ html_theme = "pydata_sphinx_theme"
 html_title = "msdlab"
 html_logo = "_static/jelly.png"
 html_favicon = "_static/jelly.png"
-html_css_files = ["offline.css"]
 html_theme_options = {
     "navbar_align": "left",
     "show_toc_level": 2,

@@ -1,10 +1,10 @@
-"""
+r"""
 Jelly cube
 ==========
 
 The brief's 20³ grid, rotated 58.3°, 26 neighbours, damped Verlet, lands on the floor.
 
-`msdlab.scenes.jelly.jelly_cube`: A ``size``³ jelly cube rotated by ``angle`` degrees about
+`msdlab.scenes.jelly.jelly_cube`: A ``size``\ ³ jelly cube rotated by ``angle`` degrees about
 ``axis``, above the floor y = 0.
 
 The gallery drops a 10³ cube (the scene's default is the brief's 20³) so that the page

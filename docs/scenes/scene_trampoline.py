@@ -1,11 +1,11 @@
-"""
+r"""
 Trampoline
 ==========
 
 A 1 kg ball dropped on a pre-tensioned 7×7 net with a fixed rim (--experiments).
 
 `msdlab.scenes.trampoline.trampoline`: A ball (the last particle, `BALL`) over a
-``size``×``size`` net with spacing 1 m, z up.
+``size``\ ×\ ``size`` net with spacing 1 m, z up.
 
 ``msdlab run trampoline --experiments`` runs the report's seven experiments and prints their
 outcomes as a table.
