@@ -33,7 +33,7 @@ def draw(path: Path) -> None:
     from matplotlib.patches import FancyBboxPatch
 
     height, gap = 0.9, 0.35
-    figure, ax = plt.subplots(figsize=(8.0, 6.4))
+    figure, ax = plt.subplots(figsize=(7.2, 5.8))
     colours = plt.get_cmap("Blues")
     for level, (name, holds) in enumerate(LAYERS):
         y = level * (height + gap)
@@ -48,7 +48,7 @@ def draw(path: Path) -> None:
             )
         )
         ax.text(0.25, y + height * 0.62, name, fontsize=12, weight="bold", va="center")
-        ax.text(0.25, y + height * 0.28, holds, fontsize=8.5, va="center", color="#222222")
+        ax.text(0.25, y + height * 0.28, holds, fontsize=9, va="center", color="#222222")
         if level:
             ax.annotate(
                 "",

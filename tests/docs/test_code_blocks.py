@@ -1,4 +1,4 @@
-"""The Python examples of the documentation run as written.
+"""The Python examples of the documentation and the README run as written.
 
 Each page's ```python blocks run in order, in one namespace, in a fresh folder, with no
 display. A block that starts with ``# Needs a display`` or ``# Sketch`` is left out.
@@ -14,7 +14,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-DOCS = Path(__file__).resolve().parents[2] / "docs"
+ROOT = Path(__file__).resolve().parents[2]
+DOCS = ROOT / "docs"
 SKIP = ("# Needs a display", "# Sketch")
 
 
@@ -23,17 +24,18 @@ def python_blocks(page: Path) -> list[str]:
     return [block for block in blocks if not block.startswith(SKIP)]
 
 
-PAGES = sorted(
+PAGES = [ROOT / "README.md"] + sorted(
     page for page in DOCS.rglob("*.md") if "_build" not in page.parts and python_blocks(page)
 )
 
 
-def test_the_engine_pages_show_python():
+def test_the_readme_and_the_engine_pages_show_python():
+    assert python_blocks(ROOT / "README.md")
     assert DOCS / "engine" / "example.md" in PAGES
     assert DOCS / "engine" / "scenes.md" in PAGES
 
 
-@pytest.mark.parametrize("page", PAGES, ids=lambda page: str(page.relative_to(DOCS)))
+@pytest.mark.parametrize("page", PAGES, ids=lambda page: str(page.relative_to(ROOT)))
 def test_page_examples_run(page, tmp_path):
     """The page's blocks as one script; files it names (.png, .gif, ...) are written."""
     script = "\n".join(python_blocks(page))
