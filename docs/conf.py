@@ -31,8 +31,14 @@ extensions = [
 ]
 
 # scenes/ holds the gallery's sources; gallery/ its generated pages, whose .ipynb downloads
-# are not pages of the site.
-exclude_patterns = ["_build", "**.ipynb_checkpoints", "scenes", "gallery/*.ipynb"]
+# are not pages of the site, nor are timing tables (they load their styles from a CDN).
+exclude_patterns = [
+    "_build",
+    "**.ipynb_checkpoints",
+    "scenes",
+    "gallery/*.ipynb",
+    "**sg_execution_times.rst",
+]
 suppress_warnings = ["mystnb.unknown_mime_type"]
 default_role = "py:obj"  # `name` links to the API where it can, plain code otherwise
 

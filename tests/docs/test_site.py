@@ -117,18 +117,3 @@ def test_page_loads_nothing_from_the_network(kind, server, browser, tmp_path):
     assert not failed, f"{kind}: requests that failed: {failed}"
     assert not broken, f"{kind}: pictures that did not load: {broken}"
     assert "msdlab" in title
-
-
-def test_gallery_pages_show_a_picture_and_an_animation(site):
-    for scene in sorted((site / "gallery").glob("scene_*.html")):
-        html = scene.read_text(encoding="utf-8")
-        assert ".png" in html, f"{scene.name}: no picture"
-        assert ".gif" in html, f"{scene.name}: no animation"
-
-
-def test_every_scene_has_a_gallery_example():
-    from msdlab.scenes import SCENES
-
-    examples = Path(__file__).resolve().parents[2] / "docs" / "scenes"
-    names = {path.stem.removeprefix("scene_") for path in examples.glob("scene_*.py")}
-    assert names == {name.replace("-", "_") for name in SCENES}
