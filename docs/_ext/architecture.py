@@ -32,11 +32,19 @@ def draw(path: Path) -> None:
     import matplotlib.pyplot as plt
     from matplotlib.patches import FancyBboxPatch
 
-    height, gap = 0.9, 0.35
+    gap, line = 0.35, 0.3
     figure, ax = plt.subplots(figsize=(7.2, 5.8))
     colours = plt.get_cmap("Blues")
+    y = 0.0
     for level, (name, holds) in enumerate(LAYERS):
-        y = level * (height + gap)
+        height = 0.6 + line * (holds.count("\n") + 1)
+        if level:
+            ax.annotate(
+                "",
+                xy=(9.4, y - gap + 0.02),
+                xytext=(9.4, y - 0.02),
+                arrowprops={"arrowstyle": "-|>", "color": "#1f4e79"},
+            )
         ax.add_patch(
             FancyBboxPatch(
                 (0.0, y),
@@ -47,17 +55,11 @@ def draw(path: Path) -> None:
                 edgecolor="#1f4e79",
             )
         )
-        ax.text(0.25, y + height * 0.62, name, fontsize=12, weight="bold", va="center")
-        ax.text(0.25, y + height * 0.28, holds, fontsize=9, va="center", color="#222222")
-        if level:
-            ax.annotate(
-                "",
-                xy=(9.4, y - gap + 0.02),
-                xytext=(9.4, y - 0.02),
-                arrowprops={"arrowstyle": "-|>", "color": "#1f4e79"},
-            )
-    ax.text(9.55, gap * 0.5 + height, "imports", fontsize=8, va="center", color="#1f4e79")
-    top = len(LAYERS) * (height + gap)
+        ax.text(0.25, y + height - 0.28, name, fontsize=12, weight="bold", va="center")
+        ax.text(0.25, y + 0.15, holds, fontsize=9, va="bottom", color="#222222", linespacing=1.4)
+        y += height + gap
+    ax.text(9.55, 0.6 + line * 2 + gap / 2, "imports", fontsize=8, va="center", color="#1f4e79")
+    top = y
     ax.set_xlim(-0.1, 10.1)
     ax.set_ylim(-0.1, top - gap + 0.1)
     ax.axis("off")
