@@ -39,7 +39,6 @@ exclude_patterns = [
     "gallery/*.ipynb",
     "**sg_execution_times.rst",
 ]
-suppress_warnings = ["mystnb.unknown_mime_type"]
 default_role = "py:obj"  # `name` links to the API where it can, plain code otherwise
 
 # MyST: $...$ maths, ::: fences, heading anchors for [text](page.md#anchor) links.
