@@ -35,12 +35,8 @@ class Ground(Constraint):
     particle's mean velocity over the step. A particle held at rest gets no
     work; one that lands loses energy, and with Verlet the ground never puts
     any in (the mean normal velocity is (x(t+dt) - x(t-dt))·n/2dt ≤ 0 when
-    x(t+dt) is on the plane and x(t-dt) was not below it). The clamp itself was
-    right; the earlier bookkeeping was not: it compared the energy before and
-    after the clamp with the velocity estimate v + ½a·dt, whose a leaves out
-    the ground's push, so a body at rest booked -¼ k (a·dt²)² per particle and
-    step ("ground" went negative and the drift grew for as long as it rested).
-    Friction books the kinetic energy it takes out of the tangential velocity.
+    x(t+dt) is on the plane and x(t-dt) was not below it). A body at rest on the
+    ground books nothing. Friction books the kinetic energy it takes out of the tangential velocity.
     """
 
     ledger_name = "ground"
@@ -148,11 +144,6 @@ class Walls(Constraint):
     a particle at rest, a loss for one that comes to rest. So walls never put
     energy in, and a body resting on them keeps every ledger entry still.
 
-    The earlier rule (keep the speed, turn it inward) was a wrong contact
-    model, not a bookkeeping slip: a particle resting on a wall got back the
-    speed its weight gave it in the step, so resting bodies jittered, every
-    step put energy in (walls < 0 in the ledger) and the drag took it out again.
-
     Periodic wrapping moves a particle across the box but not its springs, which
     then stretch across the whole box (as on the p5.js page); use it for loose
     particles, not for connected bodies.
@@ -253,7 +244,7 @@ class Grab(Constraint):
     target, and its velocity is the target's displacement over the step / dt,
     so dashpots and the ledger ("driven") see the hand's motion. On release it
     keeps that velocity: zero if the hand was still, so it does not fling with
-    the spring forces it resisted while held (the bug of pegging the position only).
+    the spring forces it resisted while held.
     """
 
     ledger_name = "driven"

@@ -1,0 +1,36 @@
+"""The documentation site, built once per test session (sphinx-build -W, as CI builds it)."""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+DOCS = Path(__file__).resolve().parents[2] / "docs"
+MISSING = [
+    name
+    for name in ("sphinx", "pydata_sphinx_theme", "myst_nb", "sphinx_gallery")
+    if importlib.util.find_spec(name) is None
+]
+
+
+@pytest.fixture(scope="session")
+def site(tmp_path_factory) -> Path:
+    """The built HTML site: ``sphinx-build -W --keep-going -b html docs OUT``.
+
+    Fails with Sphinx's warnings if there are any: a broken reference, a docstring reST
+    cannot read, a gallery example that raises.
+    """
+    if MISSING:
+        pytest.skip(f"needs {', '.join(MISSING)} to build the docs (pip install -e '.[docs]')")
+    out = tmp_path_factory.mktemp("docs") / "html"
+    command = [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html"]
+    command += ["-d", str(out.parent / "doctrees"), str(DOCS), str(out)]
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    result = subprocess.run(command, capture_output=True, text=True, env=env, timeout=1200)
+    assert result.returncode == 0, f"sphinx-build failed:\n{result.stdout}\n{result.stderr}"
+    return out
