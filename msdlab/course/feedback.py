@@ -65,6 +65,12 @@ def relative_error(got: np.ndarray, expected: np.ndarray) -> float:
 
 def as_array(value: object, what: str, shape: tuple[int, ...] | None = None) -> np.ndarray:
     """``value`` as a float array, or a `CheckFailed` saying what came back instead."""
+    expect(
+        not np.iscomplexobj(value),
+        saw=f"{what} returned complex numbers",
+        cause="a square root or power of a negative number; positions, forces and "
+        "accelerations are real",
+    )
     try:
         array = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -79,6 +85,23 @@ def as_array(value: object, what: str, shape: tuple[int, ...] | None = None) -> 
         cause="dividing by a zero spring length or a zero time step",
     )
     return array
+
+
+def expect_physics(got: np.ndarray, expected: np.ndarray, what: str, law: str) -> None:
+    """Fail unless ``got`` is about as large as ``expected`` (within a factor 4).
+
+    A property check calls it first: zeros, constants or the input returned unchanged
+    satisfy many properties (no net force, rotation invariance) without any physics.
+    """
+    size = float(np.linalg.norm(np.asarray(got, dtype=float)))
+    wanted = float(np.linalg.norm(np.asarray(expected, dtype=float)))
+    expect(
+        wanted / 4 <= size <= 4 * wanted,
+        saw=f"{what} has size {num(size)} where {law} gives {num(wanted)}: the property "
+        "checked here holds trivially for such an answer, so it earns no point until the "
+        "answer has the size of the physics",
+        cause="an answer that is all zeros, a constant, or the input returned unchanged",
+    )
 
 
 def matching_variant(

@@ -72,13 +72,21 @@ def template_kernel(old: np.ndarray, current: np.ndarray, dt: float, a: np.ndarr
     return current + dt * v
 
 
+def floor_clamped(positions: np.ndarray) -> np.ndarray:
+    """``positions`` with the template's floor y >= 0 applied."""
+    clamped = positions.copy()
+    clamped[..., 1] = np.maximum(clamped[..., 1], 0.0)
+    return clamped
+
+
 @pytest.mark.points(2)
 def test_verlet_step_is_the_kernel(task1):
     """verlet_step (eq. 1.3) gives the same new positions as the template's kernel."""
     rng = np.random.default_rng(1)
     a = np.array([0.01, -0.001, 0.002])
-    for shape, dt in (((4, 3, 5, 3), DT), ((7, 3), 0.37)):  # the step is an argument too
-        current = rng.uniform(-1.0, 1.0, shape) + np.array([0.0, 5.0, 0.0])
+    cases = (((4, 3, 5, 3), DT, 5.0), ((7, 3), 0.37, 5.0), ((6, 3), DT, 0.0))
+    for shape, dt, lift in cases:  # dt is an argument too; lift 0: some cross the floor
+        current = rng.uniform(-1.0, 1.0, shape) + np.array([0.0, lift, 0.0])
         old = current - 0.05 * rng.standard_normal(shape)
         expected = template_kernel(old, current, dt, a)
         got = as_array(task1.verlet_step(old.copy(), current.copy(), dt, tuple(a)), "verlet_step")
@@ -94,6 +102,8 @@ def test_verlet_step_is_the_kernel(task1):
                 f"the template's dt = {DT} instead of the dt argument": (
                     2 * current - old + a * DT**2
                 ),
+                "the floor clamp y = max(y, 0) copied from the template's kernel: task 1's "
+                "verlet_step leaves the floor out": floor_clamped(expected),
             },
         )
         expect(

@@ -106,6 +106,13 @@ def test_verlet_step_leaves_its_inputs_alone(task1):
     old = current - 0.01
     kept_old, kept_current = old.copy(), current.copy()
     got = as_array(task1.verlet_step(old, current, 0.1, (0.0, -0.001, 0.0)), "verlet_step")
+    expected = 2.0 * kept_current - kept_old + np.array([0.0, -0.001, 0.0]) * 0.1**2
+    expect(
+        got.shape == expected.shape and np.allclose(got, expected, rtol=1e-9, atol=1e-12),
+        saw="verlet_step does not return eq. (1.3)'s new positions (see its other checks); "
+        "leaving the inputs alone earns a point only together with the step itself",
+        cause="an answer that returns zeros, a constant or one of its inputs",
+    )
     expect(
         np.array_equal(old, kept_old) and np.array_equal(current, kept_current),
         saw="verlet_step changed the arrays it was given",
@@ -146,6 +153,15 @@ def test_steps_to_floor_refuses_a_start_on_or_below_the_floor(task1):
         (-0.5, 0.1, -0.001, "a particle that starts below the floor"),
         (1.0, 0.1, 0.0, "a particle that does not fall (g = 0)"),
         (1.0, 0.0, -0.001, "a time step of 0"),
+    )
+    first = reference.first_floor_contact(1.0, 0.1, -0.001)
+    got = task1.steps_to_floor(1.0, 0.1, -0.001)
+    expect(
+        got == first,
+        saw=f"steps_to_floor(1.0, 0.1, -0.001) = {got!r} where the template first reaches the "
+        f"floor in step {first}: refusing bad starts earns a point only together with "
+        "counting the good ones",
+        cause="an answer that returns a constant, or the refusal without the count",
     )
     for y0, dt, g, what in cases:
         call = f"steps_to_floor({y0}, {dt}, {g})"

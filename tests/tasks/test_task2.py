@@ -12,6 +12,7 @@ from msdlab.course import oracles
 from msdlab.course.feedback import (
     as_array,
     expect,
+    expect_physics,
     grid_place,
     matching_variant,
     num,
@@ -44,6 +45,12 @@ def student_acceleration(task2, x, spacing, stiffness):
     return as_array(got, "spring_acceleration", x.shape)
 
 
+def expect_spring_sized(got, x, spacing, stiffness, what):
+    """A property of the forces counts only for forces of eq. (1.2)'s size (not zeros)."""
+    expected = expected_acceleration(x, spacing, stiffness)
+    expect_physics(got, expected, f"spring_acceleration {what}", "eq. (1.1)-(1.2)")
+
+
 def compare_with_engine(got, x, spacing, stiffness, what):
     """Fail with the worst particle and the typical mistake that explains the difference."""
     expected = expected_acceleration(x, spacing, stiffness)
@@ -65,7 +72,11 @@ def compare_with_engine(got, x, spacing, stiffness, what):
 
 @pytest.mark.points(2)
 def test_grid_at_rest_feels_no_force(task2):
-    """A grid at its rest spacing is free of stress: every acceleration is zero."""
+    """A grid at its rest spacing is free of stress: every acceleration is zero (and a
+    deformed one is not)."""
+    deformed = perturbed_grid(SHAPE, SPACING, np.random.default_rng(1))
+    got = student_acceleration(task2, deformed, SPACING, STIFFNESS)
+    expect_spring_sized(got, deformed, SPACING, STIFFNESS, "on a deformed grid")
     x = oracles.template_positions(SHAPE, SPACING, (-1.0, 1.5, -1.0))
     a = student_acceleration(task2, x, SPACING, STIFFNESS)
     worst = np.unravel_index(np.argmax(np.linalg.norm(a, axis=-1)), SHAPE)
@@ -130,6 +141,7 @@ def test_forces_are_equal_and_opposite(task2):
     rng = np.random.default_rng(4)
     x = perturbed_grid(SHAPE, SPACING, rng, amount=0.3)
     a = student_acceleration(task2, x, SPACING, STIFFNESS)
+    expect_spring_sized(a, x, SPACING, STIFFNESS, "on a deformed grid")
     scale = float(np.max(np.linalg.norm(a, axis=-1)))
     net = a.reshape(-1, 3).sum(axis=0)
     expect(
@@ -159,6 +171,7 @@ def test_rotating_the_grid_rotates_the_forces(task2, seed):
     rotation = oracles.random_rotation(rng)
     x = perturbed_grid(SHAPE, SPACING, rng)
     a = student_acceleration(task2, x, SPACING, STIFFNESS)
+    expect_spring_sized(a, x, SPACING, STIFFNESS, "on a deformed grid")
     rotated = student_acceleration(task2, x @ rotation.T, SPACING, STIFFNESS)
     error = relative_error(rotated, a @ rotation.T)
     expect(
@@ -191,6 +204,8 @@ def test_energy_is_conserved_in_a_verlet_run(task2):
 
     start = energy(flat, v)
     a = acceleration(flat)
+    expected = oracles.spring_acceleration(body, flat)
+    expect_physics(a, expected, "spring_acceleration on a deformed grid", "eq. (1.1)-(1.2)")
     for _ in range(steps):
         v_half = v + 0.5 * dt * a
         flat = flat + dt * v_half

@@ -8,7 +8,15 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from msdlab.course import oracles
-from msdlab.course.feedback import as_array, expect, grid_place, matching_variant, percent, vec
+from msdlab.course.feedback import (
+    as_array,
+    expect,
+    expect_physics,
+    grid_place,
+    matching_variant,
+    percent,
+    vec,
+)
 
 import reference_hidden as reference
 
@@ -98,7 +106,10 @@ def test_positions_are_not_modified(task2):
     x = oracles.template_positions((3, 3, 2), 0.1, (0.0, 0.0, 0.0))
     x += 0.01 * rng.standard_normal(x.shape)
     kept = x.copy()
-    task2.spring_acceleration(x, 0.1, 0.5)
+    got = as_array(task2.spring_acceleration(x, 0.1, 0.5), "spring_acceleration", x.shape)
+    body = oracles.grid_body(x.shape[:3], 0.1, 0.5, (1,))
+    expected = oracles.spring_acceleration(body, kept.reshape(-1, 3)).reshape(x.shape)
+    expect_physics(got, expected, "spring_acceleration of a deformed grid", "eq. (1.1)-(1.2)")
     expect(
         np.array_equal(x, kept),
         saw="spring_acceleration changed the positions array it was given",

@@ -12,6 +12,7 @@ from msdlab.course import oracles
 from msdlab.course.feedback import (
     as_array,
     expect,
+    expect_physics,
     matching_variant,
     num,
     percent,
@@ -63,6 +64,12 @@ def rotation_at_fault(task3):
 def student_acceleration(task3, positions, springs, rest, stiffness):
     got = task3.spring_acceleration(positions.copy(), springs.copy(), rest.copy(), stiffness)
     return as_array(got, "spring_acceleration", positions.shape)
+
+
+def expect_spring_sized(got, body, x):
+    """A property of the forces counts only for forces of eq. (1.2)'s size (not zeros)."""
+    expected = oracles.spring_acceleration(body, x)
+    expect_physics(got, expected, "spring_acceleration of a deformed jelly", "eq. (1.1)-(1.2)")
 
 
 @pytest.mark.points(2)
@@ -201,6 +208,7 @@ def test_same_physics_in_any_orientation(task3, seed):
     )
     x = body.positions + 0.05 * rng.standard_normal(body.positions.shape)
     a = student_acceleration(task3, x, springs, rest, 0.5)
+    expect_spring_sized(a, body, x)
     turned = student_acceleration(task3, x @ rotation.T, springs, rest, 0.5)
     error = relative_error(turned, a @ rotation.T)
     expect(
@@ -219,6 +227,7 @@ def test_no_net_force_or_torque(task3):
     x = body.positions + 0.1 * rng.standard_normal(body.positions.shape)
     springs, rest = springs_of(body)
     a = student_acceleration(task3, x, springs, rest, 0.5)
+    expect_spring_sized(a, body, x)
     scale = float(np.max(np.abs(a)))
     net = a.sum(axis=0)
     torque = np.cross(x - x.mean(axis=0), a).sum(axis=0)

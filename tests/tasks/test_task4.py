@@ -136,6 +136,15 @@ def test_rest_lengths_unstressed(task4):
     spacing = 0.1
     springs, rest = student_springs(task4, SHAPE, spacing, (1, 2, 3))
     positions = oracles.template_positions(SHAPE, spacing, (0.0, 0.0, 0.0)).reshape(-1, 3)
+    expected, _ = engine_pairs(SHAPE, (1, 2, 3))
+    expect(
+        len(springs) == len(expected) and np.all(springs[:, 0] != springs[:, 1]),
+        saw=f"grid_springs gives {len(springs)} springs, "
+        f"{int(np.sum(springs[:, 0] == springs[:, 1]))} of them joining a particle to itself, "
+        f"where the {SHAPE} grid has {len(expected)}: a body without real springs is "
+        "unstressed trivially, so this earns no point",
+        cause="springs missing, listed twice, or spring ends left at zero",
+    )
     expect(
         np.all((springs >= 0) & (springs < len(positions))),
         saw=f"spring ends outside 0 .. {len(positions) - 1}",

@@ -101,6 +101,15 @@ BUGS = [
         "½·a·dt²",
     ),
     bug(
+        "verlet_step clamps at the floor",
+        1,
+        T1_VERLET,
+        "new = 2.0 * current - old + np.asarray(acceleration, dtype=float) * dt**2\n"
+        "    new[..., 1] = np.maximum(new[..., 1], 0.0)\n    return new",
+        "verlet_step_is_the_kernel",
+        "floor clamp",
+    ),
+    bug(
         "verlet_step in place",
         1,
         T1_VERLET,
