@@ -188,7 +188,7 @@ def write_feedback(
         (folder / "students" / f"{stem}.md").write_text(
             feedback.for_student(grade), encoding="utf-8"
         )
-        source = intake.readable(str(entries[grade.submission].source))
+        source = intake.escaped(str(entries[grade.submission].source))
         (folder / "instructor" / f"{stem}.md").write_text(
             feedback.for_instructor(grade, source), encoding="utf-8"
         )
