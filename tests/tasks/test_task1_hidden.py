@@ -9,7 +9,7 @@ from collections.abc import Iterator
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from msdlab.course.feedback import CheckFailed, as_array, expect, num
@@ -25,34 +25,6 @@ def template_height(y0: float, dt: float, g: float, steps: int) -> float:
     for _ in range(steps):
         y_old, y = y, y + dt * ((y - y_old) / dt + dt * g)
     return y
-
-
-@pytest.mark.points(2)
-@settings(max_examples=30)
-@given(
-    y0=st.floats(0.01, 5.0),
-    dt=st.floats(0.01, 0.5),
-    g=st.floats(-0.05, -1e-4),
-)
-def test_steps_to_floor_for_any_start(task1, y0, dt, g):
-    """steps_to_floor(y0, dt, g) agrees with the running template for any height, step and g."""
-    got = task1.steps_to_floor(y0, dt, g)
-    first = reference.first_floor_contact(y0, dt, g)
-    at_boundary = abs(template_height(y0, dt, g, min(int(got), first))) < 1e-9 * y0
-    if got in (first - 1, first + 1):
-        cause = f"one step {'early' if got < first else 'late'}: the answer is the first n whose "
-        cause += "height y0 + g dt² n(n+1)/2 is <= 0"
-    else:
-        cause = (
-            "a formula that only works for the default numbers, or rounding: check the "
-            "smallest n with y0 + g dt² n(n+1)/2 <= 0 directly"
-        )
-    expect(
-        got == first or at_boundary,
-        saw=f"steps_to_floor({num(y0)}, {num(dt)}, {num(g)}) = {got!r}, but the running "
-        f"template first reaches the floor in step {first}",
-        cause=cause,
-    )
 
 
 @pytest.mark.points(1)
@@ -83,6 +55,36 @@ def test_height_after_for_any_start(task1, steps, y0, dt, g):
         abs(got - expected) <= 1e-9 * max(1.0, abs(expected)),
         saw=f"height_after({steps}, {num(y0)}, {num(dt)}, {num(g)}) = {num(got, 6)}, the "
         f"template gives {num(expected, 6)}",
+        cause=cause,
+    )
+
+
+@pytest.mark.points(2)
+@settings(max_examples=30)
+@example(y0=0.01, dt=0.5, g=-0.05)  # a start within one step of the floor: the answer is 1
+@example(y0=0.001, dt=0.5, g=-0.05)
+@given(
+    y0=st.floats(0.01, 5.0),
+    dt=st.floats(0.01, 0.5),
+    g=st.floats(-0.05, -1e-4),
+)
+def test_steps_to_floor_for_any_start(task1, y0, dt, g):
+    """steps_to_floor(y0, dt, g) agrees with the running template for any height, step and g."""
+    got = task1.steps_to_floor(y0, dt, g)
+    first = reference.first_floor_contact(y0, dt, g)
+    at_boundary = abs(template_height(y0, dt, g, min(int(got), first))) < 1e-9 * y0
+    if got in (first - 1, first + 1):
+        cause = f"one step {'early' if got < first else 'late'}: the answer is the first n whose "
+        cause += "height y0 + g dt² n(n+1)/2 is <= 0"
+    else:
+        cause = (
+            "a formula that only works for the default numbers, or rounding: check the "
+            "smallest n with y0 + g dt² n(n+1)/2 <= 0 directly"
+        )
+    expect(
+        got == first or at_boundary,
+        saw=f"steps_to_floor({num(y0)}, {num(dt)}, {num(g)}) = {got!r}, but the running "
+        f"template first reaches the floor in step {first}",
         cause=cause,
     )
 
