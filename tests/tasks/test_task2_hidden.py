@@ -11,7 +11,7 @@ from msdlab.course import oracles
 from msdlab.course.feedback import (
     as_array,
     expect,
-    expect_physics,
+    expect_nontrivial,
     grid_place,
     matching_variant,
     percent,
@@ -107,9 +107,7 @@ def test_positions_are_not_modified(task2):
     x += 0.01 * rng.standard_normal(x.shape)
     kept = x.copy()
     got = as_array(task2.spring_acceleration(x, 0.1, 0.5), "spring_acceleration", x.shape)
-    body = oracles.grid_body(x.shape[:3], 0.1, 0.5, (1,))
-    expected = oracles.spring_acceleration(body, kept.reshape(-1, 3)).reshape(x.shape)
-    expect_physics(got, expected, "spring_acceleration of a deformed grid", "eq. (1.1)-(1.2)")
+    expect_nontrivial(got, kept, "spring_acceleration of a deformed grid")
     expect(
         np.array_equal(x, kept),
         saw="spring_acceleration changed the positions array it was given",
