@@ -108,7 +108,11 @@ def run(args: argparse.Namespace) -> int:
         else intake.from_paths(args.submissions) as found
     ):
         entries = {entry.id: entry for entry in found.entries}
-        prints = {i: gradebook.fingerprint(checks, e.folder) for i, e in entries.items()}
+        prints = {  # nothing is read from a submission refused at intake (a link, ...)
+            i: gradebook.fingerprint(checks, e.folder)
+            for i, e in entries.items()
+            if e.problem is None
+        }
         todo = [e for e in entries.values() if e.problem is None]
         if args.resume:
             todo = [e for e in todo if book.fingerprint_of(e.id) != prints[e.id]]
