@@ -65,6 +65,12 @@ def relative_error(got: np.ndarray, expected: np.ndarray) -> float:
 
 def as_array(value: object, what: str, shape: tuple[int, ...] | None = None) -> np.ndarray:
     """``value`` as a float array, or a `CheckFailed` saying what came back instead."""
+    expect(
+        not np.iscomplexobj(value),
+        saw=f"{what} returned complex numbers",
+        cause="a square root or power of a negative number; positions, forces and "
+        "accelerations are real",
+    )
     try:
         array = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -79,6 +85,32 @@ def as_array(value: object, what: str, shape: tuple[int, ...] | None = None) -> 
         cause="dividing by a zero spring length or a zero time step",
     )
     return array
+
+
+def expect_nontrivial(got: np.ndarray, given: np.ndarray, what: str) -> None:
+    """Fail if ``got`` (one row per particle) is all zeros, one row repeated, or ``given``.
+
+    A property check calls it first: such answers satisfy many properties (no net force,
+    rotation invariance, energy conservation) without any physics.
+    """
+    got, given = np.asarray(got, dtype=float), np.asarray(given, dtype=float)
+    rows = got.reshape(-1, got.shape[-1]) if got.ndim else got.reshape(1, 1)
+    kind = (
+        "all zeros"
+        if not np.any(got)
+        else "its input unchanged"
+        if got.shape == given.shape and np.array_equal(got, given)
+        else "the same vector for every particle"
+        if len(rows) > 1 and np.all(rows == rows[0])
+        else None
+    )
+    expect(
+        kind is None,
+        saw=f"{what} returns {kind}: the property checked here holds trivially for such an "
+        "answer, so it earns no point",
+        cause="an answer not computed from the springs; sum eq. (1.2) over each particle's "
+        "neighbours",
+    )
 
 
 def matching_variant(

@@ -8,5 +8,7 @@ Not shipped to students (see `release_rules`):
   process and a `sandbox` for the submission's code (`wire` is their data format;
   `pytest_sandbox` the judge's pytest plugin).
 - `release_rules` and `release`: which files ship to students, and the bundle.
+- `validate` and `trivial`: how strong the checks are: solutions, templates, answers
+  without physics and mutants of the solutions (``msdlab validate``).
 - `commands`: the ``msdlab templates``, ``grade`` and ``release`` sub-commands.
 """

@@ -1,8 +1,9 @@
 """The class's grades as a CSV file: one row per submission id, kept up to date across runs.
 
-Columns: ``id``, ``source`` (the folder or zip handed in), ``task1`` ... ``task5``,
-``total``, optionally one column per check (``--detail``: ``task2 rest_state_feels_no_force``),
-``notes`` and ``fingerprint`` (a hash of the checks and the submission's task files).
+Columns: ``id``, ``source`` (the folder or zip handed in, named exactly: see
+`intake.escaped`), ``task1`` ... ``task5``, ``total``, optionally one column per check
+(``--detail``: ``task2 rest_state_feels_no_force``), ``notes`` and ``fingerprint`` (a hash
+of the checks and the submission's task files).
 The first row, id ``(max points)``, holds what each column is worth.
 
 Every write replaces the file atomically (a temporary file, then `os.replace`), so
@@ -24,7 +25,7 @@ from ..course import TASKS
 from ..course.report import CheckReport
 from .feedback import scrub
 from .grading import Grade
-from .intake import MAX_POINTS_ID, Entry, readable
+from .intake import MAX_POINTS_ID, Entry, escaped
 
 FIRST = ["id", "source", *(f"task{t}" for t in TASKS), "total"]
 LAST = ["notes", "fingerprint"]
@@ -95,7 +96,7 @@ class Gradebook:
 
     def record(self, grade: Grade, entry: Entry, print_: str | None, detail: bool) -> None:
         """Put the row of ``grade`` in (replacing the row with the same id)."""
-        row = {"id": grade.submission, "source": readable(str(entry.source))}
+        row = {"id": grade.submission, "source": escaped(str(entry.source))}
         row.update({f"task{t}": str(grade.points(t)) for t in TASKS})
         row["total"] = str(grade.total)
         if grade.report is not None:

@@ -1,4 +1,4 @@
-"""Taking in a class's submissions: which folder is whose, under a unique readable id.
+r"""Taking in a class's submissions: which folder is whose, under a unique readable id.
 
 A submission is given as a folder laid out like ``assignments/``, a folder
 holding ``assignments/`` (a student who handed in the whole bundle), or a zip
@@ -9,7 +9,14 @@ submissions given, without a trailing ``assignments`` (``class/alice/assignments
 
 Ids are readable text (a folder name that is not valid UTF-8 keeps its
 readable part, the rest becomes U+FFFD) and never repeat; `file_stem` makes
-from an id a file name of bounded length that is unique too.
+from an id a file name of bounded length that is unique too. Where a path must
+name its folder exactly (the grades' ``source`` column), `escaped` writes each
+byte that is not UTF-8 as ``\xNN`` and a backslash as ``\\``; `unescaped`
+gives the path back.
+
+A submission that is a symbolic link, lies below one, or resolves outside the
+folder it was handed in is not followed (`link_problem`), nor is a zip file
+holding a link: such an entry has a problem and no folder to grade.
 """
 
 from __future__ import annotations
@@ -60,6 +67,30 @@ def readable(name: str) -> str:
     return os.fsencode(name).decode("utf-8", errors="replace")
 
 
+def escaped(path: str) -> str:
+    """``path`` as UTF-8 text naming it exactly: bytes that are not UTF-8 become ``\\xNN``,
+    a backslash becomes two; `unescaped` reverses it."""
+    text = os.fsdecode(os.fsencode(path))  # undecodable bytes as surrogates U+DC80..U+DCFF
+    return "".join(_escaped_character(char) for char in text)
+
+
+def _escaped_character(char: str) -> str:
+    if char == "\\":
+        return "\\\\"
+    if 0xDC80 <= ord(char) <= 0xDCFF:  # the byte 0x80..0xFF that was not UTF-8
+        return f"\\x{ord(char) - 0xDC00:02x}"
+    return char
+
+
+def unescaped(text: str) -> str:
+    """The path that `escaped` wrote as ``text`` (undecodable bytes back as surrogates)."""
+    return re.sub(
+        r"\\(\\|x([0-9a-f]{2}))",
+        lambda m: "\\" if m.group(2) is None else chr(0xDC00 + int(m.group(2), 16)),
+        text,
+    )
+
+
 def file_stem(identifier: str) -> str:
     """A file name (no suffix) for ``identifier``: letters, digits, ``._-`` only, at most
     `MAX_STEM` characters; any change to the id adds a short hash, so stems stay unique."""
@@ -85,15 +116,19 @@ class Intake(contextlib.AbstractContextManager):
     def __exit__(self, *exc_info: object) -> None:
         self.close()
 
-    def add(self, identifier: str, source: Path) -> Entry:
-        """Add the submission at ``source`` (folder or zip) under ``identifier``."""
+    def add(self, identifier: str, source: Path, given_in: Path | None = None) -> Entry:
+        """Add the submission at ``source`` (folder or zip) under ``identifier``; a link, or a
+        path leading outside the folder ``given_in`` (default: its parent), is not followed."""
         identifier = readable(identifier).strip()
         if not identifier or identifier == MAX_POINTS_ID:
             raise ValueError(f"{source}: {identifier!r} cannot be a submission id")
         if identifier in {entry.id for entry in self.entries}:
             raise ValueError(f"two submissions have the id {identifier!r}: give unique ids")
-        source = Path(source)
-        if source.is_file() and zipfile.is_zipfile(source):
+        source = Path(os.path.abspath(source))
+        refused = link_problem(source, given_in or source.parent)
+        if refused is not None:
+            entry = Entry(identifier, source, source, problem=refused)
+        elif source.is_file() and zipfile.is_zipfile(source):
             entry = self._from_zip(identifier, source)
         elif source.is_dir():
             entry = _from_folder(identifier, source, source)
@@ -123,19 +158,40 @@ def from_paths(paths: Iterable[Path]) -> Intake:
     missing = [str(path) for path in paths if not path.exists()]
     if missing:
         raise FileNotFoundError(f"no submission at {', '.join(missing)}")
-    resolved = list(dict.fromkeys(path.resolve() for path in paths))  # each folder once
-    base = Path(os.path.commonpath([path.parent for path in resolved]))
-    ids = [_path_id(path, base) for path in resolved]
+    placed = list(dict.fromkeys(Path(os.path.abspath(path)) for path in paths))  # each once
+    base = Path(os.path.commonpath([path.parent for path in placed]))
+    ids = [_path_id(path, base) for path in placed]
     intake = Intake()
     taken: set[str] = set()
-    for path, identifier in zip(resolved, ids):
+    for path, identifier in zip(placed, ids):
         unique, count = identifier, 1
         while unique in taken:
             count += 1
             unique = f"{identifier}-{count}"
         taken.add(unique)
-        intake.add(unique, path)
+        intake.add(unique, path, given_in=base)
     return intake
+
+
+def link_problem(path: Path, given_in: Path) -> str | None:
+    """Why the submission at ``path`` is not followed, or None: it is a symbolic link, lies
+    below one, or resolves outside the folder ``given_in`` it was handed in."""
+    path, given_in = Path(os.path.abspath(path)), Path(os.path.abspath(given_in))
+    for place in (path, *path.parents):
+        if place == given_in or given_in not in place.parents:
+            break
+        if place.is_symlink():
+            target = readable(os.readlink(place))
+            return (
+                f"not graded: {readable(place.name)} is a symbolic link (to {target}); links "
+                "are not followed, hand in the folder or zip file itself"
+            )
+    if not path.resolve().is_relative_to(given_in.resolve()):
+        return (
+            f"not graded: {readable(path.name)} resolves to {readable(str(path.resolve()))}, "
+            f"outside the folder {readable(str(given_in))} it was handed in"
+        )
+    return None
 
 
 def from_roster(roster: Path) -> Intake:
@@ -176,10 +232,12 @@ def _from_folder(identifier: str, source: Path, folder: Path) -> Entry:
     """The entry of a folder: graded from its ``assignments/`` when it holds only that."""
     entry = Entry(identifier, source, folder)
     inner = folder / BUNDLE_FOLDER
-    if not task_files(folder) and inner.is_dir():
+    if inner.is_symlink():
+        entry.problem = link_problem(inner, folder)
+    elif not task_files(folder) and inner.is_dir():
         entry.folder = inner
         entry.notes.append(f"graded from the {BUNDLE_FOLDER}/ folder inside the submission")
-    if not task_files(entry.folder):
+    if entry.problem is None and not task_files(entry.folder):
         entry.problem = f"no task files (task{TASKS[0]}.py ... task{TASKS[-1]}.py) handed in"
     return entry
 
@@ -194,8 +252,10 @@ def _unpack(archive: Path, target: Path) -> None:
             name = PurePosixPath(member.filename)
             if name.is_absolute() or ".." in name.parts:
                 raise ValueError(f"it holds a path outside its folder: {member.filename}")
-            if member.is_dir() or (member.external_attr >> 16) & 0o170000 == 0o120000:
-                continue  # folders come with their files; symbolic links are left out
+            if (member.external_attr >> 16) & 0o170000 == 0o120000:
+                raise ValueError(f"it holds a symbolic link, not followed: {member.filename}")
+            if member.is_dir():
+                continue  # folders come with their files
             destination = target.joinpath(*name.parts)
             destination.parent.mkdir(parents=True, exist_ok=True)
             with bundle.open(member) as data, destination.open("wb") as out:

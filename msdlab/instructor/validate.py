@@ -7,10 +7,13 @@ and a time limit. `validate` runs them on
 
 - the solution: every check must pass;
 - the template: every check must fail (a check a template passes gives points for nothing);
+- trivial answers (`msdlab.instructor.trivial`): the solution answering zeros, its input,
+  constants, NaN, inf, empty or complex arrays; every check must fail (no point for nothing);
 - mutants of the solution (`mutants`): small changes to the code inside the solution blocks
   (operators, operands, constants, comparisons, dropped terms, signs). A mutant is *killed*
-  when a check fails on it; the report names the checks that kill each mutant and lists the
-  survivors, which are either equivalent to the solution or a mistake no check catches.
+  when a check fails on it; the report names, per check, the mutants it alone kills, and
+  lists the survivors: each is equivalent to the solution, with the one-line reason given in
+  ``solutions/equivalent_mutants.json`` (`EQUIVALENT_FILE`), or a mistake no check catches.
   A mutant runs only the checks that reach the function it changes (`reached`).
 
 Mutation tools such as mutmut mutate a whole package and report per test-suite run; a
@@ -23,6 +26,7 @@ from __future__ import annotations
 import ast
 import contextlib
 import importlib.util
+import json
 import random
 import shutil
 import signal
@@ -39,8 +43,13 @@ import numpy as np
 
 from ..course import delegation
 from ..course.loader import FolderImplementation
+from . import trivial
 
 BEGIN, END = "### BEGIN SOLUTION", "### END SOLUTION"
+EQUIVALENT_FILE = "equivalent_mutants.json"
+"""In ``solutions/``: ``{"taskN": {"function: old -> new": "why it computes the same"}}``,
+the instructor's claim for each surviving mutant; a key ``function: <the line's code>``
+claims every mutant of that line."""
 
 
 @dataclass(frozen=True)
@@ -72,10 +81,22 @@ class Mutant:
     old: str
     new: str
     source: str
+    original: str
 
     @property
     def label(self) -> str:
         return f"line {self.line}: {self.old} -> {self.new}"
+
+    def claims(self) -> tuple[str, str]:
+        """How `EQUIVALENT_FILE` names it (no line number): ``function: old -> new``, and
+        ``function: <the line's code>`` for all mutants of its line."""
+        function = definition_at(self.source, self.line)
+        line = self.original_line.strip()
+        return f"{function}: {self.old} -> {self.new}", f"{function}: {line}"
+
+    @property
+    def original_line(self) -> str:
+        return self.original.splitlines()[self.line - 1]
 
 
 @dataclass
@@ -88,14 +109,27 @@ class TaskReport:
     template_passes: list[str] = field(default_factory=list)
     kills: dict[str, list[str]] = field(default_factory=dict)  # mutant label -> checks
     mutants: int = 0
+    trivial_paid: dict[str, list[str]] = field(default_factory=dict)  # kind -> checks passed
+    equivalent: dict[str, str] = field(default_factory=dict)  # survivor label -> reason
 
     @property
     def survivors(self) -> list[str]:
         return [label for label, checks in self.kills.items() if not checks]
 
     @property
+    def unexplained(self) -> list[str]:
+        """The survivors not claimed equivalent: mistakes that no check catches."""
+        return [label for label in self.survivors if label not in self.equivalent]
+
+    @property
     def kill_rate(self) -> float:
-        return 1.0 - len(self.survivors) / self.mutants if self.mutants else 1.0
+        """Killed mutants among those not equivalent to the solution."""
+        counted = self.mutants - len(self.survivors) + len(self.unexplained)
+        return 1.0 - len(self.unexplained) / counted if counted else 1.0
+
+    def alone(self, check: str) -> list[str]:
+        """The mutants that ``check`` alone kills."""
+        return [label for label, checks in self.kills.items() if checks == [check]]
 
 
 # ---------------------------------------------------------------------------- running checks
@@ -350,7 +384,7 @@ def mutants(source: str, task: int) -> list[Mutant]:
             key = (node.lineno, node.col_offset, new)
             if key not in found:
                 changed = _replace(source, node, new)
-                found[key] = Mutant(task, node.lineno, old, new, changed)
+                found[key] = Mutant(task, node.lineno, old, new, changed, source)
     return sorted(found.values(), key=lambda m: (m.line, m.old, m.new))
 
 
@@ -424,62 +458,109 @@ def validate(
         if template.is_file():
             outcomes = run_source(template.read_text(), task, checks, seconds=seconds)
             report.template_passes = [n for n, o in outcomes.items() if o.passed]
+        for kind in trivial.KINDS:
+            outcomes = run_source(
+                trivial.answer_source(source, kind), task, checks, seconds=seconds
+            )
+            report.trivial_paid[kind] = [n for n, o in outcomes.items() if o.passed]
         chosen = mutants(source, task)
         if sample is not None and sample < len(chosen):
             chosen = sorted(random.Random(seed).sample(chosen, sample), key=lambda m: m.line)
         report.mutants = len(chosen)
+        reasons = equivalence_reasons(course / "solutions" / EQUIVALENT_FILE, task)
         for number, mutant in enumerate(chosen, start=1):
             changed = definition_at(source, mutant.line)
             concerned = [c for c in checks if changed is None or changed in uses[c.name]]
             outcomes = run_source(mutant.source, task, concerned, seconds=seconds)
             report.kills[mutant.label] = [n for n, o in outcomes.items() if not o.passed]
+            reason = next((reasons[k] for k in mutant.claims() if k in reasons), None)
+            if not report.kills[mutant.label] and reason is not None:
+                report.equivalent[mutant.label] = reason
             if progress is not None:
                 progress(f"task {task}: mutant {number}/{len(chosen)} {mutant.label}")
         reports.append(report)
     return reports
 
 
+def equivalence_reasons(path: Path, task: int) -> dict[str, str]:
+    """``function: old -> new`` -> why that mutant computes the same, from `EQUIVALENT_FILE`."""
+    if not path.is_file():
+        return {}
+    return dict(json.loads(path.read_text(encoding="utf-8")).get(f"task{task}", {}))
+
+
 def format_report(reports: Sequence[TaskReport], verbose: bool = False) -> str:
-    """The instructor's text: per task the solution and template verdicts, kills, survivors."""
+    """The instructor's text: per task the solution, template and trivial answers' verdicts,
+    the kills of each check (and the mutants it alone kills), the survivors with reasons."""
     out = []
     for report in reports:
         out.append(f"task {report.task}: {len(report.checks)} checks, {report.mutants} mutants")
-        solution = (
-            "all pass"
-            if not report.solution_failures
-            else "FAIL: "
-            + ", ".join(
-                f"{n} ({o.exception}: {o.message.splitlines()[0] if o.message else ''})"
-                for n, o in report.solution_failures.items()
-            )
-        )
-        out.append(f"  solution: {solution}")
+        out.append(f"  solution: {_solution_verdict(report)}")
         template = (
             "all fail"
             if not report.template_passes
             else "PASSES: " + ", ".join(report.template_passes)
         )
         out.append(f"  template: {template}")
-        killers: dict[str, int] = dict.fromkeys(report.checks, 0)
-        for checks in report.kills.values():
-            for name in checks:
-                killers[name] += 1
-        out.append("  mutants killed per check:")
-        out += [f"    {killers[n]:4d}  {n}" for n in report.checks]
-        if verbose:
-            out.append("  kills:")
-            out += [
-                f"    {label}: {', '.join(checks)}"
-                for label, checks in report.kills.items()
-                if checks
-            ]
-        out.append(f"  survivors ({len(report.survivors)}):")
-        out += [f"    {label}" for label in report.survivors]
-        out.append(f"  kill rate: {report.kill_rate:.0%}")
-    total = sum(r.mutants for r in reports)
-    survived = sum(len(r.survivors) for r in reports)
+        out += _trivial_lines(report)
+        out += _kill_lines(report, verbose)
+        out += _survivor_lines(report)
+    total = sum(r.mutants - len(r.survivors) + len(r.unexplained) for r in reports)
+    missed = sum(len(r.unexplained) for r in reports)
     if total:
         out.append(
-            f"all tasks: {total - survived}/{total} mutants killed ({1 - survived / total:.0%})"
+            f"all tasks: {total - missed}/{total} non-equivalent mutants killed "
+            f"({1 - missed / total:.0%})"
         )
     return "\n".join(out)
+
+
+def broken(report: TaskReport) -> bool:
+    """A solution fails, a template passes, or a trivial answer earns a point."""
+    return bool(
+        report.solution_failures or report.template_passes or any(report.trivial_paid.values())
+    )
+
+
+def _solution_verdict(report: TaskReport) -> str:
+    if not report.solution_failures:
+        return "all pass"
+    return "FAIL: " + ", ".join(
+        f"{n} ({o.exception}: {o.message.splitlines()[0] if o.message else ''})"
+        for n, o in report.solution_failures.items()
+    )
+
+
+def _trivial_lines(report: TaskReport) -> list[str]:
+    if not report.trivial_paid:
+        return []
+    paid = {kind: checks for kind, checks in report.trivial_paid.items() if checks}
+    kinds = ", ".join(report.trivial_paid)
+    if not paid:
+        return [f"  trivial answers ({kinds}): every check fails, 0 points"]
+    return [f"  trivial answers: PAID {kind} by {', '.join(c)}" for kind, c in paid.items()]
+
+
+def _kill_lines(report: TaskReport, verbose: bool) -> list[str]:
+    killers: dict[str, int] = dict.fromkeys(report.checks, 0)
+    for checks in report.kills.values():
+        for name in checks:
+            killers[name] += 1
+    out = ["  mutants killed per check (alone: killed by no other check):"]
+    for name in report.checks:
+        alone = report.alone(name)
+        out.append(f"    {killers[name]:4d}  {name} ({len(alone)} alone)")
+        out += [f"            alone: {label}" for label in alone]
+    if verbose:
+        out.append("  kills:")
+        out += [f"    {label}: {', '.join(c)}" for label, c in report.kills.items() if c]
+    return out
+
+
+def _survivor_lines(report: TaskReport) -> list[str]:
+    out = [f"  survivors equivalent to the solution ({len(report.equivalent)}):"]
+    out += [f"    {label}: {reason}" for label, reason in report.equivalent.items()]
+    out.append(f"  survivors no check catches ({len(report.unexplained)}):")
+    out += [f"    {label}" for label in report.unexplained]
+    out.append(f"  kill rate: {report.kill_rate:.0%} of the mutants not equivalent to the solution")
+    return out

@@ -2,8 +2,13 @@
 its own task with a message that names its cause, no correct alternative loses a point, and
 a submission gets the same outcome from every check in one process and through the grader.
 
+Trivial answers (`msdlab.instructor.trivial`: zeros, the input, constants, NaN, inf, empty
+or complex arrays) earn no point at all.
+
 The set runs in this process (`msdlab.instructor.validate.run_source`): a bug runs the check
-that must catch it, an alternative every check that reaches the functions it changes.
+that must catch it, and the checks reaching what it changes up to the first that fails (the
+message a student reads first); an alternative every check that reaches the functions it
+changes.
 """
 
 from __future__ import annotations
@@ -18,7 +23,7 @@ import pytest
 
 from msdlab.course import PROJECT_ROOT, TASKS, delegation
 from msdlab.course.report import CheckReport
-from msdlab.instructor import grading, validate
+from msdlab.instructor import grading, trivial, validate
 
 CHECKS = PROJECT_ROOT / "tests" / "tasks"
 SOLUTIONS = PROJECT_ROOT / "solutions"
@@ -89,6 +94,28 @@ def test_a_planted_bug_loses_points_naming_its_cause(bug, harness):
     outcome = validate.run_source(source, bug.task, [check], seconds=120)[check.name]
     assert not outcome.passed, f"{check.name} does not catch '{bug.name}'"
     assert bug.words in outcome.message, f"{check.name} says: {outcome.message}"
+
+
+@pytest.mark.parametrize("bug", BUGS, ids=ids(BUGS))
+def test_the_first_failing_check_of_a_planted_bug_names_its_cause(bug, harness):
+    """The student reads the task's first failing check first: it must not point elsewhere."""
+    source = bug.apply(harness.sources[bug.task])
+    checks = harness.concerned(bug)
+    outcomes = validate.run_source(
+        source, bug.task, checks, seconds=300, stop_at_first_failure=True
+    )
+    name, first = next((n, o) for n, o in outcomes.items() if not o.passed)
+    assert bug.words in first.message, f"{name} (first to fail) says: {first.message}"
+
+
+@pytest.mark.parametrize("kind", trivial.KINDS)
+@pytest.mark.parametrize("task", TASKS)
+def test_a_trivial_answer_earns_no_point(task, kind, harness):
+    """The solution answering zeros, its input, constants, NaN, inf, empty or complex arrays
+    fails every check of its task."""
+    source = trivial.answer_source(harness.sources[task], kind)
+    outcomes = validate.run_source(source, task, harness.checks[task], seconds=60)
+    assert not [name for name, outcome in outcomes.items() if outcome.passed]
 
 
 @pytest.mark.parametrize("alternative", ALTERNATIVES, ids=ids(ALTERNATIVES))

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import textwrap
 
+import pytest
+
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
 from msdlab.instructor import validate
@@ -50,7 +52,28 @@ def test_validate_reports_solution_template_and_kills(capsys):
     assert report.mutants == 4 and len(report.kills) == 4
     text = validate.format_report(reports, verbose=True)
     assert "solution: all pass" in text and "template: all fail" in text
-    assert "kill rate:" in text and "mutants killed per check:" in text
+    assert "kill rate:" in text and "mutants killed per check (alone:" in text
+    assert report.trivial_paid and not any(report.trivial_paid.values())
+    assert "every check fails, 0 points" in text
+
+
+def test_the_report_names_lone_kills_and_survivors_with_their_reasons(tmp_path):
+    report = validate.TaskReport(1, ["a", "b"], mutants=4)
+    report.kills = {"m1": ["a"], "m2": ["a", "b"], "m3": [], "m4": []}
+    (tmp_path / validate.EQUIVALENT_FILE).write_text(
+        '{"task1": {"answer: x < y -> x <= y": "x == y never reaches it"}}'
+    )
+    reasons = validate.equivalence_reasons(tmp_path / validate.EQUIVALENT_FILE, 1)
+    (mutant,) = [m for m in validate.mutants(SOURCE, 1) if m.label == "line 9: x < y -> x <= y"]
+    assert mutant.claims()[0] in reasons
+    report.equivalent = {"m3": reasons[mutant.claims()[0]]}
+    assert report.alone("a") == ["m1"] and report.unexplained == ["m4"]
+    assert report.kill_rate == pytest.approx(2 / 3)
+    text = validate.format_report([report])
+    assert "alone: m1" in text and "m3: x == y never reaches it" in text
+    assert "survivors no check catches (1):\n    m4" in text
+    report.trivial_paid = {"zeros": ["b"]}
+    assert validate.broken(report) and "PAID zeros by b" in validate.format_report([report])
 
 
 def test_validate_command_refuses_an_unknown_task(capsys):

@@ -35,7 +35,9 @@ def test_particle_count(task1):
             got == expected,
             saw=f"particle_count({n}) = {got!r}, but a grid of {n} per edge has {expected} "
             "particles",
-            cause="counting one edge (n) or one layer (n²) instead of the whole cube (n³)",
+            cause="a result that holds for the default N only (N³ for every n)"
+            if got == 20**3
+            else "counting one edge (n) or one layer (n²) instead of the whole cube (n³)",
         )
 
 
@@ -72,13 +74,21 @@ def template_kernel(old: np.ndarray, current: np.ndarray, dt: float, a: np.ndarr
     return current + dt * v
 
 
+def floor_clamped(positions: np.ndarray) -> np.ndarray:
+    """``positions`` with the template's floor y >= 0 applied."""
+    clamped = positions.copy()
+    clamped[..., 1] = np.maximum(clamped[..., 1], 0.0)
+    return clamped
+
+
 @pytest.mark.points(2)
 def test_verlet_step_is_the_kernel(task1):
     """verlet_step (eq. 1.3) gives the same new positions as the template's kernel."""
     rng = np.random.default_rng(1)
     a = np.array([0.01, -0.001, 0.002])
-    for shape, dt in (((4, 3, 5, 3), DT), ((7, 3), 0.37)):  # the step is an argument too
-        current = rng.uniform(-1.0, 1.0, shape) + np.array([0.0, 5.0, 0.0])
+    cases = (((4, 3, 5, 3), DT, 5.0), ((7, 3), 0.37, 5.0), ((6, 3), DT, 0.0))
+    for shape, dt, lift in cases:  # dt is an argument too; lift 0: some cross the floor
+        current = rng.uniform(-1.0, 1.0, shape) + np.array([0.0, lift, 0.0])
         old = current - 0.05 * rng.standard_normal(shape)
         expected = template_kernel(old, current, dt, a)
         got = as_array(task1.verlet_step(old.copy(), current.copy(), dt, tuple(a)), "verlet_step")
@@ -94,6 +104,8 @@ def test_verlet_step_is_the_kernel(task1):
                 f"the template's dt = {DT} instead of the dt argument": (
                     2 * current - old + a * DT**2
                 ),
+                "the floor clamp y = max(y, 0) copied from the template's kernel: task 1's "
+                "verlet_step leaves the floor out": floor_clamped(expected),
             },
         )
         expect(
@@ -146,6 +158,9 @@ def test_steps_to_floor_as_template(task1):
             saw=f"{call} = {got!r}, but the running template's bottom layer (y0 = {BOTTOM}) "
             f"first reaches the floor in step {first} (its height after step {first - 1} is "
             f"{num(frames[first - 1, :, 0, :, 1].min())})",
-            cause="an off-by-one step, or the exact parabola ½ g t² instead of the template's "
-            "y0 + g dt² n(n+1)/2 (solve n(n+1)/2 · |g| dt² >= y0 for the smallest integer n)",
+            cause=f"one step {'early' if got < first else 'late'}: the answer is the first n "
+            "whose height y0 + g dt² n(n+1)/2 is <= 0"
+            if got in (first - 1, first + 1)
+            else "the exact parabola ½ g t² instead of the template's y0 + g dt² n(n+1)/2 "
+            "(solve n(n+1)/2 · |g| dt² >= y0 for the smallest integer n)",
         )

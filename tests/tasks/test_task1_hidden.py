@@ -9,7 +9,7 @@ from collections.abc import Iterator
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from msdlab.course.feedback import CheckFailed, as_array, expect, num
@@ -25,34 +25,6 @@ def template_height(y0: float, dt: float, g: float, steps: int) -> float:
     for _ in range(steps):
         y_old, y = y, y + dt * ((y - y_old) / dt + dt * g)
     return y
-
-
-@pytest.mark.points(2)
-@settings(max_examples=30)
-@given(
-    y0=st.floats(0.01, 5.0),
-    dt=st.floats(0.01, 0.5),
-    g=st.floats(-0.05, -1e-4),
-)
-def test_steps_to_floor_for_any_start(task1, y0, dt, g):
-    """steps_to_floor(y0, dt, g) agrees with the running template for any height, step and g."""
-    got = task1.steps_to_floor(y0, dt, g)
-    first = reference.first_floor_contact(y0, dt, g)
-    at_boundary = abs(template_height(y0, dt, g, min(int(got), first))) < 1e-9 * y0
-    if got in (first - 1, first + 1):
-        cause = f"one step {'early' if got < first else 'late'}: the answer is the first n whose "
-        cause += "height y0 + g dt² n(n+1)/2 is <= 0"
-    else:
-        cause = (
-            "a formula that only works for the default numbers, or rounding: check the "
-            "smallest n with y0 + g dt² n(n+1)/2 <= 0 directly"
-        )
-    expect(
-        got == first or at_boundary,
-        saw=f"steps_to_floor({num(y0)}, {num(dt)}, {num(g)}) = {got!r}, but the running "
-        f"template first reaches the floor in step {first}",
-        cause=cause,
-    )
 
 
 @pytest.mark.points(1)
@@ -87,6 +59,36 @@ def test_height_after_for_any_start(task1, steps, y0, dt, g):
     )
 
 
+@pytest.mark.points(2)
+@settings(max_examples=30)
+@example(y0=0.01, dt=0.5, g=-0.05)  # a start within one step of the floor: the answer is 1
+@example(y0=0.001, dt=0.5, g=-0.05)
+@given(
+    y0=st.floats(0.01, 5.0),
+    dt=st.floats(0.01, 0.5),
+    g=st.floats(-0.05, -1e-4),
+)
+def test_steps_to_floor_for_any_start(task1, y0, dt, g):
+    """steps_to_floor(y0, dt, g) agrees with the running template for any height, step and g."""
+    got = task1.steps_to_floor(y0, dt, g)
+    first = reference.first_floor_contact(y0, dt, g)
+    at_boundary = abs(template_height(y0, dt, g, min(int(got), first))) < 1e-9 * y0
+    if got in (first - 1, first + 1):
+        cause = f"one step {'early' if got < first else 'late'}: the answer is the first n whose "
+        cause += "height y0 + g dt² n(n+1)/2 is <= 0"
+    else:
+        cause = (
+            "a formula that only works for the default numbers, or rounding: check the "
+            "smallest n with y0 + g dt² n(n+1)/2 <= 0 directly"
+        )
+    expect(
+        got == first or at_boundary,
+        saw=f"steps_to_floor({num(y0)}, {num(dt)}, {num(g)}) = {got!r}, but the running "
+        f"template first reaches the floor in step {first}",
+        cause=cause,
+    )
+
+
 @pytest.mark.points(1)
 def test_particle_count_for_any_size(task1):
     """particle_count(n) is n³ for every n from 1 to 40."""
@@ -106,6 +108,13 @@ def test_verlet_step_leaves_its_inputs_alone(task1):
     old = current - 0.01
     kept_old, kept_current = old.copy(), current.copy()
     got = as_array(task1.verlet_step(old, current, 0.1, (0.0, -0.001, 0.0)), "verlet_step")
+    expected = 2.0 * kept_current - kept_old + np.array([0.0, -0.001, 0.0]) * 0.1**2
+    expect(
+        got.shape == expected.shape and np.allclose(got, expected, rtol=1e-9, atol=1e-12),
+        saw="verlet_step does not return eq. (1.3)'s new positions (see its other checks); "
+        "leaving the inputs alone earns a point only together with the step itself",
+        cause="an answer that returns zeros, a constant or one of its inputs",
+    )
     expect(
         np.array_equal(old, kept_old) and np.array_equal(current, kept_current),
         saw="verlet_step changed the arrays it was given",
@@ -146,6 +155,15 @@ def test_steps_to_floor_refuses_a_start_on_or_below_the_floor(task1):
         (-0.5, 0.1, -0.001, "a particle that starts below the floor"),
         (1.0, 0.1, 0.0, "a particle that does not fall (g = 0)"),
         (1.0, 0.0, -0.001, "a time step of 0"),
+    )
+    first = reference.first_floor_contact(1.0, 0.1, -0.001)
+    got = task1.steps_to_floor(1.0, 0.1, -0.001)
+    expect(
+        got == first,
+        saw=f"steps_to_floor(1.0, 0.1, -0.001) = {got!r} where the template first reaches the "
+        f"floor in step {first}: refusing bad starts earns a point only together with "
+        "counting the good ones",
+        cause="an answer that returns a constant, or the refusal without the count",
     )
     for y0, dt, g, what in cases:
         call = f"steps_to_floor({y0}, {dt}, {g})"

@@ -12,6 +12,7 @@ from msdlab.course import oracles
 from msdlab.course.feedback import (
     as_array,
     expect,
+    expect_nontrivial,
     grid_place,
     matching_variant,
     num,
@@ -65,7 +66,11 @@ def compare_with_engine(got, x, spacing, stiffness, what):
 
 @pytest.mark.points(2)
 def test_grid_at_rest_feels_no_force(task2):
-    """A grid at its rest spacing is free of stress: every acceleration is zero."""
+    """A grid at its rest spacing is free of stress: every acceleration is zero (and a
+    deformed one is not)."""
+    deformed = perturbed_grid(SHAPE, SPACING, np.random.default_rng(1))
+    got = student_acceleration(task2, deformed, SPACING, STIFFNESS)
+    expect_nontrivial(got, deformed, "spring_acceleration on a deformed grid")
     x = oracles.template_positions(SHAPE, SPACING, (-1.0, 1.5, -1.0))
     a = student_acceleration(task2, x, SPACING, STIFFNESS)
     worst = np.unravel_index(np.argmax(np.linalg.norm(a, axis=-1)), SHAPE)
@@ -94,23 +99,41 @@ def test_stretched_pulls_compressed_pushes(task2):
             saw=f"a spring {verb} to {factor}·h between particles at x = 0 and x = "
             f"{num(factor * h)} gives accelerations {vec(a[0, 0, 0])} and {vec(a[1, 0, 0])}; "
             f"expected {vec(expected)} and {vec(-expected)}",
-            cause=two_particle_cause(a[0, 0, 0], a[1, 0, 0], expected),
+            cause=two_particle_cause(a[0, 0, 0], a[1, 0, 0], expected, factor * h),
         )
 
 
-def two_particle_cause(first, second, expected):
-    """The usual cause of wrong accelerations of two particles joined by one spring."""
+def two_particle_cause(first, second, expected, length):
+    """The usual cause of wrong accelerations of two particles joined by one spring of
+    ``length``."""
     if np.allclose(first, -expected) and np.allclose(second, expected):
         return "the sign of (l - |x_i - x_j|) or of the direction x_i - x_j"
     if np.allclose(first, expected) or np.allclose(second, -expected):
-        return "the reaction: particle j must get -f_ij, equal and opposite to f_ij on i"
-    if np.allclose(first, -second) and first[0] * expected[0] > 0:
-        ratio = first[0] / expected[0]
         return (
-            f"the size of the force is {num(ratio)}× eq. (1.2): check the stiffness k, the "
-            "rest length (one spacing h), and that the direction is a unit vector"
+            "the reaction: f_ij added to particle i without -f_ij on j (j must get -f_ij, "
+            "equal and opposite to f_ij on i)"
         )
+    if np.allclose(first, -second) and first[0] * expected[0] > 0:
+        return size_cause(first[0] / expected[0], length)
     return "the sign of (l - |x_i - x_j|), the rest length (one spacing h), or the stiffness"
+
+
+def size_cause(ratio, length):
+    """Why a spring force is ``ratio`` × eq. (1.2) for a spring of ``length``."""
+    if np.isclose(ratio, 0.5):
+        return (
+            "half of each spring force: particle i gets all of f_ij and particle j all of "
+            "-f_ij, not half each"
+        )
+    if np.isclose(ratio, length):
+        return (
+            "the direction x_i - x_j is not divided by the spring length |x_i - x_j| (it "
+            "must be a unit vector)"
+        )
+    return (
+        f"the size of the force is {num(ratio)}× eq. (1.2): check the stiffness k, the rest "
+        "length (one spacing h), and that the direction is a unit vector"
+    )
 
 
 @pytest.mark.points(3)
@@ -130,6 +153,7 @@ def test_forces_are_equal_and_opposite(task2):
     rng = np.random.default_rng(4)
     x = perturbed_grid(SHAPE, SPACING, rng, amount=0.3)
     a = student_acceleration(task2, x, SPACING, STIFFNESS)
+    expect_nontrivial(a, x, "spring_acceleration on a deformed grid")
     scale = float(np.max(np.linalg.norm(a, axis=-1)))
     net = a.reshape(-1, 3).sum(axis=0)
     expect(
@@ -159,6 +183,7 @@ def test_rotating_the_grid_rotates_the_forces(task2, seed):
     rotation = oracles.random_rotation(rng)
     x = perturbed_grid(SHAPE, SPACING, rng)
     a = student_acceleration(task2, x, SPACING, STIFFNESS)
+    expect_nontrivial(a, x, "spring_acceleration on a deformed grid")
     rotated = student_acceleration(task2, x @ rotation.T, SPACING, STIFFNESS)
     error = relative_error(rotated, a @ rotation.T)
     expect(
@@ -191,6 +216,9 @@ def test_energy_is_conserved_in_a_verlet_run(task2):
 
     start = energy(flat, v)
     a = acceleration(flat)
+    expect_nontrivial(a, flat, "spring_acceleration on a deformed grid")
+    template_rest = expected_acceleration(x, SPACING, STIFFNESS).reshape(-1, 3)
+    ignored = relative_error(a, template_rest) < 1e-9
     for _ in range(steps):
         v_half = v + 0.5 * dt * a
         flat = flat + dt * v_half
@@ -203,6 +231,9 @@ def test_energy_is_conserved_in_a_verlet_run(task2):
         f"{steps} velocity-Verlet steps at "
         f"dt = {num(dt)} (the predicted stable limit is {num(limit)}); it should stay within "
         "2 %",
-        cause="forces that are not the gradient of the spring energy: a wrong sign, a wrong "
+        cause=f"the spacing argument is ignored: rest length {SPACING} (2/N) instead of the "
+        f"given spacing {spacing}"
+        if ignored
+        else "forces that are not the gradient of the spring energy: a wrong sign, a wrong "
         "rest length, or forces that are not equal and opposite",
     )

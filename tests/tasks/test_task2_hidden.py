@@ -8,7 +8,15 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from msdlab.course import oracles
-from msdlab.course.feedback import as_array, expect, grid_place, matching_variant, percent, vec
+from msdlab.course.feedback import (
+    as_array,
+    expect,
+    expect_nontrivial,
+    grid_place,
+    matching_variant,
+    percent,
+    vec,
+)
 
 import reference_hidden as reference
 
@@ -98,7 +106,8 @@ def test_positions_are_not_modified(task2):
     x = oracles.template_positions((3, 3, 2), 0.1, (0.0, 0.0, 0.0))
     x += 0.01 * rng.standard_normal(x.shape)
     kept = x.copy()
-    task2.spring_acceleration(x, 0.1, 0.5)
+    got = as_array(task2.spring_acceleration(x, 0.1, 0.5), "spring_acceleration", x.shape)
+    expect_nontrivial(got, kept, "spring_acceleration of a deformed grid")
     expect(
         np.array_equal(x, kept),
         saw="spring_acceleration changed the positions array it was given",

@@ -112,8 +112,21 @@ def test_grid_springs_each_pair_once(task4):
             saw=f"for {kinds} springs of a {SHAPE} grid you give {len(springs)} springs, "
             f"{len(expected)} expected: {len(missing)} missing, {len(extra)} that are not "
             f"neighbour pairs, {repeated} listed twice (e.g. particles {example})",
-            cause=pairs_cause(missing, extra, repeated, len(springs), len(expected)),
+            cause=every_kind_cause(springs, neighbours)
+            or pairs_cause(missing, extra, repeated, len(springs), len(expected)),
         )
+
+
+def every_kind_cause(springs, neighbours):
+    """The cause if ``springs`` are those of all kinds, whatever ``neighbours`` asked for."""
+    every, _ = engine_pairs(SHAPE, (1, 2, 3))
+    given = {frozenset(p) for p in springs.tolist()}
+    if tuple(neighbours) != (1, 2, 3) and given == every:
+        return (
+            "springs of every kind (axis, face- and body-diagonal), not only those that "
+            "were asked for with squared_distances"
+        )
+    return None
 
 
 def pairs_cause(missing, extra, repeated, given, expected):
@@ -136,6 +149,15 @@ def test_rest_lengths_unstressed(task4):
     spacing = 0.1
     springs, rest = student_springs(task4, SHAPE, spacing, (1, 2, 3))
     positions = oracles.template_positions(SHAPE, spacing, (0.0, 0.0, 0.0)).reshape(-1, 3)
+    expected, _ = engine_pairs(SHAPE, (1, 2, 3))
+    expect(
+        len(springs) == len(expected) and np.all(springs[:, 0] != springs[:, 1]),
+        saw=f"grid_springs gives {len(springs)} springs, "
+        f"{int(np.sum(springs[:, 0] == springs[:, 1]))} of them joining a particle to itself, "
+        f"where the {SHAPE} grid has {len(expected)}: a body without real springs is "
+        "unstressed trivially, so this earns no point",
+        cause="springs missing, listed twice, or spring ends left at zero",
+    )
     expect(
         np.all((springs >= 0) & (springs < len(positions))),
         saw=f"spring ends outside 0 .. {len(positions) - 1}",
@@ -150,8 +172,21 @@ def test_rest_lengths_unstressed(task4):
         f"{num(distance[worst])} but has rest length {num(rest[worst])}: the body at rest is "
         f"pre-stressed (with k = {stiffness} that spring pulls or pushes with "
         f"{num(stiffness * abs(rest[worst] - distance[worst]))})",
-        cause="rest lengths in grid units (1, √2, √3) instead of times the spacing, or the "
-        "same rest length for every kind of spring",
+        cause=rest_length_cause(rest, distance, spacing),
+    )
+
+
+def rest_length_cause(rest, distance, spacing):
+    """The usual cause of rest lengths that differ from the distances at rest."""
+    scale = rest / distance
+    if np.allclose(scale, scale[0]) and not np.isclose(scale[0], 1.0 / spacing):
+        return (
+            f"rest lengths {num(scale[0])}× the distances, for another spacing: not "
+            f"spacing·√(squared length) with the given spacing {spacing}"
+        )
+    return (
+        "rest lengths in grid units (1, √2, √3) instead of times the spacing, or the same "
+        "rest length for every kind of spring"
     )
 
 

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from msdlab.course import oracles
-from msdlab.course.feedback import as_array, expect, num
+from msdlab.course.feedback import as_array, expect, num, percent
 
 import reference_hidden as reference
 
@@ -107,4 +107,12 @@ def test_drop_rotated_cube_runs_the_steps_asked_for(task4):
         saw=f"drop_rotated_cube(..., steps=1) = {num(still)}: in a single step the cube "
         "cannot change its shape that much",
         cause="the number of steps is ignored (run `steps` steps, not a fixed number)",
+    )
+    folded = float(task4.drop_rotated_cube((0.0, 0.0, 1.0), 45.0, (1,)))
+    expect(
+        folded < 0.3,
+        saw=f"with all its steps the tilted cube with axis springs only kept {percent(folded)} "
+        "of its thickness, as after one step: it should fold flat",
+        cause="a ratio that does not come from the run (run `steps` steps and measure the "
+        "flatness of the cube they leave)",
     )

@@ -52,8 +52,8 @@ def step_mistakes(x, v, dt, lam, dynamics):
         "λ is ignored: this is eq. (1.3)": undamped,
         "damping applied to the acceleration term, (1 - λ) a dt², instead of to x(t) and "
         "x(t - dt)": undamped - lam * kick,
-        "damping applied to the positions, (1 - λ)(2 x(t) - x(t - dt)): it pulls every "
-        "particle towards the origin": (1 - lam) * (undamped - kick) + kick,
+        "damping applied to the positions, (1 - λ)(2 x(t) - x(t - dt)): it pulls "
+        "particles towards the origin": (1 - lam) * (undamped - kick) + kick,
         "the signs of λ reversed: (2 + λ) x(t) - (1 + λ) x(t - dt) adds energy": (
             2 * undamped - damped
         ),
@@ -76,6 +76,19 @@ def step_at_fault(task5):
     return None
 
 
+def damped_verlet(task5, lam):
+    """The student's DampedVerlet(λ) for a valid λ, or a failure naming the refusal."""
+    try:
+        return task5.DampedVerlet(lam)
+    except ValueError as error:
+        expect(
+            False,
+            saw=f"DampedVerlet({lam}) refused a valid damping: {error}",
+            cause="a range check that excludes valid values: 0 <= λ < 1 is allowed (λ = 0 is "
+            "the template's undamped scheme)",
+        )
+
+
 @pytest.mark.points(3)
 def test_one_step_is_equation_1_4(task5):
     """One step gives x(t+dt) = (2-λ)x(t) - (1-λ)x(t-dt) + a(t)dt² and v = (x(t+dt) - x(t))/dt."""
@@ -83,7 +96,7 @@ def test_one_step_is_equation_1_4(task5):
     for lam in (0.0, 0.3, 0.9):
         dynamics, x, v = one_step_case()
         expected = engine_step(lam, x, v, dt, dynamics)
-        result = task5.DampedVerlet(lam).step(x.copy(), v.copy(), dt, dynamics)
+        result = damped_verlet(task5, lam).step(x.copy(), v.copy(), dt, dynamics)
         expect(
             isinstance(result, tuple) and len(result) == 2,
             saw=f"step returned {type(result).__name__}, not the pair (x_new, v_new)",
@@ -240,8 +253,14 @@ def test_damping_acts_on_velocity_only(task5):
     v = np.array([[0.0, 0.0, 0.0], [1.0, -2.0, 0.5]])
     integrator = task5.DampedVerlet(lam)
     for _ in range(5):
-        x_new, v_new = integrator.step(x, v, dt, dynamics)
+        given = v.copy()
+        x_new, v_new = integrator.step(x, given, dt, dynamics)
         x_new, v_new = as_array(x_new, "step", x.shape), as_array(v_new, "step", x.shape)
+        expect(
+            np.array_equal(given, v),
+            saw="step changed the velocity array it was given",
+            cause="in-place updates such as v *= 1 - λ: the caller's velocities are corrupted",
+        )
         expect(
             np.allclose(x_new[0], x[0], atol=1e-12),
             saw=f"a free particle at rest at {vec(x[0])} moved to {vec(x_new[0])} with λ = {lam}",

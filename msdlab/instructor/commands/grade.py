@@ -108,7 +108,11 @@ def run(args: argparse.Namespace) -> int:
         else intake.from_paths(args.submissions) as found
     ):
         entries = {entry.id: entry for entry in found.entries}
-        prints = {i: gradebook.fingerprint(checks, e.folder) for i, e in entries.items()}
+        prints = {  # nothing is read from a submission refused at intake (a link, ...)
+            i: gradebook.fingerprint(checks, e.folder)
+            for i, e in entries.items()
+            if e.problem is None
+        }
         todo = [e for e in entries.values() if e.problem is None]
         if args.resume:
             todo = [e for e in todo if book.fingerprint_of(e.id) != prints[e.id]]
@@ -188,7 +192,7 @@ def write_feedback(
         (folder / "students" / f"{stem}.md").write_text(
             feedback.for_student(grade), encoding="utf-8"
         )
-        source = intake.readable(str(entries[grade.submission].source))
+        source = intake.escaped(str(entries[grade.submission].source))
         (folder / "instructor" / f"{stem}.md").write_text(
             feedback.for_instructor(grade, source), encoding="utf-8"
         )

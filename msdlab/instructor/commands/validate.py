@@ -3,9 +3,12 @@
 For instructors, before a release: the checks of each task (hidden ones included) run on
 the reference solution (all must pass), on the template (all must fail) and on mutants of
 the solution's code (operators, operands, constants, comparisons, dropped terms, signs).
-The report gives, per task, how many mutants each check kills, the surviving mutants
-(equivalent to the solution, or a mistake no check catches: a new check is due) and the
-kill rate. Exit status 1 if a solution fails a check or a template passes one.
+Trivial answers (the solution answering zeros, its input, constants, NaN, inf, empty or
+complex arrays) must fail every check. The report gives, per task, how many mutants each
+check kills and which it alone kills, the surviving mutants (equivalent to the solution,
+with the reason from solutions/equivalent_mutants.json, or a mistake no check catches: a
+new check is due) and the kill rate of the mutants not equivalent. Exit status 1 if a
+solution fails a check, or a template or a trivial answer passes one.
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ import sys
 from pathlib import Path
 
 from ...course import PROJECT_ROOT, TASKS
-from ..validate import format_report, validate
+from ..validate import broken, format_report, validate
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -65,5 +68,4 @@ def run(args: argparse.Namespace) -> int:
         print(format_report([report], verbose=args.verbose), flush=True)
     if len(reports) > 1:
         print(format_report(reports).splitlines()[-1])  # all tasks together
-    broken = any(r.solution_failures or r.template_passes for r in reports)
-    return 1 if broken else 0
+    return 1 if any(broken(report) for report in reports) else 0

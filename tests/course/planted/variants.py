@@ -101,6 +101,15 @@ BUGS = [
         "½·a·dt²",
     ),
     bug(
+        "verlet_step clamps at the floor",
+        1,
+        T1_VERLET,
+        "new = 2.0 * current - old + np.asarray(acceleration, dtype=float) * dt**2\n"
+        "    new[..., 1] = np.maximum(new[..., 1], 0.0)\n    return new",
+        "verlet_step_is_the_kernel",
+        "floor clamp",
+    ),
+    bug(
         "verlet_step in place",
         1,
         T1_VERLET,
@@ -496,8 +505,8 @@ BUGS += [
         T3_SUM,
         "    for axis in range(3):\n"
         "        a[:, axis] = np.bincount(i, f[:, axis], len(positions))\n",
-        "no_net_force_or_torque",
-        "the reaction -f_ij on particle j is missing",
+        "spring_acceleration_matches_equations",
+        "-f_ij is never added to particle j",
     ),
     bug(
         "zero length divides by zero",
@@ -514,6 +523,14 @@ BUGS += [
         "neighbours=(1,))",
         "drop_rotated_cube_uses_steps_and_neighbours",
         "the neighbours argument is ignored",
+    ),
+    bug(
+        "cube dropped with damped Verlet",
+        3,
+        "msd.Verlet(), DT",
+        "msd.Verlet(0.05), DT",
+        "tilted_cube_collapses_upright_one_stands",
+        "undamped scheme",
     ),
     bug(
         "cube steps ignored",
