@@ -21,14 +21,15 @@ def step_bar(
     label: str,
     *,
     file: TextIO | None = None,
+    unit: str = "step",
     delay: float = 0.5,
     note_after: float = FIRST_STEP_WAIT,
 ) -> Iterator[Callable[[int], None]]:
-    """A bar drawn once ``delay`` s have passed, updated by calling it with the steps done.
+    """A bar drawn once ``delay`` s have passed, updated by calling it with the ``unit``s done.
 
     If no step is done ``note_after`` s after the start, a line says why (`STARTING`).
     """
-    with tqdm(total=total, desc=label, unit="step", delay=delay, file=file) as bar:
+    with tqdm(total=total, desc=label, unit=unit, delay=delay, file=file) as bar:
         note = threading.Timer(note_after, _note_no_step_yet, (bar,))
         note.daemon = True
         note.start()

@@ -221,10 +221,7 @@ def _sweep(scene: Scene, settings: dict[str, object], args: argparse.Namespace) 
                    integrators=INTEGRATORS, integrator=args.integrator)  # fmt: skip
     print(f"{scene.name}: sweeping {' × '.join(axes)}, {count} runs")
     if args.cluster:
-        from ..analysis.cluster import connect
-
-        with connect(args.cluster) as client:
-            rows = sweep.sweep(scene, axes, client=client, **options)
+        rows = sweep.sweep(scene, axes, cluster=args.cluster, **options)
     else:
         with count_bar(count, "sweep") as bar:
             rows = sweep.sweep(

@@ -13,6 +13,7 @@ from __future__ import annotations
 import collections
 import contextlib
 import fcntl
+import itertools
 import os
 import queue
 import shutil
@@ -20,13 +21,13 @@ import signal
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..analysis import cluster
 from ..course import TASKS, reference_cache
 from ..course.report import CheckReport
 from .judge_server import JudgeServer
@@ -183,16 +184,15 @@ def grade_all(
     allow_delegation: Sequence[int] = (),
     **limits: float,
 ) -> list[Grade]:
-    """Grade ``submissions``, ``jobs`` at a time; ``progress(grade, done, count)`` as each ends."""
+    """Grade ``submissions``, ``jobs`` at a time (threads: each judge is its own process);
+    ``progress(grade, done, count)`` as each ends."""
     jobs = max(1, jobs)
     slots: queue.Queue[tuple[int | None, JudgeServer]] = queue.Queue()
-    finished: list[Grade] = []
-    lock = threading.Lock()
 
     def one(submission: Submission) -> Grade:
         uid, server = slots.get()
         try:
-            result = grade(
+            return grade(
                 submission,
                 checks,
                 uid=uid,
@@ -204,24 +204,43 @@ def grade_all(
             )
         finally:
             slots.put((uid, server))
-        with lock:
-            finished.append(result)
-            if progress is not None:
-                progress(result, len(finished), len(submissions))
-        return result
 
+    calls = [((submission,), {}) for submission in submissions]
     with (
         reserved_uids(jobs) as uids,
         tempfile.TemporaryDirectory(prefix="msdlab-references-") as shared,
         contextlib.ExitStack() as servers,
         ThreadPoolExecutor(max_workers=jobs) as pool,
+        cluster.tally(len(calls), "grading", rows(submissions, progress)) as (grades, finished),
     ):
         references = Path(shared)
         for uid in uids:
             server = JudgeServer(judge_environment())
             servers.callback(server.close)
             slots.put((uid, server))
-        return list(pool.map(one, submissions))
+        cluster.collect(pool, one, calls, range(len(calls)), finished, retries=0)
+    return [as_grade(submissions[i], grades[i]) for i in range(len(calls))]
+
+
+def as_grade(submission: Submission, outcome: Grade | BaseException) -> Grade:
+    """The grade, or a row that says why the grading of ``submission`` failed."""
+    if isinstance(outcome, Grade):
+        return outcome
+    reason = f"not graded: the grader lost it ({type(outcome).__name__}: {outcome})"
+    return Grade(submission.name, None, [reason])
+
+
+def rows(
+    submissions: Sequence[Submission], progress: Callable[[Grade, int, int], None] | None
+) -> cluster.Done:
+    """What to do as the grading of one submission ends: ``progress(grade, done, count)``."""
+    count = itertools.count(1)
+
+    def done(index: int, outcome: Grade | BaseException) -> None:
+        if progress is not None:
+            progress(as_grade(submissions[index], outcome), next(count), len(submissions))
+
+    return done
 
 
 @contextlib.contextmanager
