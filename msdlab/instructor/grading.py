@@ -30,7 +30,7 @@ from pathlib import Path
 from ..analysis import cluster
 from ..course import TASKS, reference_cache
 from ..course.report import CheckReport
-from .judge_server import JudgeServer
+from .judges import ForkedJudges
 
 MAX_FILE_BYTES = 1_000_000
 FIRST_UID = 61000  # as root, sandboxes run as reserved user ids from here on
@@ -101,7 +101,7 @@ def grade(
     isolation: str = "namespace",
     allow_delegation: Sequence[int] = (),
     references: Path | None = None,
-    server: JudgeServer | None = None,
+    server: ForkedJudges | None = None,
 ) -> Grade:
     """Grade one submission with the checks in ``checks`` (see the module docstring).
 
@@ -109,7 +109,7 @@ def grade(
     ``isolation`` is the sandbox's level (`sandbox.ISOLATION_LEVELS`); a weaker one
     than ``namespace`` is named in the row's notes. ``references`` is a folder the
     judges share for references (`reference_cache`). With a ``server`` the judge is
-    forked from it (`judge_server`) instead of started afresh.
+    forked from it (`judges`) instead of started afresh.
     """
     if uid is None and os.geteuid() == 0:
         with reserved_uids(1) as (reserved,):
@@ -148,7 +148,7 @@ def grade(
             if server is None:
                 raise EOFError("no judge server")
             failure = _outcome(*server.run(arguments, workspace, environment, timeout), timeout)
-        except EOFError:  # the server could not start or died: a fresh judge grades (or says why)
+        except (EOFError, OSError):  # no server, or it could not fork: a fresh judge grades
             failure = _run_judge(arguments, workspace, environment, timeout)
         if uid is not None:
             _kill_user(uid)
@@ -187,10 +187,11 @@ def grade_all(
     """Grade ``submissions``, ``jobs`` at a time (threads: each judge is its own process);
     ``progress(grade, done, count)`` as each ends."""
     jobs = max(1, jobs)
-    slots: queue.Queue[tuple[int | None, JudgeServer]] = queue.Queue()
+    slots: queue.Queue[int | None] = queue.Queue()
+    server = ForkedJudges()
 
     def one(submission: Submission) -> Grade:
-        uid, server = slots.get()
+        uid = slots.get()
         try:
             return grade(
                 submission,
@@ -203,21 +204,18 @@ def grade_all(
                 **limits,
             )
         finally:
-            slots.put((uid, server))
+            slots.put(uid)
 
     calls = [((submission,), {}) for submission in submissions]
     with (
         reserved_uids(jobs) as uids,
         tempfile.TemporaryDirectory(prefix="msdlab-references-") as shared,
-        contextlib.ExitStack() as servers,
         ThreadPoolExecutor(max_workers=jobs) as pool,
         cluster.tally(len(calls), "grading", rows(submissions, progress)) as (grades, finished),
     ):
         references = Path(shared)
         for uid in uids:
-            server = JudgeServer(judge_environment())
-            servers.callback(server.close)
-            slots.put((uid, server))
+            slots.put(uid)
         cluster.collect(pool, one, calls, range(len(calls)), finished, retries=0)
     return [as_grade(submissions[i], grades[i]) for i in range(len(calls))]
 
