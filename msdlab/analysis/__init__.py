@@ -1,6 +1,6 @@
 """Analysis on top of the engine: the predicted stable time step and the diagnosis
-of a blow-up, measured blow-up time steps, convergence orders, and the Dask
-cluster that sweeps and grading can run on.
+of a blow-up, measured blow-up time steps, convergence orders, and running the
+calls of sweeps and grading side by side, here or on a Dask cluster (`cluster`).
 
 The predictions and measurements are re-exported from `msdlab`.
 """

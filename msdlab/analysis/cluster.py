@@ -1,17 +1,37 @@
-"""Connecting to a Dask distributed scheduler, for grading and sweeps that outgrow one machine.
+"""Running independent calls side by side: worker processes here, or a Dask scheduler's workers.
 
-``ADDRESS`` is a running scheduler (``tcp://host:8786``); ``local:N`` starts a
-`LocalCluster` of N single-threaded worker processes on this machine. Dask is
-the optional extra ``msdlab[cluster]``.
+``--cluster local:N`` runs them in a `concurrent.futures.ProcessPoolExecutor` of N processes;
+any other value is a Dask scheduler's address (``tcp://host:8786``), whose
+`Client.get_executor` has the same interface (Dask is the optional extra ``msdlab[cluster]``).
+`run_all` runs a list of calls on either with a progress bar (tqdm) and gives each call's
+result or, after its retries, its error, in the order of the calls:
+
+- a call that raises runs again, up to ``retries`` times;
+- a local process that dies (killed, out of memory) breaks its pool: the calls it was
+  running count one attempt each and run again in a new pool;
+- on Dask the scheduler does both (``retries`` for errors, and a worker that dies makes it
+  run the call on another one; a call that keeps killing workers ends in ``KilledWorker``).
 """
 
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Iterator
+import multiprocessing
+import sys
+from collections import Counter
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
+from tqdm.auto import tqdm
+
 INSTALL = "pip install 'msdlab[cluster]'"
+
+Call = tuple[tuple[Any, ...], dict[str, Any]]  # positional and keyword arguments
+Done = Callable[[int, Any], None]  # called with a call's index and its result or error
+# Workers start from a clean server process, not a fork of this one and its threads.
+_START = multiprocessing.get_context("forkserver")
 
 
 def parse_cluster(spec: str) -> tuple[str | None, int]:
@@ -28,27 +48,92 @@ def parse_cluster(spec: str) -> tuple[str | None, int]:
 
 
 @contextlib.contextmanager
-def connect(spec: str) -> Iterator[Any]:
-    """A `dask.distributed.Client` for ``spec`` (see the module docstring), closed on exit."""
-    address, workers = parse_cluster(spec)
+def dask_executor(address: str, retries: int) -> Iterator[Executor]:
+    """A `concurrent.futures.Executor` on the workers of the Dask scheduler at ``address``."""
     try:
-        from dask.distributed import Client, LocalCluster
+        from dask.distributed import Client
     except ImportError:
         raise RuntimeError(f"--cluster needs Dask distributed: {INSTALL}") from None
-    if address is not None:
-        with Client(address) as client:
-            yield client
-        return
-    # One task per worker process; no dashboard; no memory monitor (the work runs in
-    # child processes with their own limits, which the nanny would not see anyway).
-    with (
-        LocalCluster(
-            n_workers=workers,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=None,
-            memory_limit=0,
-        ) as cluster,
-        Client(cluster) as client,
-    ):
-        yield client
+    with Client(address) as client:
+        yield client.get_executor(pure=False, retries=retries)
+
+
+@contextlib.contextmanager
+def tally(count: int, label: str, done: Done | None = None) -> Iterator[tuple[dict, Done]]:
+    """The outcomes of ``count`` calls by index, and the function that records one, drawing
+    a progress bar (tqdm) and calling ``done`` with each."""
+    results: dict[int, Any] = {}
+    with tqdm(total=count, desc=label, file=sys.stderr) as bar:
+
+        def finished(index: int, outcome: Any) -> None:
+            results[index] = outcome
+            bar.update()
+            if done is not None:
+                done(index, outcome)
+
+        yield results, finished
+
+
+def run_all(
+    spec: str,
+    function: Callable[..., Any],
+    calls: Sequence[Call],
+    *,
+    label: str,
+    retries: int = 2,
+    done: Done | None = None,
+) -> list[Any]:
+    """``function(*args, **kwargs)`` for each call on the workers of ``spec`` (see the module
+    docstring): each result, or the exception its last attempt raised."""
+    address, workers = parse_cluster(spec)
+    with tally(len(calls), label, done) as (results, finished):
+        if address is not None:
+            with dask_executor(address, retries) as pool:
+                collect(pool, function, calls, range(len(calls)), finished, retries=0)
+        else:
+            attempts: Counter[int] = Counter()
+            while len(results) < len(calls):
+                left = [i for i in range(len(calls)) if i not in results]
+                with ProcessPoolExecutor(workers, mp_context=_START) as pool:
+                    collect(pool, function, calls, left, finished, retries, attempts, workers)
+    return [results[i] for i in range(len(calls))]
+
+
+def collect(
+    pool: Executor,
+    function: Callable[..., Any],
+    calls: Sequence[Call],
+    indices: Sequence[int],
+    finished: Done,
+    retries: int,
+    attempts: Counter[int] | None = None,
+    in_flight: int | None = None,
+) -> None:
+    """Run the calls at ``indices`` on ``pool``, at most ``in_flight`` at a time, calling
+    ``finished`` with each outcome; returns early if the pool breaks (its unfinished calls
+    are then left for a new pool, those it was running with one attempt more)."""
+    attempts = Counter() if attempts is None else attempts
+    waiting = list(reversed(indices))
+    running: dict[Future, int] = {}
+    while waiting or running:
+        while waiting and len(running) < (in_flight or len(calls)):
+            index = waiting.pop()
+            args, kwargs = calls[index]
+            running[pool.submit(function, *args, **kwargs)] = index
+        ended, _ = wait(running, return_when=FIRST_COMPLETED)
+        for future in ended:
+            index = running.pop(future)
+            error = future.exception()
+            if error is not None:
+                attempts[index] += 1
+            if isinstance(error, BrokenProcessPool):
+                for other in running.values():
+                    attempts[other] += 1
+                for i in (index, *running.values()):
+                    if attempts[i] > retries:
+                        finished(i, error)
+                return
+            if error is not None and attempts[index] <= retries:
+                waiting.append(index)
+            else:
+                finished(index, future.result() if error is None else error)

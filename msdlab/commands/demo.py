@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ..analysis import max_stable_dt
 from ..scenes import get_scene
-from .progress import FIRST_STEP_WAIT, ProgressBar
+from .progress import step_bar
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -39,7 +39,7 @@ def run(args: argparse.Namespace) -> int:
     sim = scene.build(size=args.size)
     limit = max_stable_dt(sim.body, sim.integrator)
     print(f"jelly cube: {sim.body}, {sim.integrator!r}, dt = {sim.dt:g} (stable below {limit:.3g})")
-    with ProgressBar(args.steps, "jelly cube", starting_after=FIRST_STEP_WAIT) as bar:
+    with step_bar(args.steps, "jelly cube") as bar:
         trajectory = sim.run(
             steps=args.steps,
             record_every=max(1, args.steps // 120),

@@ -23,7 +23,7 @@ from ..integrators import (
 from ..scenes import SCENES, Scene, get_scene, sweep
 from ..scenes.trampoline import EXPERIMENTS, experiment_table, run_experiment
 from ..simulation import Simulation, Trajectory
-from .progress import FIRST_STEP_WAIT, ProgressBar
+from .progress import count_bar, step_bar
 
 INTEGRATORS: dict[str, type[Integrator]] = {
     "explicit-euler": ExplicitEuler,
@@ -180,18 +180,16 @@ def _build(scene: Scene, settings: dict[str, object], args: argparse.Namespace) 
 
 def _run(sim: Simulation, steps: int, label: str) -> Trajectory | None:
     """Run with a progress bar; on a blow-up print the diagnosis and return None."""
-    bar = ProgressBar(steps, label, starting_after=FIRST_STEP_WAIT)
     try:
-        return sim.run(
-            steps=steps,
-            record_every=max(1, steps // 200),
-            callback=lambda s: bar(s.step_count),
-        )
+        with step_bar(steps, label) as bar:
+            return sim.run(
+                steps=steps,
+                record_every=max(1, steps // 200),
+                callback=lambda s: bar(s.step_count),
+            )
     except SimulationDiverged as error:
         print(f"the simulation blew up: {error}")
         return None
-    finally:
-        bar.close()
 
 
 def _experiments(scene: Scene, settings: dict[str, object], args: argparse.Namespace) -> int:
@@ -205,12 +203,11 @@ def _experiments(scene: Scene, settings: dict[str, object], args: argparse.Names
         settings["dt"] = args.dt
     if args.integrator is not None:
         settings["integrator"] = INTEGRATORS[args.integrator]()
-    bar = ProgressBar(len(EXPERIMENTS), "experiments", delay=0.0)
-    outcomes = []
-    for done, experiment in enumerate(EXPERIMENTS.values()):
-        bar(done)
-        outcomes.append(run_experiment(experiment, duration, **settings))
-    bar.close()
+    with count_bar(len(EXPERIMENTS), "experiments") as bar:
+        outcomes = []
+        for experiment in EXPERIMENTS.values():
+            outcomes.append(run_experiment(experiment, duration, **settings))
+            bar.update()
     print(f"ball centre heights in m after {duration:g} s (deepest, mean of the last second):")
     print(experiment_table(outcomes))
     return 0
@@ -224,14 +221,12 @@ def _sweep(scene: Scene, settings: dict[str, object], args: argparse.Namespace) 
                    integrators=INTEGRATORS, integrator=args.integrator)  # fmt: skip
     print(f"{scene.name}: sweeping {' × '.join(axes)}, {count} runs")
     if args.cluster:
-        from ..analysis.cluster import connect
-
-        with connect(args.cluster) as client:
-            rows = sweep.sweep(scene, axes, client=client, **options)
+        rows = sweep.sweep(scene, axes, cluster=args.cluster, **options)
     else:
-        bar = ProgressBar(count, "sweep", delay=0.0)
-        rows = sweep.sweep(scene, axes, progress=bar, **options)
-        bar.close()
+        with count_bar(count, "sweep") as bar:
+            rows = sweep.sweep(
+                scene, axes, progress=lambda done: bar.update(done - bar.n), **options
+            )
     sweep.write_table(rows, out)
     print(sweep.format_table(rows))
     print(f"table written to {out}")

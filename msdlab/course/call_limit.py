@@ -1,33 +1,64 @@
 """A time limit on each call into a student's task module, in the checks' own process.
 
-`limited` wraps a task module's function (or the methods a task's class defines)
-so that one call may take at most ``seconds``: a real-time timer
-(`signal.setitimer`) interrupts it with `CallTimedOut`, whose message names the
-function and the check that called it. A function that timed out fails at once
-for the rest of that check (`forgive` starts the next check afresh), so a
-property check does not wait again for every example it tries.
+`time_limit` is the one real-time timer of msdlab's checks: it interrupts a block after
+``seconds`` and then gives back the timer it found (pytest-timeout's, with the time that is
+left of it), so a check stays under its own limit after a limited call. `limited` wraps a task
+module's function (or the methods a task's class defines) so that one call may take at most
+``seconds``, failing with `CallTimedOut`, whose message names the function and the check that
+called it. A function that timed out fails at once for the rest of that check (`forgive`
+starts the next check afresh), so a property check does not wait again for every example.
 
-Works only in the main thread of a POSIX process; elsewhere calls are not limited.
-Calls made while another limited call is running count toward the outer one.
+Works only in the main thread of a POSIX process; elsewhere nothing is limited. Limits nest:
+an inner limit longer than what is left of the outer one leaves the outer one in charge.
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import inspect
 import os
 import signal
 import threading
-from collections.abc import Callable
-from typing import Any
+import time
+from collections.abc import Callable, Iterator
+from typing import Any, NoReturn
 
 _LIMITED = "__msdlab_limited__"
 _timed_out: set[str] = set()
-_running = False
 
 
 class CallTimedOut(Exception):
     """A call into the task module took longer than the per-call limit."""
+
+
+@contextlib.contextmanager
+def time_limit(seconds: float, expire: Callable[[], NoReturn]) -> Iterator[None]:
+    """Call ``expire`` (which raises) if the block runs longer than ``seconds``; the timer and
+    handler found on entry are restored on exit, the timer with the time it has left."""
+    main = threading.current_thread() is threading.main_thread()
+    if not main or not hasattr(signal, "setitimer"):
+        yield
+        return
+    outer, interval = signal.getitimer(signal.ITIMER_REAL)
+    if outer and outer <= seconds:  # the outer limit comes first: leave it in charge
+        yield
+        return
+
+    def interrupt(signum: int, frame: object) -> None:
+        expire()
+
+    previous = signal.signal(signal.SIGALRM, interrupt)
+    started = time.monotonic()
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+        if outer:
+            left = outer - (time.monotonic() - started)
+            signal.setitimer(signal.ITIMER_REAL, max(left, 1e-3), interval)
 
 
 def forgive() -> None:
@@ -54,35 +85,19 @@ def limited(value: Any, seconds: float, file: str) -> Any:
 def _wrap(function: Callable, seconds: float, name: str, file: str) -> Callable:
     @functools.wraps(function)
     def call(*args: Any, **kwargs: Any) -> Any:
-        global _running
-        if _running or threading.current_thread() is not threading.main_thread():
-            return function(*args, **kwargs)
         if name in _timed_out:
             _fail(name, file, seconds)
-
-        def expire(signum: int, frame: object) -> None:
-            _fail(name, file, seconds)
-
-        previous = signal.signal(signal.SIGALRM, expire)
-        _running = True
-        try:
-            signal.setitimer(signal.ITIMER_REAL, seconds)
+        with time_limit(seconds, lambda: _fail(name, file, seconds)):
             return function(*args, **kwargs)
-        except CallTimedOut:
-            _timed_out.add(name)
-            raise
-        finally:
-            signal.setitimer(signal.ITIMER_REAL, 0)
-            signal.signal(signal.SIGALRM, previous)
-            _running = False
 
     setattr(call, _LIMITED, True)
     return call
 
 
-def _fail(name: str, file: str, seconds: float) -> None:
-    """Raise `CallTimedOut` naming the function and the check (one place, so that a property
-    check that meets it again sees the same error)."""
+def _fail(name: str, file: str, seconds: float) -> NoReturn:
+    """Raise `CallTimedOut` naming the function and the check, and remember the function (one
+    place, so that a property check that meets it again sees the same error)."""
+    _timed_out.add(name)
     check = os.environ.get("PYTEST_CURRENT_TEST", "").split("::")[-1].split(" ")[0]
     where = f" (check {check.removeprefix('test_')})" if check else ""
     raise CallTimedOut(

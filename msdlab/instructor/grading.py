@@ -13,6 +13,7 @@ from __future__ import annotations
 import collections
 import contextlib
 import fcntl
+import itertools
 import os
 import queue
 import shutil
@@ -20,16 +21,16 @@ import signal
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..analysis import cluster
 from ..course import TASKS, reference_cache
 from ..course.report import CheckReport
-from .judge_server import JudgeServer
+from .judges import ForkedJudges
 
 MAX_FILE_BYTES = 1_000_000
 FIRST_UID = 61000  # as root, sandboxes run as reserved user ids from here on
@@ -100,7 +101,7 @@ def grade(
     isolation: str = "namespace",
     allow_delegation: Sequence[int] = (),
     references: Path | None = None,
-    server: JudgeServer | None = None,
+    server: ForkedJudges | None = None,
 ) -> Grade:
     """Grade one submission with the checks in ``checks`` (see the module docstring).
 
@@ -108,7 +109,7 @@ def grade(
     ``isolation`` is the sandbox's level (`sandbox.ISOLATION_LEVELS`); a weaker one
     than ``namespace`` is named in the row's notes. ``references`` is a folder the
     judges share for references (`reference_cache`). With a ``server`` the judge is
-    forked from it (`judge_server`) instead of started afresh.
+    forked from it (`judges`) instead of started afresh.
     """
     if uid is None and os.geteuid() == 0:
         with reserved_uids(1) as (reserved,):
@@ -147,7 +148,7 @@ def grade(
             if server is None:
                 raise EOFError("no judge server")
             failure = _outcome(*server.run(arguments, workspace, environment, timeout), timeout)
-        except EOFError:  # the server could not start or died: a fresh judge grades (or says why)
+        except (EOFError, OSError):  # no server, or it could not fork: a fresh judge grades
             failure = _run_judge(arguments, workspace, environment, timeout)
         if uid is not None:
             _kill_user(uid)
@@ -183,16 +184,16 @@ def grade_all(
     allow_delegation: Sequence[int] = (),
     **limits: float,
 ) -> list[Grade]:
-    """Grade ``submissions``, ``jobs`` at a time; ``progress(grade, done, count)`` as each ends."""
+    """Grade ``submissions``, ``jobs`` at a time (threads: each judge is its own process);
+    ``progress(grade, done, count)`` as each ends."""
     jobs = max(1, jobs)
-    slots: queue.Queue[tuple[int | None, JudgeServer]] = queue.Queue()
-    finished: list[Grade] = []
-    lock = threading.Lock()
+    slots: queue.Queue[int | None] = queue.Queue()
+    server = ForkedJudges()
 
     def one(submission: Submission) -> Grade:
-        uid, server = slots.get()
+        uid = slots.get()
         try:
-            result = grade(
+            return grade(
                 submission,
                 checks,
                 uid=uid,
@@ -203,25 +204,41 @@ def grade_all(
                 **limits,
             )
         finally:
-            slots.put((uid, server))
-        with lock:
-            finished.append(result)
-            if progress is not None:
-                progress(result, len(finished), len(submissions))
-        return result
+            slots.put(uid)
 
+    calls = [((submission,), {}) for submission in submissions]
     with (
         reserved_uids(jobs) as uids,
         tempfile.TemporaryDirectory(prefix="msdlab-references-") as shared,
-        contextlib.ExitStack() as servers,
         ThreadPoolExecutor(max_workers=jobs) as pool,
+        cluster.tally(len(calls), "grading", rows(submissions, progress)) as (grades, finished),
     ):
         references = Path(shared)
         for uid in uids:
-            server = JudgeServer(judge_environment())
-            servers.callback(server.close)
-            slots.put((uid, server))
-        return list(pool.map(one, submissions))
+            slots.put(uid)
+        cluster.collect(pool, one, calls, range(len(calls)), finished, retries=0)
+    return [as_grade(submissions[i], grades[i]) for i in range(len(calls))]
+
+
+def as_grade(submission: Submission, outcome: Grade | BaseException) -> Grade:
+    """The grade, or a row that says why the grading of ``submission`` failed."""
+    if isinstance(outcome, Grade):
+        return outcome
+    reason = f"not graded: the grader lost it ({type(outcome).__name__}: {outcome})"
+    return Grade(submission.name, None, [reason])
+
+
+def rows(
+    submissions: Sequence[Submission], progress: Callable[[Grade, int, int], None] | None
+) -> cluster.Done:
+    """What to do as the grading of one submission ends: ``progress(grade, done, count)``."""
+    count = itertools.count(1)
+
+    def done(index: int, outcome: Grade | BaseException) -> None:
+        if progress is not None:
+            progress(as_grade(submissions[index], outcome), next(count), len(submissions))
+
+    return done
 
 
 @contextlib.contextmanager

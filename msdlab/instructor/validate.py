@@ -29,7 +29,6 @@ import importlib.util
 import json
 import random
 import shutil
-import signal
 import sys
 import tempfile
 import warnings
@@ -37,11 +36,11 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
-from typing import Any
+from typing import Any, NoReturn
 
 import numpy as np
 
-from ..course import delegation
+from ..course import call_limit, delegation
 from ..course.loader import FolderImplementation
 from . import trivial
 
@@ -323,25 +322,13 @@ class CheckTimeout(BaseException):
     """
 
 
-@contextlib.contextmanager
-def _time_limit(seconds: float) -> Iterator[None]:
+def _time_limit(seconds: float) -> contextlib.AbstractContextManager[None]:
     """Interrupt the block after ``seconds`` (main thread only; elsewhere no limit)."""
-    import threading
 
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def interrupt(signum: int, frame: Any) -> None:
+    def expire() -> NoReturn:
         raise CheckTimeout(f"no answer within {seconds:g} s (an endless loop?)")
 
-    previous = signal.signal(signal.SIGALRM, interrupt)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, previous)
+    return call_limit.time_limit(seconds, expire)
 
 
 # ---------------------------------------------------------------------------------- mutants

@@ -16,10 +16,10 @@ import itertools
 import math
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
+from ..analysis.cluster import run_all
 from ..errors import SimulationDiverged
 from ..integrators import Integrator
 from ..simulation import Trajectory
@@ -85,11 +85,12 @@ def sweep(
     dt: float | None = None,
     integrators: dict[str, type[Integrator]],
     integrator: str | None = None,
-    client: Any = None,
+    cluster: str | None = None,
     progress: Callable[[int], None] | None = None,
 ) -> list[dict[str, object]]:
     """One row per combination of ``axes`` (on top of the ``fixed`` settings): the combination
-    and its outcomes; on the workers of ``client`` (a Dask client) if one is given."""
+    and its outcomes; here, calling ``progress(done)`` after each, or on the workers of
+    ``cluster`` (``local:N`` or a Dask scheduler's address: `analysis.cluster.run_all`)."""
     rows = combinations(axes)
     calls = []
     for row in rows:
@@ -103,15 +104,18 @@ def sweep(
             "integrator": integrators[name] if name is not None else None,
         }
         calls.append((settings, options))
-    if client is None:
+    if cluster is None:
         outcomes = []
         for done, (settings, options) in enumerate(calls, start=1):
             outcomes.append(run_point(scene.name, settings, **options))
             if progress is not None:
                 progress(done)
     else:
-        futures = [client.submit(run_point, scene.name, s, pure=False, **o) for s, o in calls]
-        outcomes = client.gather(futures)
+        jobs = [((scene.name, settings), options) for settings, options in calls]
+        outcomes = run_all(cluster, run_point, jobs, label="sweep")
+        for row, outcome in zip(rows, outcomes):
+            if isinstance(outcome, BaseException):
+                raise RuntimeError(f"the sweep's run {row} failed: {outcome!r}") from outcome
     return [{**row, **outcome} for row, outcome in zip(rows, outcomes)]
 
 

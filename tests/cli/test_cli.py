@@ -11,7 +11,7 @@ from matplotlib.animation import FFMpegWriter
 from PIL import Image
 
 from msdlab.cli import main
-from msdlab.commands.progress import STARTING, ProgressBar
+from msdlab.commands.progress import STARTING, step_bar
 from msdlab.scenes import SCENES
 
 
@@ -125,51 +125,27 @@ def test_demo_writes_animation_and_plot(tmp_path, capsys):
 
 def test_progress_bar_only_for_runs_that_take_a_moment():
     stream = io.StringIO()
-    quick = ProgressBar(100, "quick", stream=stream, delay=10.0)
-    quick(100)
-    quick.close()
+    with step_bar(100, "quick", file=stream, delay=10.0) as bar:
+        bar(100)
     assert stream.getvalue() == ""
-    slow = ProgressBar(100, "slow", stream=stream, delay=0.0)
-    slow(50)
-    slow.close()
+    with step_bar(100, "slow", file=stream, delay=0.0) as bar:
+        bar(50)
     text = stream.getvalue()
-    assert "slow [###############...............]  50%" in text and "100%" in text
-    assert text.endswith("\n")
-
-
-def test_progress_bar_estimates_the_time_left_from_the_pace_after_the_first_step(monkeypatch):
-    """A first step that loads the kernels (2 s) does not count toward the pace of the rest."""
-    clock = iter([0.0, 2.0, 3.0])  # perf_counter: created, then one per call
-    monkeypatch.setattr("msdlab.commands.progress.time.perf_counter", lambda: next(clock))
-    stream = io.StringIO()
-    bar = ProgressBar(1000, "run", stream=stream, delay=0.0)
-    bar(1)  # at 2 s: one step done, the first one slow
-    assert stream.getvalue().endswith("time left unknown yet")
-    bar(101)  # at 3 s: 100 steps in 1 s since then, 899 to go
-    assert stream.getvalue().rstrip().endswith("~ 9.0 s left")
+    assert "slow:  50%|#####     | 50/100" in text and text.endswith("\n")
 
 
 def test_progress_bar_says_why_the_first_step_takes_long():
-    """No step after ``starting_after`` s (compiling on a first run): the bar says so."""
+    """No step after ``note_after`` s (compiling on a first run): a line says so, once."""
     stream = io.StringIO()
-    with ProgressBar(100, "run", stream=stream, starting_after=0.05) as bar:
+    with step_bar(100, "run", file=stream, note_after=0.05) as bar:
         time.sleep(0.5)
-        assert stream.getvalue() == f"\rrun [{'.' * 30}]   0%  {STARTING}"
+        assert stream.getvalue().count(STARTING + "\n") == 1
         bar(1)
-    lines = stream.getvalue().split("\r")
-    assert lines[-1].startswith("run [##############################] 100%")
-    assert lines[-1].endswith("\n") and len(lines[-1]) > len(STARTING)  # the long line blanked
-    quick = ProgressBar(100, "quick", stream=stream, starting_after=0.2)
-    quick(100)
-    quick.close()
-    quick.close()
+    quick = io.StringIO()
+    with step_bar(100, "quick", file=quick, note_after=0.2) as bar:
+        bar(100)
     time.sleep(0.4)
-    assert "quick" not in stream.getvalue()  # done before the delay: nothing, not even later
-    assert stream.getvalue().count("\n") == 1
-    idle = ProgressBar(100, "idle", stream=stream, starting_after=60.0)
-    idle.close()  # no step at all, and the timer's call comes after the close
-    idle._no_step_yet()
-    assert "idle" not in stream.getvalue()
+    assert quick.getvalue() == ""  # done before the delay: nothing, not even later
 
 
 def test_quick_start_demo_in_a_real_process(tmp_path):

@@ -6,7 +6,6 @@ from __future__ import annotations
 import csv
 import os
 import shutil
-import sys
 import textwrap
 from pathlib import Path
 
@@ -15,7 +14,7 @@ import pytest
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
 from msdlab.instructor import grading
-from msdlab.instructor.judge_server import JudgeServer
+from msdlab.instructor.judges import ForkedJudges
 
 SOLUTIONS = PROJECT_ROOT / "solutions"
 CHECKS = PROJECT_ROOT / "tests" / "tasks"
@@ -168,10 +167,11 @@ def test_a_refused_action_at_import_costs_only_that_task(tmp_path):
     assert any("task1" in note and "sandbox forbids" in note for note in grade.notes), grade.notes
 
 
-class DeadServer(JudgeServer):
-    """A judge server that dies as it starts (say, an import that fails in its Python)."""
+class DeadServer(ForkedJudges):
+    """Judges that cannot be forked (say, the forkserver cannot start in this Python)."""
 
-    command = (sys.executable, "-c", "raise SystemExit(1)")
+    def run(self, *args: object) -> tuple[int | None, str]:
+        raise OSError("the forkserver could not start")
 
 
 def test_a_judge_server_that_dies_leaves_the_grading_to_a_fresh_judge(tmp_path):
@@ -179,12 +179,10 @@ def test_a_judge_server_that_dies_leaves_the_grading_to_a_fresh_judge(tmp_path):
     checks.mkdir()
     for name in ("conftest.py", "test_task1.py"):
         shutil.copy(CHECKS / name, checks)
-    server = DeadServer(grading.judge_environment())
-    try:
-        folder = submission(tmp_path, "alice")
-        grade = grading.grade(grading.Submission("alice", folder), checks, server=server, **LIMITS)
-    finally:
-        server.close()
+    folder = submission(tmp_path, "alice")
+    grade = grading.grade(
+        grading.Submission("alice", folder), checks, server=DeadServer(), **LIMITS
+    )
     assert grade.report is not None and grade.points(1) > 0, grade.notes
     assert not any("server" in note for note in grade.notes), grade.notes
 

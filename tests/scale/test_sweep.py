@@ -49,9 +49,10 @@ def test_sweeping_what_the_scene_does_not_have_names_the_valid_settings() -> Non
     assert main(["run", "hanging-particle", "--cluster", "local:2"]) == 2
 
 
-def test_a_sweep_on_a_cluster_writes_the_same_table(tmp_path: Path) -> None:
-    pytest.importorskip("dask.distributed", reason="needs the extra: pip install -e '.[cluster]'")
+@pytest.mark.parametrize("where", ["local:2", "scheduler"])
+def test_a_sweep_on_a_cluster_writes_the_same_table(tmp_path: Path, where: str, request) -> None:
+    spec = request.getfixturevalue("scheduler") if where == "scheduler" else where
     command = ["run", "hanging-particle", "--duration", "100", "--sweep", "dt=1.5,2.5"]
     assert main([*command, "--out", str(tmp_path / "local.csv")]) == 0
-    assert main([*command, "--out", str(tmp_path / "cluster.csv"), "--cluster", "local:1"]) == 0
+    assert main([*command, "--out", str(tmp_path / "cluster.csv"), "--cluster", spec]) == 0
     assert (tmp_path / "cluster.csv").read_text() == (tmp_path / "local.csv").read_text()

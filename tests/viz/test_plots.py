@@ -11,7 +11,6 @@ from matplotlib.path import Path
 import msdlab as msd
 from msdlab import viz
 from msdlab.scenes import cloth, gallery, trampoline
-from msdlab.viz import lines
 from msdlab.viz.lines import LEVELS, SpringLines
 
 
@@ -107,51 +106,6 @@ def test_spring_lines_draw_every_spring_once_in_the_colour_of_its_value():
             assert abs(np.clip(values[spring], -1, 1) - value) <= half_level + 1e-12
             drawn.append(spring)
     assert sorted(drawn) == list(range(500))
-
-
-def _drawn(springs: SpringLines, painted: bool, monkeypatch: pytest.MonkeyPatch) -> np.ndarray:
-    """The RGB pixels of a figure holding ``springs``, painted by `raster.paint` or by Agg."""
-    monkeypatch.setattr(lines, "_PAINT", [] if painted else [None])
-    figure, ax = plt.subplots(figsize=(4, 3), dpi=80)
-    ax.add_collection(springs)
-    ax.set(xlim=(-2.5, 2.5), ylim=(-2.5, 2.5))
-    figure.canvas.draw()
-    return np.asarray(figure.canvas.buffer_rgba())[..., :3].astype(int)
-
-
-@pytest.mark.parametrize("width", [0.6, 1.2, 1.7])  # points: 0.67 to 1.9 px at 80 dpi
-def test_spring_lines_paint_as_agg_draws_them(width, monkeypatch):
-    """On an Agg canvas thin springs are painted by `raster.paint`: the picture is Agg's own
-    to a few levels of 255, for lines in every direction, crossing and leaving the axes,
-    and for horizontal and vertical ones, which Agg snaps to pixels."""
-    rng = np.random.default_rng(4)
-    angle, offset = rng.uniform(0, np.pi, 300), rng.uniform(-2.5, 2.5, 300)
-    along = np.stack([np.cos(angle), np.sin(angle)], axis=1)
-    across = offset[:, None] * along[:, ::-1] * [-1, 1]
-    crossing = np.stack([across - 6 * along, across + 6 * along], axis=1)  # ends outside
-    square = [[[-4, 0.3], [4, 0.3]], [[0.7, -4], [0.7, 4]], [[-4, -1.0], [4, -1.0]]]
-    ends = np.concatenate([crossing, square])
-    values = np.concatenate([rng.uniform(-0.9, 0.9, 300), [-1.0, -1.0, -1.0]])
-    style = {"cmap": "coolwarm", "norm": Normalize(-1, 1), "linewidths": width, "alpha": 0.7}
-    agg, painted = (
-        _drawn(SpringLines(ends, values, **style), paint, monkeypatch) for paint in (False, True)
-    )
-    assert np.abs(agg - painted).max() <= 8
-    assert (painted < 250).any(axis=2).mean() > 0.2  # the springs are there
-    assert lines._PAINT[0] is not None  # and were painted
-
-
-def test_thick_or_broken_spring_lines_are_drawn_by_agg(monkeypatch):
-    """Lines wider than 2 px (the painter cuts their ends square) are left to Agg, and so
-    are springs with an end at NaN; ends far away do not hang the painter."""
-    ends = np.array([[[0.0, 0.0], [np.nan, 1.0]], [[-1e12, -1e12], [1e12, 0.9e12]]])
-    for width, tolerance in ((1.0, 8), (3.0, 0)):
-        agg, painted = (
-            _drawn(SpringLines(ends, np.zeros(2), linewidths=width), paint, monkeypatch)
-            for paint in (False, True)
-        )
-        assert np.abs(agg - painted).max() <= tolerance
-        assert (painted < 250).any()
 
 
 def test_sag_colouring_needs_a_3d_body():

@@ -12,8 +12,8 @@ holds the maximum points. Rows of earlier runs in the CSV are kept, a
 submission graded again gets its row replaced, and --resume skips those
 already graded with the same checks. --feedback DIR writes DIR/students/ID.md
 (to hand out), DIR/instructor/ID.md (everything) and DIR/summary.md. Exit
-status 0 if every submission was graded, 1 otherwise. With --cluster the
-submissions are graded by Dask workers (msdlab[cluster]).
+status 0 if every submission was graded, 1 otherwise. With --cluster ADDRESS the
+submissions are graded by a Dask scheduler's workers (msdlab[cluster]).
 """
 
 from __future__ import annotations
@@ -25,7 +25,9 @@ import sys
 import time
 from pathlib import Path
 
-from ...analysis.cluster import connect
+from tqdm.auto import tqdm
+
+from ...analysis.cluster import parse_cluster
 from ...course import PROJECT_ROOT, TASKS
 from .. import feedback, gradebook, grading, intake, sandbox
 from ..cluster_grading import grade_all_on_cluster
@@ -84,7 +86,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--cluster",
         metavar="ADDRESS|local:N",
-        help="grade on a Dask scheduler, or on N local worker processes (instead of --jobs)",
+        help="grade on a Dask scheduler's workers, or N at a time here (local:N is --jobs N)",
     )
     parser.set_defaults(run=run)
 
@@ -94,6 +96,7 @@ def run(args: argparse.Namespace) -> int:
         raise FileNotFoundError(f"no checks in {args.checks}; give --checks DIR")
     if args.jobs < 1 or args.timeout <= 0 or args.call_timeout <= 0 or args.memory < 256:
         raise ValueError("--jobs >= 1, --timeout and --call-timeout > 0 and --memory >= 256 MB")
+    address, jobs = parse_cluster(args.cluster) if args.cluster else (None, args.jobs)
     problem = sandbox.isolation_problem(args.isolation)
     if problem is not None:
         print(f"msdlab grade: {problem}", file=sys.stderr)
@@ -125,7 +128,7 @@ def run(args: argparse.Namespace) -> int:
                 None,
                 args.detail,
             )
-        where = f"on the cluster {args.cluster}" if args.cluster else f"{args.jobs} at a time"
+        where = f"on the cluster {address}" if address else f"{jobs} at a time"
         plural = "" if len(todo) == 1 else "s"
         resumed = f" ({skipped} unchanged since graded, skipped)" if skipped else ""
         print(
@@ -142,8 +145,8 @@ def run(args: argparse.Namespace) -> int:
                 result = f"{grade.total}/{grade.report.points} points"
             else:
                 result = "NOT GRADED: " + "; ".join(grade.notes)
-            print(f"[{done:>{len(str(count))}}/{count}] {grade.submission:<{width}}  {result}  "
-                  f"({grade.seconds:.1f} s)", file=sys.stderr)  # fmt: skip
+            tqdm.write(f"[{done:>{len(str(count))}}/{count}] {grade.submission:<{width}}  "
+                       f"{result}  ({grade.seconds:.1f} s)", file=sys.stderr)  # fmt: skip
 
         started = time.monotonic()
         options = dict(
@@ -156,11 +159,10 @@ def run(args: argparse.Namespace) -> int:
         graded = [grading.Submission(e.id, e.folder) for e in todo]
         if not graded:
             grades = []
-        elif args.cluster:
-            with connect(args.cluster) as client:
-                grades = grade_all_on_cluster(graded, checks, client, progress=progress, **options)
+        elif address is not None:
+            grades = grade_all_on_cluster(graded, checks, address, progress=progress, **options)
         else:
-            grades = grading.grade_all(graded, checks, jobs=args.jobs, progress=progress, **options)
+            grades = grading.grade_all(graded, checks, jobs=jobs, progress=progress, **options)
         book.write(args.out)
         grades = unusable + grades
         if args.feedback is not None:

@@ -1,15 +1,20 @@
-"""Judges forked from a `JudgeServer`: each starts from the server's state, gets its own
-environment, and one that runs too long is killed without taking the server with it."""
+"""Judges forked from the forkserver (`ForkedJudges`): each starts from the server's state,
+gets its own environment, and one that runs too long is killed without taking the server
+with it."""
 
 from __future__ import annotations
 
+import os
+import signal
 import textwrap
+import time
+from multiprocessing import forkserver
 from pathlib import Path
 
 import pytest
 
 from msdlab.instructor.grading import judge_environment
-from msdlab.instructor.judge_server import JudgeServer
+from msdlab.instructor.judges import ForkedJudges
 
 CHECKS = """
 import os
@@ -36,13 +41,11 @@ def test_sleeps():
 
 
 @pytest.fixture
-def server():
-    judges = JudgeServer(judge_environment())
-    yield judges
-    judges.close()
+def server() -> ForkedJudges:
+    return ForkedJudges()
 
 
-def judge(server: JudgeServer, folder: Path, timeout: float = 120.0, **settings: str):
+def judge(server: ForkedJudges, folder: Path, timeout: float = 120.0, **settings: str):
     (folder / "tmp").mkdir(exist_ok=True)
     (folder / "test_checks.py").write_text(textwrap.dedent(CHECKS))
     environment = {**judge_environment(), "GIVEN": str(folder), "TMPDIR": str(folder / "tmp")}
@@ -67,7 +70,11 @@ def test_a_judge_over_its_time_limit_is_killed_and_the_next_one_runs(server, tmp
 def test_a_dead_server_is_started_again(server, tmp_path):
     (tmp_path / "first").mkdir()
     assert judge(server, tmp_path / "first")[0] == 0
-    server.process.kill()
-    server.process.wait()
+    pid = forkserver._forkserver._forkserver_pid
+    os.kill(pid, signal.SIGKILL)
+    deadline = time.monotonic() + 30
+    while Path(f"/proc/{pid}/stat").read_text().split()[2] != "Z":  # dead, not yet reaped
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
     (tmp_path / "second").mkdir()
     assert judge(server, tmp_path / "second")[0] == 0
