@@ -104,10 +104,6 @@ class Dynamics:
         self._add_forces(x, v, self._buffer, fields)
         return self.springs.advance(update, self.body, x, v, self._buffer, field, dt, coefficients)
 
-    def dashpot_power(self, x: np.ndarray, v: np.ndarray) -> float:
-        """Power (W) the spring dashpots take out of the body at (x, v), Σ c ((v_a - v_b)·n)²."""
-        return self.springs.dashpot_power(self.body, x, v)
-
     def acceleration_of(
         self,
         particles: np.ndarray,

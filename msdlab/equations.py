@@ -35,8 +35,16 @@ def spring_force(
     length = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
     safe = length + (length == 0.0)  # 1 where d = 0, which then makes f_a = 0
     rate = (w[0] * d[0] + w[1] * d[1] + w[2] * d[2]) / safe
-    scale = (stiffness * (rest - length) - damping * rate) / safe  # |f_a| / |d|
+    scale = spring_tension(stiffness, rest, length, damping, rate) / safe  # |f_a| / |d|
     return scale * d[0], scale * d[1], scale * d[2]
+
+
+def spring_tension(
+    stiffness: float, rest: float, length: float, damping: float, rate: float
+) -> float:
+    """The signed size (N) of `spring_force` along n: k (l - |d|) - c ṡ, positive pushing
+    the ends apart (the grid gather of the numba kernel sums it by offset)."""
+    return stiffness * (rest - length) - damping * rate
 
 
 def spring_energy(stiffness: float, rest: float, length: float) -> float:

@@ -178,13 +178,13 @@ class Simulation:
         """Add to `dissipated` the energy (J) each mechanism took out in the step from (x, v)
         to velocities ``v_new``: the dashpots, the integrator's damping, the dissipative
         forces, and the constraints (``removed``: (ledger name, energy) of each)."""
-        dt, masses = self._dt, self.body.masses
+        body, dt = self.body, self._dt
         booked = {
-            "dashpot": self.dynamics.dashpot_power(x, v) * dt,
-            "integrator": self.integrator.dissipated_energy(v, masses, v_new),
+            "dashpot": self.dynamics.springs.dashpot_power(body, x, v) * dt,
+            "integrator": self.integrator.dissipated_energy(v, body.masses, v_new),
         }
         for force in self.dynamics.forces:
-            lost = force.dissipated_power(self.body, x, v)
+            lost = force.dissipated_power(body, x, v)
             if lost:
                 booked[force.ledger_name] = booked.get(force.ledger_name, 0.0) + lost * dt
         for name, energy in removed:

@@ -1,8 +1,8 @@
 """The grid gather: the spring forces of a grid body by offset, with no list of springs.
 
 Each particle computes its springs to the neighbours ahead of it (half the
-stencil, so each spring once, with the same `equations.spring_force`), adds
-their forces to itself and, in a second loop, their opposites to the
+stencil, so each spring once, with `equations.spring_tension`, the size of
+`equations.spring_force`), adds their forces to itself and, in a second loop, their opposites to the
 neighbours. The positions are copied by coordinate so that the inner loops
 walk contiguous memory on vector registers, over whole grid rows (those whose
 neighbour would leave its row masked out), three offsets at a time (a
@@ -17,17 +17,22 @@ import math
 import numba
 import numpy as np
 
-from .equations import dashpot_power, spring_force
+from .equations import dashpot_power, spring_tension
 
 
 @numba.njit(cache=True, error_model="numpy")
 def _pull(y0, y1, y2, x0, x1, x2, q, there, k, rest):
-    """The force (3 components, N) on a particle at y from its spring to particle ``q``, eq.
-    (1.2), times ``there`` (1, or 0 when that neighbour does not exist), and |d|² (m²),
-    d = y - x_q. The force on ``q`` is its opposite."""
+    """The spring from a particle at y to particle ``q``, times ``there`` (1, or 0 when
+    that neighbour does not exist): f/|d| of eq. (1.2) (N/m), d = y - x_q (3 components)
+    and |d|² (m²). The force on the particle is (f/|d|)·d, on ``q`` its opposite.
+    """
     d0, d1, d2 = y0 - x0[q], y1 - x1[q], y2 - x2[q]
-    g0, g1, g2 = spring_force(k, rest, 0.0, (d0, d1, d2), (0.0, 0.0, 0.0))
-    return there * g0, there * g1, there * g2, there * (d0 * d0 + d1 * d1 + d2 * d2)
+    length_squared = d0 * d0 + d1 * d1 + d2 * d2
+    length = math.sqrt(length_squared)
+    safe = length if length > 0.0 else 1.0  # coincident ends: no direction, no force
+    scale = there * spring_tension(k, rest, safe, 0.0, 0.0) / safe
+    scale = scale if length > 0.0 else 0.0
+    return scale, d0, d1, d2, there * length_squared
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -36,20 +41,21 @@ def _pull_damped(y0, y1, y2, u0, u1, u2, xs, vs, q, there, k, rest, c):
     x0, x1, x2 = xs
     v0, v1, v2 = vs
     d0, d1, d2 = y0 - x0[q], y1 - x1[q], y2 - x2[q]
-    w0, w1, w2 = u0 - v0[q], u1 - v1[q], u2 - v2[q]
     length_squared = d0 * d0 + d1 * d1 + d2 * d2
     length = math.sqrt(length_squared)
     safe = length if length > 0.0 else 1.0
-    power = there * dashpot_power(c, (w0 * d0 + w1 * d1 + w2 * d2) / safe)
-    g0, g1, g2 = spring_force(k, rest, c, (d0, d1, d2), (w0, w1, w2))
-    return there * g0, there * g1, there * g2, there * length_squared, power
+    rate = ((u0 - v0[q]) * d0 + (u1 - v1[q]) * d1 + (u2 - v2[q]) * d2) / safe
+    power = there * dashpot_power(c, rate)
+    scale = there * spring_tension(k, rest, safe, c, rate) / safe
+    scale = scale if length > 0.0 else 0.0
+    return scale, d0, d1, d2, there * length_squared, power
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _push_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, values, kept, pad):
+def _push_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, values, scales, pad):
     """Add to particles ``first`` to ``stop - 1`` the forces of their springs to three
     neighbours, at p + ``shifts[j]``, the same grid row offset apart, and keep each
-    spring's force (3 components) in ``kept[3 j + q, pad + p - first]`` for `_react`.
+    spring's f/|d| in ``scales[j, pad + p - first]`` for `_react`.
 
     ``xs``, ``vs``, ``fs`` are positions, velocities and forces by coordinate,
     contiguous, so the loop runs on vector registers; a particle's position
@@ -68,19 +74,21 @@ def _push_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, values
     ka, ra, ca, wa = values[0, 0], values[0, 1], values[0, 2], values[0, 3]
     kb, rb, cb, wb = values[1, 0], values[1, 1], values[1, 2], values[1, 3]
     kc, rc, cc, wc = values[2, 0], values[2, 1], values[2, 2], values[2, 3]
+    kept_a, kept_b, kept_c = scales[0], scales[1], scales[2]
     power = 0.0
     if ca == 0.0 and cb == 0.0 and cc == 0.0:  # no sum across springs: vector registers
         for i in range(first, stop):
             p, r = numba.uint64(i), numba.uint64(i - first)
             y0, y1, y2 = x0[p], x1[p], x2[p]
             qa, qb, qc = numba.uint64(i + sa), numba.uint64(i + sb), numba.uint64(i + sc)
-            a0, a1, a2, la = _pull(y0, y1, y2, x0, x1, x2, qa, columns[ma, r], ka, ra)
-            b0, b1, b2, lb = _pull(y0, y1, y2, x0, x1, x2, qb, columns[mb, r], kb, rb)
-            c0, c1, c2, lc = _pull(y0, y1, y2, x0, x1, x2, qc, columns[mc, r], kc, rc)
-            f0[p] += a0 + b0 + c0
-            f1[p] += a1 + b1 + c1
-            f2[p] += a2 + b2 + c2
-            _keep(kept, numba.uint64(i - first + pad), a0, a1, a2, b0, b1, b2, c0, c1, c2)
+            a, a0, a1, a2, la = _pull(y0, y1, y2, x0, x1, x2, qa, columns[ma, r], ka, ra)
+            b, b0, b1, b2, lb = _pull(y0, y1, y2, x0, x1, x2, qb, columns[mb, r], kb, rb)
+            c, c0, c1, c2, lc = _pull(y0, y1, y2, x0, x1, x2, qc, columns[mc, r], kc, rc)
+            f0[p] += a * a0 + b * b0 + c * c0
+            f1[p] += a * a1 + b * b1 + c * c1
+            f2[p] += a * a2 + b * b2 + c * c2
+            kept = numba.uint64(i - first + pad)
+            kept_a[kept], kept_b[kept], kept_c[kept] = a, b, c
             squared[p] = max(squared[p], la * wa, lb * wb, lc * wc)
         return power
     v0, v1, v2 = vs
@@ -89,59 +97,57 @@ def _push_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, values
         y0, y1, y2, u0, u1, u2 = x0[p], x1[p], x2[p], v0[p], v1[p], v2[p]
         y, u = (y0, y1, y2), (u0, u1, u2)
         qa, qb, qc = numba.uint64(i + sa), numba.uint64(i + sb), numba.uint64(i + sc)
-        a0, a1, a2, la, pa = _pull_damped(*y, *u, xs, vs, qa, columns[ma, r], ka, ra, ca)
-        b0, b1, b2, lb, pb = _pull_damped(*y, *u, xs, vs, qb, columns[mb, r], kb, rb, cb)
-        c0, c1, c2, lc, pc = _pull_damped(*y, *u, xs, vs, qc, columns[mc, r], kc, rc, cc)
-        f0[p] += a0 + b0 + c0
-        f1[p] += a1 + b1 + c1
-        f2[p] += a2 + b2 + c2
-        _keep(kept, numba.uint64(i - first + pad), a0, a1, a2, b0, b1, b2, c0, c1, c2)
+        a, a0, a1, a2, la, pa = _pull_damped(*y, *u, xs, vs, qa, columns[ma, r], ka, ra, ca)
+        b, b0, b1, b2, lb, pb = _pull_damped(*y, *u, xs, vs, qb, columns[mb, r], kb, rb, cb)
+        c, c0, c1, c2, lc, pc = _pull_damped(*y, *u, xs, vs, qc, columns[mc, r], kc, rc, cc)
+        f0[p] += a * a0 + b * b0 + c * c0
+        f1[p] += a * a1 + b * b1 + c * c1
+        f2[p] += a * a2 + b * b2 + c * c2
+        kept = numba.uint64(i - first + pad)
+        kept_a[kept], kept_b[kept], kept_c[kept] = a, b, c
         squared[p] = max(squared[p], la * wa, lb * wb, lc * wc)
         power += pa + pb + pc
     return power
 
 
-@numba.njit(cache=True, inline="always")
-def _keep(kept, at, a0, a1, a2, b0, b1, b2, c0, c1, c2):
-    """Keep the forces of three springs (3 components each) in column ``at`` of ``kept``."""
-    kept[0, at], kept[1, at], kept[2, at] = a0, a1, a2
-    kept[3, at], kept[4, at], kept[5, at] = b0, b1, b2
-    kept[6, at], kept[7, at], kept[8, at] = c0, c1, c2
-
-
 @numba.njit(cache=True, error_model="numpy")
-def _react(fs, kept, first, stop, shifts, pad):
+def _react(xs, fs, scales, first, stop, shifts, pad):
     """Add to each neighbour q = p + ``shifts[j]`` of particles p = ``first`` to ``stop - 1``
-    the opposite of the force its spring j exerts on p (eq. 1.1), kept in
-    ``kept[3 j + coordinate, pad + p - first]`` (see `_push_three`).
+    the opposite of the force its spring exerts on p (eq. 1.1), -(f/|d|)·(x_p - x_q),
+    with f/|d| from ``scales[j, pad + p - first]`` (see `_push_three`).
 
-    One loop over the neighbours q takes the three springs, so q's force is
-    written once. ``kept`` is 0 in its first and last ``pad`` columns
-    (pad ≥ the spread of the shifts), where q has no spring j.
+    One loop over the neighbours q takes the three springs, so q's position is
+    read and its force written once. ``scales`` is 0 in its first and last
+    ``pad`` columns (pad ≥ the spread of the shifts), where q has no spring j;
+    the scratch padding is as wide, so p stays in memory there.
     """
+    x0, x1, x2 = xs
     f0, f1, f2 = fs
+    kept_a, kept_b, kept_c = scales[0], scales[1], scales[2]
     sa, sb, sc = shifts
     low, high = min(sa, sb, sc), max(sa, sb, sc)
-    kept[:, pad + stop - first :] = 0.0
+    scales[:, pad + stop - first :] = 0.0
     for i in range(first + low, stop + high):
         q = numba.uint64(i)
-        ja = numba.uint64(i - sa - first + pad)
-        jb = numba.uint64(i - sb - first + pad)
-        jc = numba.uint64(i - sc - first + pad)
-        f0[q] -= kept[0, ja] + kept[3, jb] + kept[6, jc]
-        f1[q] -= kept[1, ja] + kept[4, jb] + kept[7, jc]
-        f2[q] -= kept[2, ja] + kept[5, jb] + kept[8, jc]
+        pa, pb, pc = numba.uint64(i - sa), numba.uint64(i - sb), numba.uint64(i - sc)
+        a = kept_a[numba.uint64(i - sa - first + pad)]
+        b = kept_b[numba.uint64(i - sb - first + pad)]
+        c = kept_c[numba.uint64(i - sc - first + pad)]
+        y0, y1, y2 = x0[q], x1[q], x2[q]
+        f0[q] -= a * (x0[pa] - y0) + b * (x0[pb] - y0) + c * (x0[pc] - y0)
+        f1[q] -= a * (x1[pa] - y1) + b * (x1[pb] - y1) + c * (x1[pc] - y1)
+        f2[q] -= a * (x2[pa] - y2) + b * (x2[pb] - y2) + c * (x2[pc] - y2)
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _push_rows(scratch, pad, columns, shape, triples, rows_of, o2s, values, plane, rows, kept):
+def _push_rows(scratch, pad, columns, shape, triples, rows_of, o2s, values, plane, rows, scales):
     """Add the forces of the springs from the particles of grid rows ``rows`` (first, stop)
     of ``plane`` to their neighbours ahead to both ends; return their dashpot power (W).
 
     ``scratch`` (10, N + 2·pad) holds the positions, velocities and forces by
     coordinate and the squared stretches, particle p at p + pad (the padding
     stays zero, so a masked neighbour past either end is still in memory);
-    ``kept`` (9, rows·n_2 + 2·pad) is the room `_push_three` and `_react` share.
+    ``scales`` (3, rows·n_2 + 2·pad) is the room `_push_three` and `_react` share.
     Triple t joins each particle to its neighbours at the offsets
     (``triples[t]``, ``o2s[t, j]``), j = 0, 1, 2, with the spring values
     ``values[t, j]`` (see `stencil.stencil_triples`); for each, the rows whose
@@ -164,9 +170,9 @@ def _push_rows(scratch, pad, columns, shape, triples, rows_of, o2s, values, plan
         masks = (rows_of[t, 0], rows_of[t, 1], rows_of[t, 2])
         shifts = (shift + o2s[t, 0], shift + o2s[t, 1], shift + o2s[t, 2])
         power += _push_three(
-            xs, vs, fs, scratch[9], columns, masks, first, stop, shifts, values[t], kept, pad
+            xs, vs, fs, scratch[9], columns, masks, first, stop, shifts, values[t], scales, pad
         )
-        _react(fs, kept, first, stop, shifts, pad)
+        _react(xs, fs, scales, first, stop, shifts, pad)
     return power
 
 
@@ -181,12 +187,12 @@ def _push_unit(scratch, pad, columns, shape, rows, triples, rows_of, o2s, values
     """
     n0, n1, n2 = shape[0], shape[1], shape[2]
     plane, lo, hi = (unit, 0, n1) if n0 > 1 else (0, unit * rows, min(unit * rows + rows, n1))
-    kept = np.zeros((9, rows * n2 + 2 * pad))
+    scales = np.zeros((3, rows * n2 + 2 * pad))
     power = 0.0
     for first in range(lo, hi, rows):
         block = (first, min(first + rows, hi))
         power += _push_rows(
-            scratch, pad, columns, shape, triples, rows_of, o2s, values, plane, block, kept
+            scratch, pad, columns, shape, triples, rows_of, o2s, values, plane, block, scales
         )
     start, end = (plane * n1 + lo) * n2 + pad, (plane * n1 + hi) * n2 + pad
     return scratch[9, start:end].max(), power
