@@ -13,6 +13,7 @@ from .errors import as_vectors, check_non_negative, check_positive
 from .lattice import grid_pair_blocks, grid_pair_count, grid_positions, neighbour_offsets
 from .particle import Particle
 from .spring import Spring
+from .tracked import TrackedArray
 
 Item = TypeVar("Item", Particle, Spring)
 MASS_HINT = "To pin a particle use fixed=True instead of a zero mass."
@@ -26,6 +27,10 @@ FIELDS = {  # the arrays of a body and their types: one row per particle / per s
         "spring_damping": float,
     },
 }
+
+
+_SPRING_VALUES = ("stiffness", "rest_lengths", "spring_damping")
+_VIEWS = {*FIELDS["particles"], *FIELDS["springs"], "spring_values"}  # kept in the __dict__
 
 
 def _per_row(name: str, values: object, count: int, hint: str, zero: bool = True) -> np.ndarray:
@@ -46,8 +51,12 @@ def _pin(body: Body, fixed: object, count: int) -> np.ndarray:
 class _Rows:
     """A body array as an attribute: a view of the used rows of a buffer that grows.
 
-    The view is valid until the body grows. Assigning the whole array goes through
-    ``check(body, value, rows)``; without a check the array is read-only.
+    Reading ``body.<name>`` finds the view in the body's ``__dict__`` (this
+    descriptor has no ``__get__``), where `Body` puts it whenever the rows
+    change: the view is valid until the body grows. Assigning the whole array
+    goes through ``check(body, value, rows)``; without a check the array is
+    read-only. Spring values are `TrackedArray` views, so writes to them
+    count in ``body.parameters_version``.
     """
 
     def __init__(self, doc: str, check: Callable[[Body, Any, int], Any] | None = None) -> None:
@@ -57,20 +66,19 @@ class _Rows:
         self.name = name
         self.kind = "particles" if name in FIELDS["particles"] else "springs"
 
-    def __get__(self, body: Body | None, owner: type | None = None) -> Any:
-        if body is None:
-            return self
+    def view(self, body: Body) -> np.ndarray:
+        """The used rows of the body's buffer, as the attribute shows them."""
         view = body._buffers[self.name][: body._size[self.kind]]
         if self.check is None:
             view.flags.writeable = False
         elif self.kind == "springs":
-            body.parameters_version += 1  # the caller may write to the spring values
+            return TrackedArray.of(view, body._spring_values_edited)
         return view
 
     def __set__(self, body: Body, value: object) -> None:
         if self.check is None:
             raise AttributeError(f"body.{self.name} is read-only; add springs to change it")
-        rows = self.__get__(body)
+        rows = body.__dict__[self.name]
         rows[...] = self.check(body, value, len(rows))
 
 
@@ -110,13 +118,17 @@ class Body:
         lambda body, c, n: _per_row("damping", c, n, "Use a dashpot coefficient c >= 0 (N·s/m)."),
     )
 
+    spring_values: tuple[np.ndarray, np.ndarray, np.ndarray]
+    """Stiffness (N/m), rest lengths (m) and dashpots (N·s/m) (E,) as plain arrays to read.
+    Write through `stiffness`, `rest_lengths` and `spring_damping`, which count edits."""
+
     def __init__(self, dim: int | None = None) -> None:
         if dim not in (None, 2, 3):
             raise ValueError(f"a body is 2-D or 3-D, got dim = {dim!r}")
         self.dim = dim
         self.grid_shape: tuple[int, ...] | None = None
         self.topology_version = 0  # grows whenever particles or springs are added
-        self.parameters_version = 0  # grows whenever the spring values may have been edited
+        self.parameters_version = 0  # grows whenever the spring values are edited
         self._size = {"particles": 0, "springs": 0}
         self._buffers: dict[str, np.ndarray] = {}
         self._capacity = {"particles": 0, "springs": 0}
@@ -135,16 +147,9 @@ class Body:
     def __len__(self) -> int:
         return self.n_particles
 
-    def spring_values(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Stiffness (N/m), rest lengths (m) and dashpots (N·s/m) (E,) to read only.
-
-        Unlike `stiffness`, `rest_lengths` and `spring_damping` this does not
-        count as a possible edit in ``parameters_version``.
-        """
-        used = self.n_springs
-        return tuple(  # type: ignore[return-value]
-            self._buffers[name][:used] for name in ("stiffness", "rest_lengths", "spring_damping")
-        )
+    def _spring_values_edited(self) -> None:
+        """Count an in-place write to the spring values (see `tracked.TrackedArray`)."""
+        self.parameters_version += 1
 
     @property
     def particles(self) -> _Items[Particle]:
@@ -274,7 +279,25 @@ class Body:
             self._buffers[name][start : start + count] = values
         self._size[kind] += count
         self.topology_version += 1
+        self._show(kind)
         return np.arange(start, start + count)
+
+    def _show(self, kind: str) -> None:
+        """Put the views of the used rows of ``kind`` (see `_Rows`) in the body's attributes."""
+        for name in FIELDS[kind]:
+            self.__dict__[name] = getattr(Body, name).view(self)
+        if kind == "springs":  # the same rows as plain arrays, for kernels to read
+            used = self._size[kind]
+            self.spring_values = tuple(self._buffers[name][:used] for name in _SPRING_VALUES)
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The body without its views (they would be pickled as copies, not views)."""
+        return {name: value for name, value in self.__dict__.items() if name not in _VIEWS}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._show("particles")
+        self._show("springs")
 
     def _reserve(self, kind: str, capacity: int) -> None:
         """Grow the buffers of ``kind`` to hold ``capacity`` rows (their used rows kept)."""
@@ -286,6 +309,7 @@ class Body:
                 grown[:used] = self._buffers[name][:used]
             self._buffers[name] = grown
         self._capacity[kind] = capacity
+        self._show(kind)
 
     @classmethod
     def from_arrays(

@@ -29,9 +29,6 @@ class StepState:
     time: float  # time at the end of the step (s)
     dt: float  # step (s)
     energy_of: Callable[[np.ndarray], float]  # energy (J) involving these particles now
-    # For the constraint whose `Constraint.floor` the step's update loop used: the free
-    # particles it found under that plane, else None.
-    under: np.ndarray | None = None
 
 
 class Constraint(ABC):
@@ -41,12 +38,6 @@ class Constraint(ABC):
 
     def check(self, body: Body) -> None:
         """Raise ValueError if this constraint cannot act on ``body``."""
-
-    def floor(self, body: Body) -> tuple[np.ndarray, float] | None:
-        """The plane (unit normal (d,), height m) if `apply` acts only on the free particles
-        under it; first among the constraints, the step's update loop then finds them
-        (``state.under``) and checks the state is finite. None by default."""
-        return None
 
     @abstractmethod
     def apply(self, state: StepState) -> float:

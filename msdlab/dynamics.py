@@ -7,10 +7,11 @@ from collections.abc import Sequence
 import numpy as np
 import scipy.sparse as sp
 
-from . import equations, kernels
+from . import equations
 from .body import Body
 from .forces import Force
-from .kernels import Update
+from .jacobian import JacobianPattern
+from .spring_kernel import SpringKernel, Update, make_kernel
 
 
 class Dynamics:
@@ -21,7 +22,7 @@ class Dynamics:
     acceleration. Integrators call `acceleration` or `advance` (and `force`,
     `jacobians` or `implicit_matrix`, `masses`, `free` for implicit methods).
 
-    ``kernel`` picks the spring kernel (`msdlab.kernels`): "numba" (compiled,
+    ``kernel`` picks the spring kernel (`msdlab.spring_kernel`): "numba" (compiled,
     threaded) or "numpy" (readable); the default is ``MSDLAB_KERNEL`` or "numba".
     Both apply the same `msdlab.equations`; nothing here depends on which runs.
     """
@@ -29,12 +30,10 @@ class Dynamics:
     def __init__(self, body: Body, forces: Sequence[Force] = (), kernel: str | None = None) -> None:
         self.body = body
         self.forces = list(forces)
-        self.springs: kernels.SpringKernel = kernels.make_kernel(kernel)
+        self.springs: SpringKernel = make_kernel(kernel)
         self.max_stretch = 0.0  # largest |d|/l seen in the last force evaluation
-        self._pattern: kernels.JacobianPattern | None = None
-        self._last_power: tuple[np.ndarray, np.ndarray, float] | None = None
-        self._buffer: np.ndarray | None = None
-        self.step_end: kernels.StepEnd | None = None  # for the next `advance`; see there
+        self._pattern: JacobianPattern | None = None
+        self._buffer = np.zeros((0, 0))  # the forces of `advance`, used up within each call
 
     @property
     def kernel(self) -> str:
@@ -66,8 +65,7 @@ class Dynamics:
     ) -> None:
         """Add the spring, dashpot and external forces at (x, v) to ``total``, but those
         of the forces whose `Force.uniform_acceleration` is given in ``fields`` (not None)."""
-        self.max_stretch, power = self.springs.add_spring_forces(self.body, x, v, total, None)
-        self._last_power = (x, v, power)
+        self.max_stretch, _ = self.springs.add_spring_forces(self.body, x, v, total, None)
         for i, force in enumerate(self.forces):
             if fields is None or fields[i] is None:
                 force.add_to(self.body, x, v, total)
@@ -86,50 +84,25 @@ class Dynamics:
         a = F/m + g, g the forces' `Force.uniform_acceleration` (gravity). When every
         force is such a g, F is the springs' alone and the kernel computes it and the
         update in one go (`SpringKernel.advance_with_springs`).
-
-        In a `Simulation` step the loop may also do the end of the step: pin the
-        fixed particles, check the values are finite, find those under the floor
-        and sum the damping's work (`step_end`, set by the Simulation for the
-        step's first call; see `kernels.StepEnd`). The
-        arrays returned are then read-only: return them as they are, or compute
-        new ones from them (``x_new + ...``), which the Simulation then checks.
         """
-        if self._buffer is None or self._buffer.shape != x.shape:
-            self._buffer = np.empty_like(x)  # the forces, used up within this call
-        fields = [force.uniform_acceleration(self.body) for force in self.forces]
-        field = np.zeros(x.shape[1])
-        for g in fields:
-            if g is not None:
-                field += g
-        end, self.step_end = self.step_end, None
-        if all(g is not None for g in fields):  # the springs' forces only: the kernel sums them
-            x_new, v_new, self.max_stretch, power = self.springs.advance_with_springs(
-                update, self.body, x, v, self._buffer, field, dt, coefficients, end
+        if self._buffer.shape != x.shape:
+            self._buffer = np.empty_like(x)
+        field = np.zeros(x.shape[1])  # Σ g (m/s²) of the uniform fields
+        fields: list[np.ndarray | None] = []  # per force: its g, or None if it is not one
+        uniform = True
+        for force in self.forces:
+            g = force.uniform_acceleration(self.body)
+            fields.append(g)
+            uniform = uniform and g is not None
+            field += 0.0 if g is None else g
+        if uniform:  # the springs' forces only: the kernel sums them
+            x_new, v_new, self.max_stretch, _ = self.springs.advance_with_springs(
+                update, self.body, x, v, self._buffer, field, dt, coefficients
             )
-            self._last_power = (x, v, power)
-        else:
-            self._buffer.fill(0.0)
-            self._add_forces(x, v, self._buffer, fields)
-            x_new, v_new = self.springs.advance(
-                update, self.body, x, v, self._buffer, field, dt, coefficients, end
-            )
-        if end is not None and end.arrays:
-            x_new.flags.writeable = v_new.flags.writeable = False
-        return x_new, v_new
-
-    def forget_last_state(self) -> None:
-        """Drop the dashpot power kept from the last force evaluation (the state changed)."""
-        self._last_power = None
-
-    def dashpot_power(self, x: np.ndarray, v: np.ndarray) -> float:
-        """Power (W) the spring dashpots take out of the body at (x, v), Σ c ((v_a - v_b)·n)².
-
-        Taken from the last force evaluation when it was at these very arrays.
-        """
-        last = self._last_power
-        if last is not None and last[0] is x and last[1] is v:
-            return last[2]
-        return self.springs.dashpot_power(self.body, x, v)
+            return x_new, v_new
+        self._buffer.fill(0.0)
+        self._add_forces(x, v, self._buffer, fields)
+        return self.springs.advance(update, self.body, x, v, self._buffer, field, dt, coefficients)
 
     def acceleration_of(
         self,
@@ -148,8 +121,8 @@ class Dynamics:
         self.springs.add_spring_forces(self.body, x, v, total, springs)
         for force in self.forces:
             force.add_to(self.body, x, v, total)
-        inverse = equations.inverse_mass(self.body.masses[particles], ~self.body.fixed[particles])
-        return equations.acceleration(total[particles], inverse[:, None])
+        masses, free = self.body.masses[particles, None], ~self.body.fixed[particles, None]
+        return equations.acceleration(total[particles], masses, free)
 
     def jacobians(self, x: np.ndarray, v: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """∂F/∂x and ∂F/∂v, sparse (N·d × N·d), for implicit integrators.
@@ -188,7 +161,7 @@ class Dynamics:
     def _spring_jacobians(self, x: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """∂F/∂x and ∂F/∂v of the springs, on their pattern (rebuilt when they change)."""
         if self._pattern is None or self._pattern.topology_version != self.body.topology_version:
-            self._pattern = kernels.JacobianPattern(self.body)
+            self._pattern = JacobianPattern(self.body)
         return self.springs.jacobians(self.body, x, self._pattern)
 
     def elastic_energy(self, x: np.ndarray, springs: np.ndarray | None = None) -> float:

@@ -16,17 +16,34 @@ import numpy as np
 
 
 def spring_force(
+    stiffness: float,
+    rest: float,
+    damping: float,
+    d: tuple[float, float, float],
+    w: tuple[float, float, float],
+) -> tuple[float, float, float]:
+    """Force (N) on end ``a`` of a spring from end ``b``: eq. (1.2) plus the dashpot, a vector.
+
+    ``d`` = x_a - x_b (m) and ``w`` = v_a - v_b (m/s), three coordinates each (0 for
+    the third in 2-D; ``w`` may be 0 where there is no dashpot)::
+
+        n = d / |d|,   ṡ = w·n,   f_a = [k (l - |d|) - c ṡ] n,   f_b = -f_a
+
+    ṡ is how fast the spring lengthens. Coincident ends (d = 0) have no
+    direction and get no force.
+    """
+    length = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+    safe = length + (length == 0.0)  # 1 where d = 0, which then makes f_a = 0
+    rate = (w[0] * d[0] + w[1] * d[1] + w[2] * d[2]) / safe
+    scale = spring_tension(stiffness, rest, length, damping, rate) / safe  # |f_a| / |d|
+    return scale * d[0], scale * d[1], scale * d[2]
+
+
+def spring_tension(
     stiffness: float, rest: float, length: float, damping: float, rate: float
 ) -> float:
-    """Force (N) along a spring on its end ``a``, eq. (1.2) plus the dashpot.
-
-    ``rate`` ṡ = (v_a - v_b)·n (m/s) is how fast the spring lengthens (0 without
-    a dashpot). Positive pushes ``a`` away from ``b``::
-
-        f = k (l - |x_a - x_b|) - c ṡ,   n = (x_a - x_b) / |x_a - x_b|
-
-    The force vector on ``a`` is f·n and ``b`` feels -f·n (eq. 1.1 sums them).
-    """
+    """The signed size (N) of `spring_force` along n: k (l - |d|) - c ṡ, positive pushing
+    the ends apart (the grid gather of the numba kernel sums it by offset)."""
     return stiffness * (rest - length) - damping * rate
 
 
@@ -50,14 +67,10 @@ def transverse_stiffness(stiffness: float, rest: float, length: float) -> float:
     return stiffness * np.maximum(0.0, 1.0 - rest / length)
 
 
-def inverse_mass(mass: float, free: bool) -> float:
-    """1/m (1/kg) for a free particle, 0 for a fixed one (so it never accelerates)."""
-    return free / mass
-
-
-def acceleration(force: float, inverse_mass: float) -> float:
-    """Newton's second law a = F/m (m/s²), written with the inverse mass."""
-    return force * inverse_mass
+def acceleration(force: float, mass: float, free: bool) -> float:
+    """Newton's second law a = F/m (m/s²) for a free particle, 0 for a fixed one: the
+    inverse mass of a fixed particle is 0, so no force moves it."""
+    return force * (free / mass)
 
 
 def kinetic_energy(masses: np.ndarray, velocities: np.ndarray) -> float:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 
 import numpy as np
 
@@ -20,20 +19,6 @@ class SimulationDiverged(RuntimeError):
         self.step, self.time, self.diagnosis = step, time, diagnosis
         self.trajectory = None
         super().__init__(f"simulation diverged in step {step} (t = {time:.6g} s): {diagnosis}")
-
-
-_diagnosis: list[Callable[..., str]] = []  # one function, registered from the analysis layer
-
-
-def register_diagnosis(diagnose: Callable[..., str]) -> None:
-    """Explain blow-ups with ``diagnose`` (`msdlab.analysis.stability` registers itself)."""
-    _diagnosis[:] = [diagnose]
-
-
-def diagnose_divergence(*blowup: object) -> str:
-    """Why a step blew up, by the registered diagnosis, given (body, integrator, dt (s),
-    forces, reference positions, x, x_new, v_new): the core raises, the analysis explains."""
-    return _diagnosis[0](*blowup) if _diagnosis else "no diagnosis registered"
 
 
 def check_positive(name: str, value: float, hint: str = "") -> float:

@@ -6,6 +6,7 @@ import math
 from collections import defaultdict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
@@ -14,10 +15,10 @@ from .body import Body
 from .constraint import Constraint, StepState
 from .dynamics import Dynamics
 from .energy import EnergyLedger, kinetic_energy
-from .errors import SimulationDiverged, check_finite_array, check_positive, diagnose_divergence
+from .errors import SimulationDiverged, check_finite_array, check_positive
 from .forces import Force
 from .integrators import Integrator, Verlet
-from .kernels import StepEnd
+from .stability import describe_blowup
 
 
 @dataclass
@@ -47,7 +48,7 @@ class Simulation:
 
     ``forces`` holds `Force` objects (gravity, contact, ...) and `Constraint`
     objects (ground, drag, walls, ...), applied in the given order after each
-    integrator step. Each step pins the fixed particles, keeps an energy
+    integrator step. Each step keeps the fixed particles in place, keeps an energy
     ledger, and raises `SimulationDiverged` in the step where the state stops
     being finite or a spring is stretched past ``max_stretch`` times its rest length.
     ``kernel`` picks the spring kernel, "numba" or "numpy" (see `Dynamics`).
@@ -125,115 +126,71 @@ class Simulation:
     def step(self) -> None:
         """Advance the body by one step of ``dt``.
 
-        The integrator's step, then: pin the fixed particles, apply the constraints,
-        book the energy, check for divergence, and copy the new state into the body.
-        The update loop of `Dynamics.advance` may have done the pinning, the finite
-        check, the floor's search and the sum for the damping's work already
-        (`kernels.StepEnd`); the rest is the same.
+        Integrate, apply the constraints, book the energy each mechanism took out,
+        check for divergence, and store the new state in the body (whose
+        ``positions`` and ``velocities`` are then the new state).
         """
-        body, dt = self.body, self.dt
+        body, dt = self.body, self._dt
         x, v = body.positions, body.velocities
-        self.dynamics.forget_last_state()
-        end = self._step_end()
-        self.dynamics.step_end = end
-        try:
-            result = self.integrator.step(x, v, dt, self.dynamics)
-        except ValueError as error:
-            if "read-only" in str(error) and end.arrays:
-                raise TypeError(
-                    f"{self.integrator!r}.step wrote into a read-only array: in a Simulation "
-                    "the arrays dynamics.advance returns are read-only; return them as they "
-                    "are, or compute new ones (x_new + ..., not x_new += ...)"
-                ) from error
-            raise
-        finally:
-            self.dynamics.step_end = None
-        x_new, v_new = self._checked(result, x)
-        ended = len(end.arrays) == 2 and end.arrays[0] is x_new and end.arrays[1] is v_new
-        if ended:  # the constraints edit them
-            x_new.flags.writeable = v_new.flags.writeable = True
-        power = self.dynamics.dashpot_power(x, v) if self.ledger else 0.0
-        fixed = body.fixed
-        if not ended and fixed.any():
-            x_new[fixed] = x[fixed]
-            v_new[fixed] = 0.0
-        energy_of = self._energy_of(x_new, v_new) if self.ledger else _unbooked
+        x_new, v_new = self._integrate(x, v)
+        energy_of = partial(self._energy, x_new, v_new) if self.ledger else _unbooked
         state = StepState(body, x, v, x_new, v_new, self.time + dt, dt, energy_of)
         removed = []
-        for i, constraint in enumerate(self.constraints):
-            state.under = end.under if ended and i == 0 else None
+        for constraint in self.constraints:
             removed.append((constraint.ledger_name, constraint.apply(state)))
-        floors = 0 if end.under is None else 1
-        summed = ended and len(self.constraints) == floors  # no constraint but the floor
         if self.ledger:  # after the constraints: the integrator's damping works at the final v
-            booked = self._dissipation(x, v, v_new, power, end if summed else None)
-            for name, energy in removed:
-                booked[name] = booked.get(name, 0.0) + energy
-        else:
-            booked = {}
-        # a floor keeps finite values finite; other constraints may not: check after them
-        self._check_divergence(x, x_new, v_new, end.finite if summed else None)
+            self._book(x, v, v_new, removed)
+        self._check_divergence(x, x_new, v_new)
         x[...] = x_new
         v[...] = v_new
         self.time += dt
         self.step_count += 1
-        for name, energy in booked.items():
-            self.dissipated[name] += energy
 
-    def _step_end(self) -> StepEnd:
-        """What the step's update loop may do for this step: see `kernels.StepEnd`."""
-        floor = self.constraints[0].floor(self.body) if self.constraints else None
-        normal, height = (np.zeros(0), 0.0) if floor is None else self._checked_floor(floor)
-        integrator = self.integrator
-        damping = (
-            self.ledger
-            and type(integrator).dissipated_energy is Integrator.dissipated_energy
-            and integrator.velocity_factor != 1.0
-        )
-        return StepEnd(normal, height, damping)
-
-    def _checked_floor(self, floor: object) -> tuple[np.ndarray, float]:
-        """A constraint's `Constraint.floor` as (unit normal (d,), height), or ValueError."""
+    def _integrate(self, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The integrator's step from (x, v) as new float arrays of the body's shape, with
+        the fixed particles kept where they are, at rest."""
+        result = self.integrator.step(x, v, self._dt, self.dynamics)
         try:
-            normal, height = floor  # type: ignore[misc]
-            normal, height = np.asarray(normal, dtype=float), float(height)
+            x_new, v_new = result
         except (TypeError, ValueError):
-            normal, height = np.zeros(0), math.nan
-        if (
-            normal.shape != (self.body.dim,)
-            or not math.isfinite(height)
-            or not abs(math.hypot(*normal) - 1.0) <= 1e-9  # False for NaN
-        ):
-            raise ValueError(
-                f"{self.constraints[0]!r}.floor must return None or (unit normal of "
-                f"{self.body.dim} numbers, height in m), got {floor!r}"
-            )
-        return normal, height
+            raise TypeError(
+                f"{self.integrator!r}.step must return (x_new, v_new), got {type(result).__name__}"
+            ) from None
+        arrays = []
+        for name, array in (("x_new", x_new), ("v_new", v_new)):
+            array = np.asarray(array, dtype=float)
+            if array.shape != x.shape:
+                raise ValueError(
+                    f"{self.integrator!r}.step returned {name} of shape {array.shape}; "
+                    f"it must have the shape of the positions, {x.shape}"
+                )
+            arrays.append(array.copy() if np.shares_memory(array, x) else array)
+        x_new, v_new = arrays
+        fixed = self.body.fixed
+        if fixed.any():
+            x_new[fixed] = x[fixed]
+            v_new[fixed] = 0.0
+        return x_new, v_new
 
-    def _dissipation(
-        self,
-        x: np.ndarray,
-        v: np.ndarray,
-        v_new: np.ndarray,
-        dashpot_power: float,
-        end: StepEnd | None = None,
-    ) -> dict[str, float]:
-        """Energy (J) the dashpots, the integrator's damping and dissipative forces take out
-        in the step from (x, v) to velocities ``v_new``, by source. ``end``: the update
-        loop summed the damping's work but over the particles under the floor."""
-        dt, masses = self.dt, self.body.masses
-        if end is not None and end.damping:
-            rows = end.under if end.under is not None else slice(0)
-            damping = (1.0 - self.integrator.velocity_factor) * end.damping_work
-            damping += self.integrator.dissipated_energy(v[rows], masses[rows], v_new[rows])
-        else:
-            damping = self.integrator.dissipated_energy(v, masses, v_new)
-        booked = {"dashpot": dashpot_power * dt, "integrator": damping}
-        for force in self.forces:
-            lost = force.dissipated_power(self.body, x, v)
+    def _book(
+        self, x: np.ndarray, v: np.ndarray, v_new: np.ndarray, removed: list[tuple[str, float]]
+    ) -> None:
+        """Add to `dissipated` the energy (J) each mechanism took out in the step from (x, v)
+        to velocities ``v_new``: the dashpots, the integrator's damping, the dissipative
+        forces, and the constraints (``removed``: (ledger name, energy) of each)."""
+        body, dt = self.body, self._dt
+        booked = {
+            "dashpot": self.dynamics.springs.dashpot_power(body, x, v) * dt,
+            "integrator": self.integrator.dissipated_energy(v, body.masses, v_new),
+        }
+        for force in self.dynamics.forces:
+            lost = force.dissipated_power(body, x, v)
             if lost:
                 booked[force.ledger_name] = booked.get(force.ledger_name, 0.0) + lost * dt
-        return booked
+        for name, energy in removed:
+            booked[name] = booked.get(name, 0.0) + energy
+        for name, energy in booked.items():
+            self.dissipated[name] += energy
 
     def run(
         self,
@@ -300,68 +257,29 @@ class Simulation:
             raise ValueError(f"steps must be an integer >= 0, got {steps!r}")
         return int(steps)
 
-    def _checked(self, result: object, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The integrator's (x, v) as fresh float arrays of the body's shape."""
-        try:
-            x_new, v_new = result  # type: ignore[misc]
-        except (TypeError, ValueError):
-            raise TypeError(
-                f"{self.integrator!r}.step must return (x_new, v_new), got {type(result).__name__}"
-            ) from None
-        arrays = []
-        for name, array in (("x_new", x_new), ("v_new", v_new)):
-            array = np.asarray(array, dtype=float)
-            if array.shape != x.shape:
-                raise ValueError(
-                    f"{self.integrator!r}.step returned {name} of shape {array.shape}; "
-                    f"it must have the shape of the positions, {x.shape}"
-                )
-            arrays.append(array.copy() if np.shares_memory(array, x) else array)
-        return arrays[0], arrays[1]
-
-    def _energy_of(self, x: np.ndarray, v: np.ndarray) -> Callable[[np.ndarray], float]:
+    def _energy(self, x: np.ndarray, v: np.ndarray, particles: np.ndarray) -> float:
         """Energy (J) of some particles at (x, v): their kinetic and external potential
         energy plus the elastic energy of the springs touching them. The kinetic
         part uses the velocity at the time of x (see `Integrator.velocity_at_positions`)."""
         body, dynamics, integrator = self.body, self.dynamics, self.integrator
-        last: list = [None, None]  # constraints ask before and after a change: find springs once
-        synchronising = (
-            type(integrator).velocity_at_positions is not Integrator.velocity_at_positions
-        )
+        touching = body.springs_touching(particles)
+        u = v[particles]
+        if type(integrator).velocity_at_positions is not Integrator.velocity_at_positions:
+            a = dynamics.acceleration_of(particles, x, v, touching)
+            u = integrator.velocity_at_positions(u, a, self._dt)
+        kinetic = equations.kinetic_energy(body.masses[particles], u)
+        potential = sum(f.potential_energy(body, x, particles) for f in self.forces)
+        return float(kinetic + potential + dynamics.elastic_energy(x, touching))
 
-        def energy(particles: np.ndarray) -> float:
-            if last[0] is not particles:
-                last[:] = particles, body.springs_touching(particles)
-            touching = last[1]
-            u = v[particles]
-            if synchronising:
-                a = dynamics.acceleration_of(particles, x, v, touching)
-                u = integrator.velocity_at_positions(u, a, self.dt)
-            kinetic = equations.kinetic_energy(body.masses[particles], u)
-            potential = sum(f.potential_energy(body, x, particles) for f in self.forces)
-            return float(kinetic + potential + dynamics.elastic_energy(x, touching))
-
-        return energy
-
-    def _check_divergence(
-        self, x: np.ndarray, x_new: np.ndarray, v_new: np.ndarray, finite: bool | None = None
-    ) -> None:
-        """Raise `SimulationDiverged` if the new state is not finite (``finite``, if the
-        update loop checked) or a spring is stretched past ``max_stretch``."""
-        if finite is None:
-            finite = math.isfinite(float(x_new.sum()) + float(v_new.sum()))
+    def _check_divergence(self, x: np.ndarray, x_new: np.ndarray, v_new: np.ndarray) -> None:
+        """Raise `SimulationDiverged` if the new state is not finite or a spring is
+        stretched past ``max_stretch`` times its rest length."""
+        finite = math.isfinite(float(x_new.sum()) + float(v_new.sum()))
         stretched = self.max_stretch is not None and self.dynamics.max_stretch > self.max_stretch
         if not finite or stretched:
-            diagnosis = diagnose_divergence(
-                self.body,
-                self.integrator,
-                self.dt,
-                self.forces,
-                self.initial_positions,
-                x,
-                x_new,
-                v_new,
-            )
+            body, integrator, dt, forces = self.body, self.integrator, self._dt, self.forces
+            blowup = (self.initial_positions, x, x_new, v_new)
+            diagnosis = describe_blowup(body, integrator, dt, forces, *blowup)
             raise SimulationDiverged(self.step_count, self.time, diagnosis)
 
     def _trajectory(self, frames: list, ledger: EnergyLedger) -> Trajectory:

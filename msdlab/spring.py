@@ -34,8 +34,8 @@ class Spring(Bound):
         f_a = k (l - |x_a - x_b|) n  -  c ((v_a - v_b) · n) n,     f_b = -f_a
 
     ``rest_length=None`` takes the distance between the particles when the spring
-    is added to a body. `Spring.force` and the spring kernels (`msdlab.kernels`)
-    all apply `equations.spring_force`.
+    is added to a body. `Spring.force` and the spring kernels (`msdlab.kernels`,
+    `msdlab.compiled`) all apply `equations.spring_force`.
     """
 
     a = Field("spring_a", "Index of the first particle.", kind=int)
@@ -79,12 +79,10 @@ class Spring(Bound):
     def force(self) -> np.ndarray:
         """Force on particle ``a`` (N), eq. (1.2) plus the dashpot; ``b`` feels minus this."""
         x_a, x_b, v_a, v_b = self._ends()
-        length = math.dist(x_a, x_b)
-        if length == 0.0:  # coincident ends: no direction, no force
-            return np.zeros_like(x_a)
-        rate = float(np.dot(v_a - v_b, x_a - x_b)) / length
-        along = equations.spring_force(self.stiffness, self.rest_length, length, self.damping, rate)
-        return along * (x_a - x_b) / length
+        d, w = np.zeros(3), np.zeros(3)  # three coordinates, the third 0 in 2-D
+        d[: len(x_a)], w[: len(x_a)] = x_a - x_b, v_a - v_b
+        f = equations.spring_force(self.stiffness, self.rest_length, self.damping, d, w)
+        return np.array(f[: len(x_a)])
 
     def energy(self) -> float:
         """Elastic energy ½ k (|x_a - x_b| - l)² (J)."""

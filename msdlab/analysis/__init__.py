@@ -5,8 +5,8 @@ calls of sweeps and grading side by side, here or on a Dask cluster (`cluster`).
 The predictions and measurements are re-exported from `msdlab`.
 """
 
+from ..stability import Mode, max_stable_dt, stability_limit, stiffest_mode
 from .measure import Convergence, bisect_blowup, convergence_order, measure_blowup_dt
-from .stability import Mode, max_stable_dt, stability_limit, stiffest_mode
 
 __all__ = [
     "Convergence",

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
@@ -15,7 +16,7 @@ from ..errors import SimulationDiverged
 from ..forces import Force
 from ..integrators import Integrator
 from ..simulation import Simulation
-from .stability import max_stable_dt
+from ..stability import max_stable_dt
 
 
 def bisect_blowup(
@@ -68,28 +69,40 @@ def measure_blowup_dt(
         perturbation * float(np.min(body.rest_lengths)) * rng.standard_normal(body.positions.shape)
     )
     kick[body.fixed] = 0.0
-
-    def strain(trial: Body) -> float:
-        _, length = kernels.spring_vectors(trial, trial.positions)
-        return float(np.max(np.abs(length / trial.rest_lengths - 1.0)))
-
-    def is_stable(dt: float) -> bool:
-        trial = body.copy()
-        trial.positions = trial.positions + kick
-        trial.velocities = np.zeros_like(trial.velocities)
-        limit = 100.0 * strain(trial)
-
-        def watch(sim: Simulation) -> None:
-            if strain(sim.body) > limit:
-                raise SimulationDiverged(sim.step_count, sim.time, "strain grew 100-fold")
-
-        try:
-            Simulation(trial, integrator, dt, forces).run(steps, record_every=steps, callback=watch)
-        except SimulationDiverged:
-            return False
-        return True
-
+    is_stable = partial(_stays_stable, body, integrator, forces, kick, steps)
     return bisect_blowup(is_stable, low, high, rtol)
+
+
+def _strain(body: Body) -> float:
+    """The largest spring strain |l/l₀ - 1| of ``body``."""
+    _, length = kernels.spring_vectors(body, body.positions)
+    return float(np.max(np.abs(length / body.rest_lengths - 1.0)))
+
+
+def _stays_stable(
+    body: Body,
+    integrator: Integrator,
+    forces: Sequence[Force | Constraint],
+    kick: np.ndarray,
+    steps: int,
+    dt: float,
+) -> bool:
+    """Whether a copy of ``body`` moved by ``kick`` (m) and at rest runs ``steps`` steps of
+    ``dt`` (s) without diverging or its largest strain growing 100-fold."""
+    trial = body.copy()
+    trial.positions = trial.positions + kick
+    trial.velocities = np.zeros_like(trial.velocities)
+    limit = 100.0 * _strain(trial)
+
+    def watch(sim: Simulation) -> None:
+        if _strain(sim.body) > limit:
+            raise SimulationDiverged(sim.step_count, sim.time, "strain grew 100-fold")
+
+    try:
+        Simulation(trial, integrator, dt, forces).run(steps, record_every=steps, callback=watch)
+    except SimulationDiverged:
+        return False
+    return True
 
 
 @dataclass

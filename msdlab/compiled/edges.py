@@ -60,21 +60,19 @@ def _add_spring_forces(x, v, a, b, kinds, k, rest, c, first, stop, out, three):
             peak[0] = length / rest[m]
         if length == 0.0:  # coincident ends: no direction, no force
             continue
-        rate = 0.0
+        w0 = w1 = w2 = 0.0  # v_a - v_b, read only for a dashpot
         if c[m] != 0.0:
-            closing = (v[i, 0] - v[j, 0]) * d0 + (v[i, 1] - v[j, 1]) * d1
-            if three:
-                closing += (v[i, 2] - v[j, 2]) * d2
-            rate = closing / length
-            power += dashpot_power(c[m], rate)
-        scale = spring_force(k[m], rest[m], length, c[m], rate) / length
-        f0 += scale * d0
-        out[j, 0] -= scale * d0
-        f1 += scale * d1
-        out[j, 1] -= scale * d1
+            w0, w1 = v[i, 0] - v[j, 0], v[i, 1] - v[j, 1]
+            w2 = v[i, 2] - v[j, 2] if three else 0.0
+            power += dashpot_power(c[m], (w0 * d0 + w1 * d1 + w2 * d2) / length)
+        g0, g1, g2 = spring_force(k[m], rest[m], c[m], (d0, d1, d2), (w0, w1, w2))
+        f0 += g0
+        out[j, 0] -= g0
+        f1 += g1
+        out[j, 1] -= g1
         if three:
-            f2 += scale * d2
-            out[j, 2] -= scale * d2
+            f2 += g2
+            out[j, 2] -= g2
     out[i, 0], out[i, 1] = f0, f1
     if three:
         out[i, 2] = f2

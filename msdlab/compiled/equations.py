@@ -9,8 +9,8 @@ import numba
 from .. import equations
 
 spring_force = numba.njit(cache=True, inline="always")(equations.spring_force)
+spring_tension = numba.njit(cache=True, inline="always")(equations.spring_tension)
 spring_energy = numba.njit(cache=True, inline="always")(equations.spring_energy)
 dashpot_power = numba.njit(cache=True, inline="always")(equations.dashpot_power)
 transverse_stiffness = numba.njit(cache=True, inline="always")(equations.transverse_stiffness)
-inverse_mass = numba.njit(cache=True, inline="always")(equations.inverse_mass)
 acceleration = numba.njit(cache=True, inline="always")(equations.acceleration)

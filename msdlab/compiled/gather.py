@@ -1,8 +1,8 @@
 """The grid gather: the spring forces of a grid body by offset, with no list of springs.
 
 Each particle computes its springs to the neighbours ahead of it (half the
-stencil, so each spring once, with the same `equations.spring_force`), adds
-their forces to itself and, in a second loop, their opposites to the
+stencil, so each spring once, with `equations.spring_tension`, the size of
+`equations.spring_force`), adds their forces to itself and, in a second loop, their opposites to the
 neighbours. The positions are copied by coordinate so that the inner loops
 walk contiguous memory on vector registers, over whole grid rows (those whose
 neighbour would leave its row masked out), three offsets at a time (a
@@ -17,7 +17,7 @@ import math
 import numba
 import numpy as np
 
-from .equations import dashpot_power, spring_force
+from .equations import dashpot_power, spring_tension
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -30,7 +30,7 @@ def _pull(y0, y1, y2, x0, x1, x2, q, there, k, rest):
     length_squared = d0 * d0 + d1 * d1 + d2 * d2
     length = math.sqrt(length_squared)
     safe = length if length > 0.0 else 1.0  # coincident ends: no direction, no force
-    scale = there * spring_force(k, rest, safe, 0.0, 0.0) / safe
+    scale = there * spring_tension(k, rest, safe, 0.0, 0.0) / safe
     scale = scale if length > 0.0 else 0.0
     return scale, d0, d1, d2, there * length_squared
 
@@ -46,7 +46,7 @@ def _pull_damped(y0, y1, y2, u0, u1, u2, xs, vs, q, there, k, rest, c):
     safe = length if length > 0.0 else 1.0
     rate = ((u0 - v0[q]) * d0 + (u1 - v1[q]) * d1 + (u2 - v2[q]) * d2) / safe
     power = there * dashpot_power(c, rate)
-    scale = there * spring_force(k, rest, safe, c, rate) / safe
+    scale = there * spring_tension(k, rest, safe, c, rate) / safe
     scale = scale if length > 0.0 else 0.0
     return scale, d0, d1, d2, there * length_squared, power
 

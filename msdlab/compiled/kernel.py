@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import sys
 import warnings
 from collections.abc import Callable
 from typing import TYPE_CHECKING
@@ -36,7 +35,7 @@ from .stencil import (
 )
 
 if TYPE_CHECKING:
-    from ..kernels import JacobianPattern, StepEnd
+    from ..jacobian import JacobianPattern
 
 # Below this many springs (particles for the update) one thread is faster than waking the others.
 PARALLEL_MIN_SPRINGS = 50_000
@@ -48,28 +47,6 @@ PARALLEL_MIN_GATHERED = 250_000
 # At most this many distinct (stiffness, rest length, dashpot) triples are kept as a table
 # with a class number per spring (uint8 up to 256, else uint16); past it, the values per spring.
 SPRING_CLASSES = 65_536
-
-
-def _references_of_a_private_array() -> int:
-    """How many references the memory of a body's spring array has when only the body
-    and one view of it refer to it (as in `_shared`)."""
-    owner = type("Owner", (), {})()
-    owner.array = np.zeros(2)
-    view = owner.array[:1]
-    return sys.getrefcount(view.base)
-
-
-_PRIVATE = _references_of_a_private_array()
-
-
-def _shared(views: tuple[np.ndarray, ...]) -> bool:
-    """True if anything besides the body and ``views`` refers to the memory of ``views``.
-
-    A view of ``body.stiffness`` kept by the user could be written at any time
-    without touching ``body.parameters_version``; while one exists, the spring
-    values are checked at every step.
-    """
-    return any(sys.getrefcount(view.base) > _PRIVATE for view in views)
 
 
 # Spring forces not yet added to the force buffer: the threads' buffers (T, N, d), the
@@ -89,9 +66,9 @@ class NumbaKernel:
     offset (`grid_stencil`); other bodies go through the edge loop, over the
     springs sorted by their ends (`_edge_list`), with one force buffer per
     extra thread. What is kept is rebuilt when the springs change
-    (``body.topology_version``) and re-checked when their values may have
-    (``body.parameters_version``, or a view of them kept elsewhere), so edits
-    count at once. ``springs`` (indices) restricts a computation to some
+    (``body.topology_version``) and re-checked when their values are edited
+    (``body.parameters_version``, counted by the body's tracked arrays), so
+    edits count at once. ``springs`` (indices) restricts a computation to some
     springs, on one thread, in the body's order.
     """
 
@@ -99,7 +76,7 @@ class NumbaKernel:
         self._version = -1
         self._a = self._b = np.zeros(0, dtype=np.int32)
         self._partial: np.ndarray | None = None
-        self._none: Pending = (np.zeros((0, 0, 0)), np.zeros((0, 0)), 0)  # see `_no_partial`
+        self._none: Pending = (np.zeros((0, 0, 0)), np.zeros((0, 0)), 0)  # no spring forces pending
         self._threads = 1
         self._stencil_version = -1
         self._stencil: GridStencil | None = None
@@ -111,11 +88,10 @@ class NumbaKernel:
         self._pad = 0
         self._values_version = -1
         self._uniform = False
+        self._damped = ((-1, -1), True)  # (versions, whether any spring has a dashpot)
         self._order: np.ndarray | None = None
         self._classes_version = -1
         self._classes: tuple[np.ndarray | None, ...] = (None,)  # see `_edge_list`
-        self._no_floor = np.zeros(0)
-        self._under = np.zeros(0, dtype=bool)  # see `advance.compile_advance`
 
     name = "numba"
 
@@ -146,11 +122,17 @@ class NumbaKernel:
         `advance.compile_advance`): none with ``reduce``, else the threads' buffers of
         `edges.spring_forces_parallel` or the gather's forces by coordinate; without
         ``reduce`` ``out`` is scratch: the edge loops clear it, the gather leaves it."""
-        none = self._no_partial(x)
+        if self._none[0].shape[1:] != x.shape:
+            self._none = (np.zeros((0, *x.shape)), np.zeros((0, 0)), 0)
+        none = self._none
         if springs is None:
-            stencil = self.grid_stencil(body)
+            versions = (body.topology_version, body.parameters_version)
+            if (self._stencil_version, self._values_version) != versions:
+                self.grid_stencil(body)
+            stencil = self._stencil if self._uniform else None
             if stencil is not None:
-                threads = self._parallel(body, PARALLEL_MIN_GATHERED)
+                self._threads = numba.get_num_threads()
+                threads = len(body.spring_a) >= PARALLEL_MIN_GATHERED and self._threads > 1
                 gather = gather_parallel if threads else gather_serial
                 if self._scratch.shape != (10, len(x) + 2 * self._pad):
                     self._scratch = np.zeros((10, len(x) + 2 * self._pad))  # 2-D: x2 = v2 = 0
@@ -163,7 +145,7 @@ class NumbaKernel:
                     return stretch, power, none
                 return stretch, power, (none[0], self._scratch[6 : 6 + x.shape[1]], self._pad)
         if springs is not None:
-            a, b, k, rest, c = (body.spring_a, body.spring_b, *body.spring_values())
+            a, b, k, rest, c = (body.spring_a, body.spring_b, *body.spring_values)
             a, b, k, rest, c = (array[springs] for array in (a, b, k, rest, c))
             return *spring_forces_serial(x, v, a, b, None, k, rest, c, out), none
         arrays = self._edge_list(body)
@@ -176,19 +158,13 @@ class NumbaKernel:
         sums = spring_forces_parallel(x, v, *arrays, self._partial, out, reduce)
         return *sums, none if reduce else (self._partial, none[1], 0)
 
-    def _no_partial(self, x: np.ndarray) -> Pending:
-        """No spring forces pending (see `advance.compile_advance`)."""
-        if self._none[0].shape[1:] != x.shape:
-            self._none = (np.zeros((0, *x.shape)), np.zeros((0, 0)), 0)
-        return self._none
-
     def grid_stencil(self, body: Body) -> GridStencil | None:
         """The body's grid stencil if its forces can be gathered by offset now, else None.
 
         The stencil is found once per topology (``body.topology_version``); that
         each of its blocks has one stiffness, rest length and dashpot is checked
-        at every call (one read of the spring values, stopping at the first
-        difference), so edits of single springs switch to the edge loop at once.
+        again whenever the values are edited (``body.parameters_version``), so
+        edits of single springs switch to the edge loop at once.
         """
         if self._stencil_version != body.topology_version:
             self._stencil = grid_stencil(body)
@@ -206,8 +182,8 @@ class NumbaKernel:
             self._values_version = -1
         if self._stencil is None:
             return None
-        values = body.spring_values()
-        if body.parameters_version != self._values_version or _shared(values):
+        if body.parameters_version != self._values_version:
+            values = body.spring_values
             self._uniform = uniform_blocks(*values, self._stencil.starts, self._stencil_values)
             self._values_version = body.parameters_version
             if self._uniform:
@@ -219,18 +195,22 @@ class NumbaKernel:
         ``least`` of them (default `PARALLEL_MIN_SPRINGS`)."""
         self._threads = numba.get_num_threads()
         least = PARALLEL_MIN_SPRINGS if least is None else least
-        return body.n_springs >= least and self._threads > 1
+        return len(body.spring_a) >= least and self._threads > 1
 
     def dashpot_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
         """Power (W) the dashpots take out of the body at (x, v), always >= 0."""
-        a, b, damping = body.spring_a, body.spring_b, body.spring_values()[2]
+        a, b, damping = body.spring_a, body.spring_b, body.spring_values[2]
+        if self._damped[0] != (body.topology_version, body.parameters_version):
+            self._damped = ((body.topology_version, body.parameters_version), damping.any())
+        if not self._damped[1]:
+            return 0.0
         if not self._parallel(body):
             return dashpot_power_serial(x, v, a, b, damping)
         return dashpot_power_parallel(x, v, a, b, damping, self._threads)
 
     def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
         """Energy (J) stored in the springs (or in the given ones) at positions x."""
-        arrays = (body.spring_a, body.spring_b, *body.spring_values()[:2])
+        arrays = (body.spring_a, body.spring_b, *body.spring_values[:2])
         if springs is not None:
             return elastic_energy_serial(x, *(array[springs] for array in arrays))
         if not self._parallel(body):
@@ -243,7 +223,7 @@ class NumbaKernel:
     ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """∂F/∂x and ∂F/∂v of the springs on ``pattern``, as `kernels.spring_jacobians`,
         with the blocks computed spring by spring."""
-        values = body.spring_values()
+        values = body.spring_values
         dim = x.shape[1]
         stiff = np.empty((body.n_springs, dim, dim))
         damp = np.empty((body.n_springs if values[2].any() else 0, dim, dim))
@@ -266,15 +246,14 @@ class NumbaKernel:
         field: np.ndarray,
         dt: float,
         coefficients: tuple[float, ...],
-        end: StepEnd | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
         """``update(x, v, a, dt, *coefficients)`` with a = (F + m·g)/m (0 if fixed),
-        g = ``field`` (d,) in m/s², in one loop, which also does ``end`` if given.
+        g = ``field`` (d,) in m/s², in one loop.
 
         An update numba cannot compile warns once and runs on whole arrays.
         """
-        pending = self._no_partial(x)
-        return self._advance(update, body, x, v, forces, pending, field, dt, coefficients, end)
+        pending = (np.zeros((0, *x.shape)), np.zeros((0, 0)), 0)  # no spring forces
+        return self._advance(update, body, x, v, forces, pending, field, dt, coefficients)
 
     def advance_with_springs(
         self,
@@ -286,7 +265,6 @@ class NumbaKernel:
         field: np.ndarray,
         dt: float,
         coefficients: tuple[float, ...],
-        end: StepEnd | None = None,
     ) -> tuple[np.ndarray, np.ndarray, float, float]:
         """The spring forces, then `advance`: (x_new, v_new, largest stretch, dashpot power W).
         The threads' partial spring forces, or the gather's, are added to F in the
@@ -295,9 +273,7 @@ class NumbaKernel:
         stretch, power, pending = self._spring_forces(body, x, v, forces, None, reduce=False)
         if len(pending[1]):  # the gather's forces by coordinate are all of F
             forces = forces[:0]
-        x_new, v_new = self._advance(
-            update, body, x, v, forces, pending, field, dt, coefficients, end
-        )
+        x_new, v_new = self._advance(update, body, x, v, forces, pending, field, dt, coefficients)
         return x_new, v_new, stretch, power
 
     def _advance(
@@ -311,32 +287,21 @@ class NumbaKernel:
         field: np.ndarray,
         dt: float,
         coefficients: tuple[float, ...],
-        end: StepEnd | None,
     ) -> tuple[np.ndarray, np.ndarray]:
         """`advance` with F = ``forces`` plus the spring forces ``pending`` (see
         `advance.compile_advance`)."""
         threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
-        if update in _FAILED:
-            compiled = None
-        elif (update, threads) not in _ADVANCES:
+        compiled = None if update in _FAILED else _ADVANCES.get((update, threads))
+        if compiled is None and update not in _FAILED:
             compiled = _ADVANCES[update, threads] = compile_advance(update, threads)
-        else:
-            compiled = _ADVANCES[update, threads]
         if compiled is not None:
             x_new, v_new = np.empty_like(x), np.empty_like(v)
-            if end is None:
-                floor = (self._no_floor, 0.0, False, False)
-            else:
-                floor = (end.normal, end.height, True, end.damping)
-                if len(self._under) != len(x):
-                    self._under = np.zeros(len(x), dtype=bool)
-                self._under[:] = False
             try:
                 masses, fixed = body.masses, body.fixed
-                bad, work = compiled(
-                    x, v, forces, pending, field, masses, fixed, dt, coefficients, floor,
-                    x_new, v_new, self._under,
-                )  # fmt: skip
+                compiled(
+                    x, v, forces, pending, field, masses, fixed, dt, coefficients, x_new, v_new
+                )
+                return x_new, v_new
             except numba.core.errors.NumbaError as error:
                 _FAILED.add(update)
                 warnings.warn(
@@ -345,20 +310,7 @@ class NumbaKernel:
                     RuntimeWarning,
                     stacklevel=5,
                 )
-            else:
-                if end is not None:
-                    end.arrays, end.finite, end.damping_work = (x_new, v_new), bad == 0, work / 2
-                    end.under = np.flatnonzero(self._under) if len(end.normal) else None
-                return x_new, v_new
-        partial, by_coordinate, pad = pending
-        forces = forces if len(forces) else np.zeros_like(x)
-        for part in partial:
-            forces = forces + part  # in the order of `edges.spring_forces_parallel`
-        if len(by_coordinate):
-            forces = forces + by_coordinate[:, pad : pad + len(x)].T
-        inverse = equations.inverse_mass(body.masses, ~body.fixed)
-        a = equations.acceleration(forces + body.masses[:, None] * field, inverse[:, None])
-        return update(x, v, a, dt, *coefficients)
+        return _advance_on_arrays(update, body, x, v, forces, pending, field, dt, coefficients)
 
     def _edge_list(self, body: Body) -> tuple[np.ndarray | None, ...]:
         """Ends a, b of all springs sorted by (a, b), each one's class (or None) and the
@@ -369,7 +321,7 @@ class NumbaKernel:
         order the springs were added in (a shuffled 60³ grid: several times
         faster). The ends (uint32: half the memory traffic of int64) and the
         order are kept per topology; the classes (`edges.spring_classes`) are found
-        again when the values may have changed (see `grid_stencil`). Past
+        again when the values are edited (see `grid_stencil`). Past
         `SPRING_CLASSES` distinct values the loop reads them per spring: the
         body's arrays, or copies in the sorted order.
         """
@@ -383,14 +335,12 @@ class NumbaKernel:
             self._a, self._b = (end.astype(index) for end in ends)
             self._version = body.topology_version
             self._classes_version = -1
-        values = body.spring_values()
-        shared = _shared(values)
-        if body.parameters_version != self._classes_version or shared:
-            # sorted springs and a view held: the body's arrays, not classes to find every step
-            self._classes = (None,) if shared and self._order is None else self._classify(values)
+        values = body.spring_values
+        if body.parameters_version != self._classes_version:
+            self._classes = self._classify(values)
             self._classes_version = body.parameters_version
         if self._classes[0] is None and self._order is None:
-            return self._a, self._b, None, *values  # not kept: a reference would look shared
+            return self._a, self._b, None, *values
         return self._a, self._b, *self._classes
 
     def _classify(self, values: tuple[np.ndarray, ...]) -> tuple[np.ndarray | None, ...]:
@@ -415,3 +365,27 @@ class NumbaKernel:
         if self._order is not None:
             kinds = kinds[self._order]
         return kinds, *(np.ascontiguousarray(column) for column in table.T)
+
+
+def _advance_on_arrays(
+    update: Callable,
+    body: Body,
+    x: np.ndarray,
+    v: np.ndarray,
+    forces: np.ndarray,
+    pending: Pending,
+    field: np.ndarray,
+    dt: float,
+    coefficients: tuple[float, ...],
+) -> tuple[np.ndarray, np.ndarray]:
+    """`NumbaKernel._advance` for an update numba cannot compile: on whole arrays, with the
+    pending spring forces added in the order of the compiled loop."""
+    partial, by_coordinate, pad = pending
+    forces = forces if len(forces) else np.zeros_like(x)
+    for part in partial:
+        forces = forces + part  # in the order of `edges.spring_forces_parallel`
+    if len(by_coordinate):
+        forces = forces + by_coordinate[:, pad : pad + len(x)].T
+    masses, free = body.masses[:, None], ~body.fixed[:, None]
+    a = equations.acceleration(forces + masses * field, masses, free)
+    return update(x, v, a, dt, *coefficients)

@@ -16,7 +16,7 @@ from ..body import Body
 from ..constraint import Constraint, StepState
 from ..errors import check_non_negative
 
-_UP = {2: (0.0, 1.0), 3: (0.0, 1.0, 0.0)}  # the default ground normal, +y
+_UP = {2: np.array([0.0, 1.0]), 3: np.array([0.0, 1.0, 0.0])}  # the default ground normal, +y
 
 
 class Ground(Constraint):
@@ -56,36 +56,21 @@ class Ground(Constraint):
             raise ValueError(f"ground friction is a fraction in [0, 1], got {friction}")
         self.friction = float(friction)
 
-    def _normal(self, body: Body) -> np.ndarray:
-        return np.array(_UP[body.dim]) if self.normal is None else self.normal
-
     def check(self, body: Body) -> None:
-        if len(self._normal(body)) != body.dim:
+        if self.normal is not None and len(self.normal) != body.dim:
             raise ValueError(
-                f"ground normal has {len(self._normal(body))} components but the body is "
-                f"{body.dim}-D"
+                f"ground normal has {len(self.normal)} components but the body is {body.dim}-D"
             )
 
-    def _heights(self, x: np.ndarray, n: np.ndarray) -> np.ndarray:
-        """x·n of each row (m), summed in the order of the update loop (no matrix product)."""
-        return x[:, 1] if self.normal is None else (x * n).sum(axis=1)
-
-    def floor(self, body: Body) -> tuple[np.ndarray, float] | None:
-        """The plane, for the update loop to find the particles under it (not for subclasses
-        that change `apply`)."""
-        return (self._normal(body), self.height) if type(self).apply is Ground.apply else None
-
     def apply(self, state: StepState) -> float:
-        n = self._normal(state.body)
-        if state.under is None:
-            candidates = (self._heights(state.x, n) < self.height).nonzero()[0]
-        else:  # the update loop found them, the same way
-            candidates = state.under
+        n = _UP[state.body.dim] if self.normal is None else self.normal
+        heights = state.x[:, 1] if self.normal is None else (state.x * n).sum(axis=1)  # x·n (m)
+        candidates = (heights < self.height).nonzero()[0]
         below = candidates[~state.body.fixed[candidates]]  # fixed ones only among the few below
         if len(below) == 0:
             return 0.0
         x = state.x.take(below, axis=0)
-        x = x + (self.height - self._heights(x, n))[:, None] * n  # depth > 0 along n
+        x = x + (self.height - heights[below])[:, None] * n  # depth > 0 along n
         v = state.v.take(below, axis=0)
         state.x[below] = x
         landing = v @ n

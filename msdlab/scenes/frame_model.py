@@ -64,11 +64,11 @@ class FrameEuler(Integrator):
 
     def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: Dynamics) -> State:
         body = dynamics.body
-        inverse = equations.inverse_mass(body.masses, ~body.fixed)[:, None]
+        masses, free = body.masses[:, None], ~body.fixed[:, None]
         external = np.zeros_like(x)
         for force in dynamics.forces:
             force.add_to(body, x, v, external)
-        u = self.damping * (v + dt * equations.acceleration(external, inverse))
+        u = self.damping * (v + dt * equations.acceleration(external, masses, free))
         if self.max_speed is not None:
             speed = np.sqrt(np.einsum("ij,ij->i", u, u))[:, None]
             capped = u * (self.max_speed / np.maximum(speed, self.max_speed))
@@ -85,7 +85,7 @@ class FrameEuler(Integrator):
         _, length = kernels.spring_vectors(body, x_new)
         pushing = np.flatnonzero(length > self.min_length)
         springs, _ = kernels.spring_forces(body, x_new, u, springs=pushing)
-        return x_new, u + dt * equations.acceleration(springs, inverse)
+        return x_new, u + dt * equations.acceleration(springs, masses, free)
 
     def dissipated_energy(
         self, v: np.ndarray, masses: np.ndarray, v_new: np.ndarray | None = None

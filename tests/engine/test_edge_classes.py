@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab import kernels
+from msdlab import kernels, spring_kernel
 from msdlab.compiled import NumbaKernel
 
 RTOL = 1e-12
@@ -35,7 +35,7 @@ def shuffled_body(seed: int = 0) -> msd.Body:
     return body
 
 
-def forces_by(kernel: kernels.SpringKernel, body: msd.Body, springs=None) -> tuple:
+def forces_by(kernel: spring_kernel.SpringKernel, body: msd.Body, springs=None) -> tuple:
     out = np.zeros_like(body.positions)
     stretch, power = kernel.add_spring_forces(body, body.positions, body.velocities, out, springs)
     return out, stretch, power
@@ -63,7 +63,7 @@ def test_class_table_holds_each_springs_values() -> None:
     assert kinds.dtype == np.uint8 and len(k) == 6  # 3 rest lengths, with and without dashpot
     assert np.all(np.diff(a.astype(np.int64)) >= 0)  # sorted by the first end
     order = np.lexsort((body.spring_b, body.spring_a))
-    for table, values in zip((k, rest, c), body.spring_values()):
+    for table, values in zip((k, rest, c), body.spring_values):
         np.testing.assert_array_equal(table[kinds], values[order])
     assert len({(k[m], rest[m], c[m]) for m in range(len(k))}) == len(k)  # each class once
 
@@ -102,27 +102,37 @@ def test_past_the_limit_in_the_bodys_order(monkeypatch: pytest.MonkeyPatch) -> N
     monkeypatch.setattr("msdlab.compiled.kernel.SPRING_CLASSES", 2)
     kernel = NumbaKernel()
     _, _, kinds, k, _, _ = kernel._edge_list(body)
-    assert kinds is None and np.shares_memory(k, body.spring_values()[0])
+    assert kinds is None and np.shares_memory(k, body.spring_values[0])
     held = body.stiffness
     held[4] = 7.0  # seen without copying
     assert_close_to_numpy(body, kernel)
 
 
-def test_sorted_springs_with_a_held_view_read_the_bodys_arrays() -> None:
-    """No classes to find again at every step while a view is held: the body's own arrays."""
+def test_reading_the_values_keeps_the_classes_and_writing_counts() -> None:
+    """Reading a spring array, or holding it, is no edit: the classes are kept. Writing
+    through it, in place or with numpy, counts at once (the body's tracked arrays)."""
     body = sorted_body()
     kernel = NumbaKernel()
     classed = forces_by(kernel, body)
-    assert kernel._edge_list(body)[2] is not None
+    kinds = kernel._edge_list(body)[2]
     held = body.rest_lengths
-    assert kernel._edge_list(body)[2] is None
+    assert kernel._edge_list(body)[2] is kinds
     assert_same(forces_by(kernel, body), classed)
-    held[6] *= 1.1
-    assert_close_to_numpy(body, kernel)
-    del held
-    body.spring_damping[2] = 0.1  # no view left, an edit: classes again
-    assert kernel._edge_list(body)[2] is not None
-    assert_close_to_numpy(body, kernel)
+    for edit in (
+        lambda: held.__setitem__(6, held[6] * 1.1),
+        lambda: held.__imul__(1.01),
+        lambda: np.copyto(body.stiffness[3:5], 7.0),
+        lambda: np.multiply(body.spring_damping, 0.0, out=body.spring_damping),
+    ):
+        version = body.parameters_version
+        edit()
+        assert body.parameters_version > version
+        assert kernel._edge_list(body)[2] is not kinds
+        kinds = kernel._edge_list(body)[2]
+        assert_close_to_numpy(body, kernel)
+    version = body.parameters_version
+    _ = body.stiffness * 2.0, held.sum(), body.spring_values[0][3]
+    assert body.parameters_version == version
 
 
 @pytest.mark.parametrize("threaded", [False, True])

@@ -9,6 +9,7 @@ import msdlab as msd
 from msdlab import kernels
 from msdlab.compiled import NumbaKernel
 from msdlab.compiled.stencil import grid_stencil
+from msdlab.spring_kernel import SpringKernel
 
 RTOL = 1e-12
 
@@ -29,7 +30,7 @@ def shaken_grid(shape: tuple[int, ...], neighbours: tuple[int, ...], damping: fl
     return body
 
 
-def forces_by(kernel: kernels.SpringKernel, body: msd.Body) -> tuple[np.ndarray, float, float]:
+def forces_by(kernel: SpringKernel, body: msd.Body) -> tuple[np.ndarray, float, float]:
     out = np.zeros_like(body.positions)
     stretch, power = kernel.add_spring_forces(body, body.positions, body.velocities, out, None)
     return out, stretch, power

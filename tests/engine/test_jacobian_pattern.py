@@ -8,7 +8,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 import msdlab as msd
-from msdlab import kernels
+from msdlab import jacobian, kernels, spring_kernel
 from msdlab.dynamics import Dynamics
 
 
@@ -107,8 +107,8 @@ def test_each_kernel_sums_the_blocks_a_fresh_assembly_sums(kernel: str, shape: t
         body = msd.Body.grid(shape, spacing=0.1, stiffness=40.0, neighbours=(1, 2))
         body.positions[:] += np.random.default_rng(3).normal(scale=0.03, size=(20, 2))
         body.spring_damping[::2] = 0.3
-    pattern = kernels.JacobianPattern(body)
-    jx, jv = kernels.make_kernel(kernel).jacobians(body, body.positions, pattern)
+    pattern = jacobian.JacobianPattern(body)
+    jx, jv = spring_kernel.make_kernel(kernel).jacobians(body, body.positions, pattern)
     fresh_x, fresh_v = fresh_jacobians(body, body.positions)
     np.testing.assert_allclose(jx.toarray(), fresh_x.toarray(), rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(jv.toarray(), fresh_v.toarray(), rtol=1e-12, atol=1e-12)
@@ -119,8 +119,8 @@ def test_coincident_ends_give_an_isotropic_block(kernel: str) -> None:
     body = msd.Body.from_arrays([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]], [[0, 1]], stiffness=7.0)
     body.spring_damping[:] = 0.5
     body.positions[1] = body.positions[0]
-    pattern = kernels.JacobianPattern(body)
-    jx, jv = kernels.make_kernel(kernel).jacobians(body, body.positions, pattern)
+    pattern = jacobian.JacobianPattern(body)
+    jx, jv = spring_kernel.make_kernel(kernel).jacobians(body, body.positions, pattern)
     block = 7.0 * np.eye(3)
     np.testing.assert_array_equal(jx.toarray(), np.block([[-block, block], [block, -block]]))
     np.testing.assert_array_equal(jv.toarray(), np.zeros((6, 6)))

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab import integrators, kernels
+from msdlab import integrators, kernels, spring_kernel
 from msdlab.dynamics import Dynamics
 
 RTOL = 1e-12
@@ -61,7 +61,7 @@ def test_kernel_matches_spring_objects(
         monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
     body = deformed_body(dim)
     x, v = body.positions, body.velocities
-    springs = kernels.make_kernel(kernel)
+    springs = spring_kernel.make_kernel(kernel)
     assert springs.name == kernel
     forces, energy, power = per_spring(body)
     out = np.ones_like(x)  # the kernel adds to what is there
@@ -129,7 +129,7 @@ def test_advance_with_springs_is_forces_then_advance(
         body.stiffness[:] = 30.0
         body.spring_damping[:] = 0.3
     x, v, field = body.positions, body.velocities, np.array([0.0, -9.81, 0.0][:dim])
-    springs = kernels.make_kernel(kernel)
+    springs = spring_kernel.make_kernel(kernel)
     if kernel == "numba":
         assert (springs.grid_stencil(body) is not None) == uniform
     with warnings.catch_warnings():
@@ -147,16 +147,16 @@ def test_advance_with_springs_is_forces_then_advance(
 def test_kernel_choice(monkeypatch: pytest.MonkeyPatch) -> None:
     body = deformed_body(2)
     monkeypatch.setenv("MSDLAB_KERNEL", "numpy")
-    assert kernels.default_kernel() == "numpy"
+    assert spring_kernel.default_kernel() == "numpy"
     assert msd.Simulation(body).dynamics.kernel == "numpy"
     monkeypatch.setenv("MSDLAB_KERNEL", "numba")
     assert msd.Simulation(body).dynamics.kernel == "numba"
     assert msd.Simulation(body, kernel="numpy").dynamics.kernel == "numpy"
     monkeypatch.delenv("MSDLAB_KERNEL")
-    assert kernels.default_kernel() == "numba"
+    assert spring_kernel.default_kernel() == "numba"
     monkeypatch.setenv("MSDLAB_KERNEL", "fortran")
     with pytest.raises(ValueError, match="MSDLAB_KERNEL must be one of numba, numpy"):
-        kernels.default_kernel()
+        spring_kernel.default_kernel()
     with pytest.raises(ValueError, match="kernel must be one of"):
         msd.Simulation(body, kernel="cuda")
 

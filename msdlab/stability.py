@@ -6,7 +6,7 @@ is stable for a mode when its one-step map on (x, v) has spectral radius <= 1;
 `step` on that one mode, so it works for any `Integrator`, a student's included.
 `max_stable_dt` applies it to the stiffest mode of a body: the largest
 eigenvalue ω² of M⁻¹K (K = -∂F/∂x of the springs). `describe_blowup` is what
-`Simulation` reports when a step blows up (registered with `msdlab.errors`).
+`Simulation` reports when a step blows up.
 """
 
 from __future__ import annotations
@@ -20,11 +20,10 @@ import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .. import kernels
-from ..body import Body
-from ..errors import register_diagnosis
-from ..forces import Force
-from ..integrators import Integrator
+from . import kernels
+from .body import Body
+from .forces import Force
+from .integrators import Integrator
 
 
 @dataclass(frozen=True)
@@ -178,31 +177,30 @@ def describe_blowup(
             f"spring {worst} (particles {body.spring_a[worst]}-{body.spring_b[worst]}) is at "
             f"{stretch[worst]:.3g}× its rest length"
         )
-    mode = stiffest_mode(body, forces, reference)
+    lines.append(_against_the_limit(integrator, dt, stiffest_mode(body, forces, reference)))
+    return "; ".join(lines)
+
+
+def _against_the_limit(integrator: Integrator, dt: float, mode: Mode) -> str:
+    """What dt (s) is against the predicted stable limit of ``integrator`` for ``mode``."""
     name = type(integrator).__name__
     try:
         limit = stability_limit(integrator, mode)
     except Exception as error:  # a user's integrator that cannot step a one-mode system
-        lines.append(f"(no stability prediction: {name}.step failed on a test mode: {error!r})")
-        return "; ".join(lines)
+        return f"(no stability prediction: {name}.step failed on a test mode: {error!r})"
     if limit == 0.0:
-        lines.append(
+        return (
             f"{name} is unstable at any dt for these springs (its energy grows every step): "
             "use SymplecticEuler, Verlet, VelocityVerlet or ImplicitEuler, or add dashpots"
         )
-    elif dt > limit:
-        lines.append(
+    if dt > limit:
+        return (
             f"dt = {dt:.3g} s is {dt / limit:.3g}× the predicted stable limit {limit:.3g} s "
             f"of {name} (stiffest mode ω = {mode.omega:.3g} rad/s, period {mode.period:.3g} s): "
             f"use dt < {0.9 * limit:.3g} s, softer springs, or ImplicitEuler"
         )
-    else:
-        lines.append(
-            f"dt = {dt:.3g} s is below the predicted linear limit {limit:.3g} s of {name}, so "
-            "the blow-up comes from large deformations or contact (ground, sphere, drivers): "
-            "reduce dt or the stiffness, or add damping"
-        )
-    return "; ".join(lines)
-
-
-register_diagnosis(describe_blowup)
+    return (
+        f"dt = {dt:.3g} s is below the predicted linear limit {limit:.3g} s of {name}, so "
+        "the blow-up comes from large deformations or contact (ground, sphere, drivers): "
+        "reduce dt or the stiffness, or add damping"
+    )

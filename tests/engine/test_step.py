@@ -1,5 +1,6 @@
-"""The end of a step done in the update loop (`kernels.StepEnd`): the same step as the
-Simulation's per-array passes (pinning, the floor, the finite check), bit for bit."""
+"""The guarantees of `Simulation.step`, through the public step: fixed particles stay put,
+the constraints and the ledger see the integrator's new state whoever owns its arrays, a
+state that stops being finite is caught in its step, and the body holds the new state."""
 
 from __future__ import annotations
 
@@ -8,14 +9,13 @@ import pytest
 
 import msdlab as msd
 from msdlab.compiled import kernel as numba_kernel
-from msdlab.kernels import StepEnd
 
 GRAVITY = (0.0, -9.81, 0.0)
 
 
 def copying(integrator: type[msd.Integrator]) -> type[msd.Integrator]:
-    """``integrator`` returning copies of its arrays: the Simulation then does the end of
-    each step with its per-array passes, the reference."""
+    """``integrator`` returning copies of its arrays: a step that cannot depend on who owns
+    the arrays `Dynamics.advance` returns, the reference."""
 
     class Copying(integrator):  # type: ignore[misc, valid-type]
         def step(self, x, v, dt, dynamics):
@@ -37,14 +37,10 @@ def falling_body(dim: int, size: int) -> msd.Body:
 
 
 def run(integrator: msd.Integrator, body: msd.Body, constraints: list, steps: int = 200):
-    """Run and return the simulation and the `StepEnd` of each step."""
     gravity = msd.Gravity(GRAVITY[: body.dim])
     sim = msd.Simulation(body, integrator, dt=1e-3, forces=[gravity, *constraints])
-    ends: list[StepEnd] = []
-    make_end = sim._step_end
-    sim._step_end = lambda: ends.append(make_end()) or ends[-1]  # type: ignore[method-assign]
     sim.run(steps=steps)
-    return sim, ends
+    return sim
 
 
 @pytest.mark.parametrize("threads", [False, True], ids=["one thread", "threads"])
@@ -52,7 +48,7 @@ def run(integrator: msd.Integrator, body: msd.Body, constraints: list, steps: in
 @pytest.mark.parametrize("normal", [None, (0.1, 1.0, 0.05)], ids=["y up", "tilted"])
 @pytest.mark.parametrize("scheme", [msd.Verlet, msd.SymplecticEuler, msd.ExplicitEuler])
 @pytest.mark.parametrize("friction", [0.0, 0.4])
-def test_the_loop_ends_the_step_as_the_simulation_does(
+def test_the_step_does_not_depend_on_who_owns_the_arrays(
     scheme, friction: float, normal, dim: int, threads: bool, kernel: str, monkeypatch
 ) -> None:
     if threads:
@@ -62,46 +58,44 @@ def test_the_loop_ends_the_step_as_the_simulation_does(
             monkeypatch.setattr(numba_kernel, limit, 10)
     normal = None if normal is None else normal[:dim]
     integrator = (lambda cls: cls(0.01)) if scheme is msd.Verlet else (lambda cls: cls())
-    searched: list[bool] = []  # did the floor get the particles the loop found?
-    apply = msd.Ground.apply
-    monkeypatch.setattr(
-        msd.Ground,
-        "apply",
-        lambda self, state: searched.append(state.under is not None) or apply(self, state),
-    )
     results = []
     for cls in (scheme, copying(scheme)):
         body = falling_body(dim, 9 if dim == 3 else 20)
+        fixed = body.positions[body.fixed].copy()
         floor = msd.Ground(height=0.1, normal=normal, friction=friction)
-        sim, ends = run(integrator(cls), body, [floor])
-        results.append((body.positions, body.velocities, dict(sim.dissipated), ends))
-    (x, v, booked, ends), (x_ref, v_ref, booked_ref, _) = results
+        sim = run(integrator(cls), body, [floor])
+        np.testing.assert_array_equal(body.positions[body.fixed], fixed)  # pinned exactly
+        assert not body.velocities[body.fixed].any()
+        results.append((body.positions, body.velocities, dict(sim.dissipated)))
+    (x, v, booked), (x_ref, v_ref, booked_ref) = results
     np.testing.assert_array_equal(x, x_ref)
     np.testing.assert_array_equal(v, v_ref)
-    damping = booked.pop("integrator"), booked_ref.pop("integrator")  # summed in another order
     assert booked == booked_ref
     assert booked["ground"] != 0.0  # the floor acted
-    fused = kernel == "numba"  # the loop ended the steps of the first run, not the reference's
-    assert searched == [fused] * len(ends) + [False] * len(ends)
-    assert any(end.under is not None and len(end.under) for end in ends) == fused
-    if scheme is msd.Verlet:  # λ's work, summed by the loop but under the floor
-        assert damping[0] == pytest.approx(damping[1], rel=1e-12, abs=0.0)
-        assert all(end.damping and (end.damping_work > 0) == fused for end in ends)
-    else:
-        assert damping == (0.0, 0.0)
-        assert not any(end.damping for end in ends)
+    assert (booked["integrator"] > 0.0) == (scheme is msd.Verlet)
 
 
-def test_more_constraints_after_the_floor(kernel: str) -> None:
+def test_more_constraints_after_the_floor() -> None:
     results = []
     for cls in (msd.Verlet, copying(msd.Verlet)):
         body = falling_body(3, 8)
-        constraints = [msd.Ground(height=0.1, friction=0.2), msd.Drag(0.5)]
-        sim, _ = run(cls(0.02), body, constraints)
+        sim = run(cls(0.02), body, [msd.Ground(height=0.1, friction=0.2), msd.Drag(0.5)])
         results.append((body.positions, body.velocities, dict(sim.dissipated)))
     np.testing.assert_array_equal(results[0][0], results[1][0])
     np.testing.assert_array_equal(results[0][1], results[1][1])
-    assert results[0][2] == results[1][2]  # with drag after it, λ's work is summed afterwards
+    assert results[0][2] == results[1][2]
+
+
+def test_the_body_holds_the_new_state_after_each_step() -> None:
+    body = falling_body(3, 4)
+    sim = msd.Simulation(body, msd.Verlet(0.01), forces=[msd.Gravity(GRAVITY)])
+    x, v = body.positions.copy(), body.velocities.copy()
+    x_new, v_new = msd.Verlet(0.01).step(x, v, sim.dt, sim.dynamics)
+    free = ~body.fixed
+    sim.step()
+    np.testing.assert_array_equal(body.positions[free], x_new[free])
+    np.testing.assert_array_equal(body.velocities[free], v_new[free])
+    assert sim.step_count == 1 and sim.time == sim.dt
 
 
 class Poison(msd.Constraint):
@@ -128,8 +122,8 @@ def test_a_constraint_making_nan_is_caught_in_its_step(first: bool) -> None:
     assert np.isfinite(body.velocities).all()  # the body keeps the last finite state
 
 
-@pytest.mark.filterwarnings("ignore:.*encountered:RuntimeWarning")  # the reference's inf - inf
-def test_the_loop_catches_a_step_that_blows_up() -> None:
+@pytest.mark.filterwarnings("ignore:.*encountered:RuntimeWarning")  # inf - inf
+def test_a_step_that_blows_up_is_caught() -> None:
     body = falling_body(3, 5)
     body.velocities[2, 1] = 1e306
     sim = msd.Simulation(body, msd.SymplecticEuler(), dt=1e3, forces=[msd.Ground(height=-1.0)])
@@ -141,7 +135,7 @@ def test_the_loop_catches_a_step_that_blows_up() -> None:
 
 
 class InPlace(msd.Integrator):
-    """Writes into the arrays `Dynamics.advance` returned (which a Simulation's end owns)."""
+    """Writes into the arrays `Dynamics.advance` returned."""
 
     def step(self, x, v, dt, dynamics):
         x_new, v_new = dynamics.advance(msd.integrators.symplectic_euler_update, x, v, dt)
@@ -149,66 +143,47 @@ class InPlace(msd.Integrator):
         return x_new, v_new
 
 
-def test_writing_into_advances_arrays_is_explained(kernel: str) -> None:
-    sim = msd.Simulation(falling_body(2, 4), InPlace(), forces=[msd.Ground()])
-    if kernel == "numpy":  # nothing was done in a loop: the arrays are the integrator's
-        sim.run(steps=2)
-        return
-    with pytest.raises(TypeError, match="x_new \\+ \\.\\.\\., not x_new \\+="):
-        sim.run(steps=2)
+class Fresh(msd.Integrator):
+    """`InPlace` computing new arrays instead."""
+
+    def step(self, x, v, dt, dynamics):
+        x_new, v_new = dynamics.advance(msd.integrators.symplectic_euler_update, x, v, dt)
+        return x_new, v_new * 0.99
+
+
+def test_an_integrator_may_write_into_the_arrays_advance_returns() -> None:
+    bodies = [falling_body(2, 4), falling_body(2, 4)]
+    for body, integrator in zip(bodies, (InPlace(), Fresh())):
+        msd.Simulation(body, integrator, forces=[msd.Ground()]).run(steps=20)
+    np.testing.assert_array_equal(bodies[0].positions, bodies[1].positions)
 
 
 class SpringyFloor(msd.Ground):
-    """A floor with its own `apply`: the update loop must not search for it."""
+    """A floor with its own `apply`."""
 
     def apply(self, state) -> float:
-        return super().apply(state)
+        return 2.0 * super().apply(state)
 
 
-def test_a_floor_with_its_own_apply_is_searched_by_itself() -> None:
-    body = falling_body(3, 4)
-    assert msd.Ground().floor(body) is not None
-    assert SpringyFloor().floor(body) is None
-    sim, ends = run(msd.Verlet(), body, [SpringyFloor(height=0.1)], steps=150)
-    assert all(end.under is None for end in ends)
-    assert sim.dissipated["ground"] != 0.0
+def test_a_floor_with_its_own_apply_is_used() -> None:
+    sims = [
+        run(msd.Verlet(), falling_body(3, 4), [cls(height=0.1)], steps=150)
+        for cls in (msd.Ground, SpringyFloor)
+    ]
+    np.testing.assert_array_equal(sims[0].body.positions, sims[1].body.positions)
+    assert sims[1].dissipated["ground"] == 2.0 * sims[0].dissipated["ground"] != 0.0
 
 
 class OwnLedger(msd.Verlet):
-    """A Verlet that books its damping its own way: the loop must not sum it for it."""
+    """A Verlet that books its damping its own way."""
 
     def dissipated_energy(self, v, masses, v_new=None) -> float:
         return 1.0
 
 
 @pytest.mark.parametrize("ledger", [True, False])
-def test_damping_is_summed_only_for_the_ledger_of_a_velocity_factor(ledger: bool) -> None:
-    for integrator, summed in ((msd.Verlet(0.1), ledger), (OwnLedger(0.1), False)):
-        body = falling_body(3, 4)
-        gravity = msd.Gravity(GRAVITY)
-        sim = msd.Simulation(body, integrator, forces=[gravity], ledger=ledger)
-        assert sim._step_end().damping == summed
+def test_an_integrator_books_its_own_damping(ledger: bool) -> None:
+    body = falling_body(3, 4)
+    sim = msd.Simulation(body, OwnLedger(0.1), forces=[msd.Gravity(GRAVITY)], ledger=ledger)
     sim.run(steps=3)
     assert sim.dissipated.get("integrator", 0.0) == (3.0 if ledger else 0.0)
-
-
-class BadFloor(msd.Constraint):
-    """A constraint whose floor is not a plane of the body's dimension."""
-
-    def __init__(self, floor) -> None:
-        self.plane = floor
-
-    def floor(self, body):
-        return self.plane
-
-    def apply(self, state) -> float:
-        return 0.0
-
-
-@pytest.mark.parametrize(
-    "floor", [((0.0, 1.0), 0.0), ((0.0, 2.0, 0.0), 0.0), ((0.0, 1.0, 0.0), np.nan), "flat"]
-)
-def test_a_floor_that_is_not_a_plane_is_refused(floor) -> None:
-    sim = msd.Simulation(falling_body(3, 3), msd.Verlet(), forces=[BadFloor(floor)])
-    with pytest.raises(ValueError, match="floor must return None or \\(unit normal of 3 numbers"):
-        sim.step()
