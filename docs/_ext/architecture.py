@@ -12,10 +12,10 @@ from pathlib import Path
 LAYERS = [
     (
         "engine core",
-        "equations · particle, spring · body, lattice · kernels (numpy) + compiled (numba)\n"
-        "forces, constraint · dynamics, integrators · simulation, energy",
+        "equations · particle, spring · body, lattice · spring kernel: numpy | compiled (numba)\n"
+        "forces, constraint · dynamics, integrators · simulation, energy, stability",
     ),
-    ("analysis · interaction", "stable dt, blow-up diagnosis, convergence · ground, walls, grab"),
+    ("analysis · interaction", "measured stable dt, convergence · ground, walls, grab"),
     ("msdlab", "the package: re-exports the two layers below (import msdlab as msd)"),
     ("scenes · course", "ready simulations · task loading, checks' feedback, pytest plugin"),
     ("viz", "pictures, animations, the live view"),
