@@ -1,7 +1,7 @@
 """Helpers for tests in a real browser: headless Chromium, a JupyterLab server, waiting.
 
-Tests import it (``from browser import ...``); their marks skip them where Chromium
-or the Python packages are missing.
+Tests import it (``from browser import ...``: tests/ is on every test's path); the
+marks of `needs` skip them where Chromium or the Python packages are missing.
 """
 
 import importlib.util
