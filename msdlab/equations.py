@@ -76,3 +76,32 @@ def acceleration(force: float, mass: float, free: bool) -> float:
 def kinetic_energy(masses: np.ndarray, velocities: np.ndarray) -> float:
     """½ Σ m |v|² (J) of particles of ``masses`` (N,) moving at ``velocities`` (N, d)."""
     return float(0.5 * np.sum(masses * np.einsum("ij,ij->i", velocities, velocities)))
+
+
+def contact_work(
+    masses: np.ndarray, kick: np.ndarray, v_before: np.ndarray, v_after: np.ndarray
+) -> float:
+    """Work (J) a contact did in one step: Σ m Δv·(v_before + v_after)/2.
+
+    ``kick`` (M, d) is the velocity change Δv the contact gave each particle in
+    the step (its impulse per mass, m/s); ``v_before`` and ``v_after`` are the
+    velocities at the start and the end of the step. The contact force m·Δv/dt
+    does work at the particle's velocity at the time it acts, the mean of the
+    two: for position Verlet, (x(t+dt) - x(t-dt))/2dt. A contact that holds a
+    particle at rest does no work; one that stops a particle does negative work.
+    """
+    return 0.5 * float(np.einsum("i,ij,ij->", masses, kick, v_before + v_after))
+
+
+def damping_work(
+    masses: np.ndarray, v_before: np.ndarray, v_after: np.ndarray, factor: float
+) -> float:
+    """Energy (J) a velocity factor per step takes out of a leapfrog step.
+
+    The step scales the velocity it starts from, v_before, by ``factor`` before
+    the forces act (damped Verlet, eq. 1.4: factor = 1 - λ): a kick
+    Δv = (factor - 1)·v_before, whose work is `contact_work` with the step's
+    end velocity v_after. Booking (1 - factor²)·½ Σ m v_before² instead misses
+    the work against the forces' kick and leaves a first-order drift.
+    """
+    return (1.0 - factor) * contact_work(masses, v_before, v_before, v_after)  # linear in Δv

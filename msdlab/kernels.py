@@ -118,6 +118,11 @@ def spring_jacobians(
     return pattern.jacobians(stiff, damping[:, None, None] * outer if damping.any() else None)
 
 
+def finite(x: np.ndarray, v: np.ndarray) -> bool:
+    """Whether every position and velocity (N, d) is a finite number."""
+    return bool(np.isfinite(x).all() and np.isfinite(v).all())
+
+
 class NumpyKernel:
     """The readable kernel (`spring_kernel.SpringKernel`): the functions above on whole arrays."""
 
@@ -125,6 +130,8 @@ class NumpyKernel:
     elastic_energy = staticmethod(elastic_energy)
     dashpot_power = staticmethod(dashpot_power)
     jacobians = staticmethod(spring_jacobians)
+    finite = staticmethod(finite)
+    damping_work = staticmethod(equations.damping_work)
 
     @staticmethod
     def add_spring_forces(

@@ -178,11 +178,14 @@ class Simulation:
         """Add to `dissipated` the energy (J) each mechanism took out in the step from (x, v)
         to velocities ``v_new``: the dashpots, the integrator's damping, the dissipative
         forces, and the constraints (``removed``: (ledger name, energy) of each)."""
-        body, dt = self.body, self._dt
-        booked = {
-            "dashpot": self.dynamics.springs.dashpot_power(body, x, v) * dt,
-            "integrator": self.integrator.dissipated_energy(v, body.masses, v_new),
-        }
+        body, dt, integrator, kernel = self.body, self._dt, self.integrator, self.dynamics.springs
+        if type(integrator).dissipated_energy is not Integrator.dissipated_energy:
+            damping = integrator.dissipated_energy(v, body.masses, v_new)  # its own booking
+        elif (factor := integrator.velocity_factor) == 1.0:
+            damping = 0.0
+        else:  # Integrator.dissipated_energy's work of the velocity factor, summed by the kernel
+            damping = kernel.damping_work(body.masses, v, v_new, factor)
+        booked = {"dashpot": kernel.dashpot_power(body, x, v) * dt, "integrator": damping}
         for force in self.dynamics.forces:
             lost = force.dissipated_power(body, x, v)
             if lost:
@@ -274,7 +277,7 @@ class Simulation:
     def _check_divergence(self, x: np.ndarray, x_new: np.ndarray, v_new: np.ndarray) -> None:
         """Raise `SimulationDiverged` if the new state is not finite or a spring is
         stretched past ``max_stretch`` times its rest length."""
-        finite = math.isfinite(float(x_new.sum()) + float(v_new.sum()))
+        finite = self.dynamics.springs.finite(x_new, v_new)
         stretched = self.max_stretch is not None and self.dynamics.max_stretch > self.max_stretch
         if not finite or stretched:
             body, integrator, dt, forces = self.body, self.integrator, self._dt, self.forces

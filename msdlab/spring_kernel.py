@@ -42,6 +42,14 @@ class SpringKernel(Protocol):
     def dashpot_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
         """Power (W) the dashpots take out at (x, v)."""
 
+    def finite(self, x: np.ndarray, v: np.ndarray) -> bool:
+        """Whether every position and velocity (N, d) is a finite number."""
+
+    def damping_work(
+        self, masses: np.ndarray, v_before: np.ndarray, v_after: np.ndarray, factor: float
+    ) -> float:
+        """`equations.damping_work`: the energy (J) a velocity factor per step takes out."""
+
     def jacobians(
         self, body: Body, x: np.ndarray, pattern: JacobianPattern
     ) -> tuple[sp.csr_matrix, sp.csr_matrix]:

@@ -25,6 +25,7 @@ from .edges import (
     spring_forces_serial,
 )
 from .gather import gather_parallel, gather_serial
+from .reductions import damping_work, finite
 from .stencil import (
     GridStencil,
     column_masks,
@@ -94,6 +95,8 @@ class NumbaKernel:
         self._classes: tuple[np.ndarray | None, ...] = (None,)  # see `_edge_list`
 
     name = "numba"
+    finite = staticmethod(finite)
+    damping_work = staticmethod(damping_work)
 
     def add_spring_forces(
         self,

@@ -1,0 +1,30 @@
+"""The kernels' sums over the end of a step: the numba kernel's compiled passes give the
+numpy kernel's readable results (to rounding), and a NaN or infinity anywhere is seen."""
+
+import numpy as np
+import pytest
+
+import msdlab as msd
+from msdlab.spring_kernel import make_kernel
+
+
+def test_damping_work_is_the_readable_sum_to_rounding(kernel: str) -> None:
+    rng = np.random.default_rng(1)
+    masses, v, v_new = (
+        rng.random(1000) + 0.5,
+        rng.normal(size=(1000, 3)),
+        rng.normal(size=(1000, 3)),
+    )
+    expected = msd.energy.damping_work(masses, v, v_new, 0.99)
+    got = make_kernel(kernel).damping_work(masses, v, v_new, 0.99)
+    assert got == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+@pytest.mark.parametrize("where", ["x", "v"])
+def test_finite_sees_one_bad_coordinate(kernel: str, bad: float, where: str) -> None:
+    springs = make_kernel(kernel)
+    x, v = np.full((50, 3), 1e300), np.zeros((50, 3))  # large but finite: still finite
+    assert springs.finite(x, v)
+    (x if where == "x" else v)[37, 2] = bad
+    assert not springs.finite(x, v)
