@@ -5,9 +5,13 @@ each case with `viz.show` in a fresh notebook, at 60 steps a second (the gallery
 the template cube's steps of dt = 0.4, whose real time would be 2.5 steps a second), and
 counts, over ``--seconds``, the frames the page drew (requestAnimationFrame callbacks) and
 the new positions it received from Python. For the mesh it then presses on a particle and
-moves the mouse 15 px every 0.3 s: the delay is the time from a mouse move to the first
-frame showing the held particle where that move put it (the page's request, the kernel, a
-step, the positions back, a draw).
+moves the mouse 15 px every 0.3 s, and gives two delays from a mouse move (the event's
+time stamp): to the end of the frame that draws the held particle at the hand (the page
+draws it there itself, where `Grab` will pin it), and to the first positions from the
+engine with the particle there (the page's request, the server, the kernel, a step, the
+positions back).
+The ceiling: requestAnimationFrame callbacks a second of an empty page in the same
+browser, measured before each case; and the machine's load average (`os.getloadavg`).
 Beside it, the matplotlib view measured on the Agg canvas alone: the time of one frame
 (the steps of a frame and a full redraw), an upper bound of ipympl's frame rate, which
 then encodes a PNG per frame and sends it over the websocket.
@@ -15,13 +19,14 @@ then encodes a PNG per frame and sends it over the websocket.
     python benchmarks/live_view.py [--seconds 10] [--cases mesh,cube10,cube20]
 
 Headless Chromium with --disable-gpu draws on the CPU and paces requestAnimationFrame at
-the display's 60 Hz at most, so 60 fps is the ceiling here.
+the display's 60 Hz at most, so 60 fps is the ceiling here (less on a loaded machine).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 import urllib.request
@@ -46,6 +51,11 @@ from msdlab.scenes import SCENES
 
 live = viz.show({build}, steps_per_second={pace})
 """
+EMPTY_RATE = """(ms) => new Promise((done) => { let n = 0; const t0 = performance.now();
+const frame = (t) => { n++; if (t - t0 < ms) requestAnimationFrame(frame);
+  else done((1000 * n) / (t - t0)); };
+requestAnimationFrame(frame); })"""
+DELAYS = "() => {const s = window.msdlabViews.at(-1).stats; return [s.drawDelays, s.engineDelays];}"
 COUNTS = "() => {const v = window.msdlabViews.at(-1); return [v.stats.frames, v.stats.updates, \
 performance.now()];}"
 
@@ -59,8 +69,17 @@ def page_rate(page, seconds: float) -> tuple[float, float]:
     return (frames1 - frames0) / elapsed, (updates1 - updates0) / elapsed
 
 
-def drag_delays(page, moves: int = 12) -> list[float]:
-    """Delays (ms) from mouse moves to the held particle's move on the page."""
+def empty_page_rate(browser, seconds: float = 3.0) -> float:
+    """requestAnimationFrame callbacks a second of an empty page: the browser's ceiling."""
+    page = browser.new_page()
+    rate = page.evaluate(EMPTY_RATE, 1000 * seconds)
+    page.close()
+    return rate
+
+
+def drag_delays(page, moves: int = 12) -> tuple[list[float], list[float]]:
+    """Delays (ms) from mouse moves to the frame drawing the held particle at the hand, and
+    to the engine's positions showing it there."""
     canvas = page.locator(".msdlab-canvas")
     box = canvas.bounding_box()
     screen = np.array(
@@ -74,7 +93,9 @@ def drag_delays(page, moves: int = 12) -> list[float]:
         page.mouse.move(particle[0] - 15 * i, particle[1] - 5 * i)
         time.sleep(0.3)
     page.mouse.up()
-    return page.evaluate("() => window.msdlabViews.at(-1).stats.delays")
+    time.sleep(0.5)
+    drawn, engine = page.evaluate(DELAYS)
+    return drawn, engine
 
 
 def shut_down_kernels(url: str, token: str) -> None:
@@ -122,6 +143,7 @@ def main() -> None:
             browser = launch(playwright)
             for key in args.cases.split(","):
                 label, build, pace = CASES[key]
+                ceiling, load = empty_page_rate(browser), os.getloadavg()[0]
                 notebook = nbformat.v4.new_notebook(metadata={"kernelspec": KERNEL})
                 notebook.cells = [nbformat.v4.new_code_cell(CELL.format(build=build, pace=pace))]
                 nbformat.write(notebook, tmp / f"{key}.ipynb")
@@ -131,23 +153,25 @@ def main() -> None:
                 page.wait_for_function("() => window.msdlabViews?.at(-1)?.stats.updates > 20")
                 time.sleep(2)
                 fps, updates = page_rate(page, args.seconds)
-                delays = drag_delays(page) if key == "mesh" else []
+                drawn, engine = drag_delays(page) if key == "mesh" else ([], [])
                 page.screenshot(path=f"/tmp/live_view_{key}.png")
                 page.close()
                 shut_down_kernels(url, token)
                 agg = agg_frame_time(build, pace)
-                rows.append((label, fps, updates, delays, agg))
+                rows.append((label, fps, updates, drawn, engine, agg))
                 print(
-                    f"{label}: page {fps:.1f} fps, {updates:.1f} updates/s; "
-                    f"matplotlib on Agg {1000 * agg:.0f} ms/frame = {1 / agg:.1f} fps",
+                    f"{label}: page {fps:.1f} fps ({fps / ceiling:.0%} of an empty page's "
+                    f"{ceiling:.1f}), {updates:.1f} updates/s; matplotlib on Agg "
+                    f"{1000 * agg:.0f} ms/frame = {1 / agg:.1f} fps; load {load:.1f}",
                     flush=True,
                 )
-                if delays:
-                    print(
-                        f"  drag delay: median {np.median(delays):.0f} ms, "
-                        f"max {np.max(delays):.0f} ms over {len(delays)} moves",
-                        flush=True,
-                    )
+                for what, delays in (("drawn at the hand", drawn), ("engine there", engine)):
+                    if delays:
+                        print(
+                            f"  drag delay, {what}: median {np.median(delays):.0f} ms, "
+                            f"max {np.max(delays):.0f} ms over {len(delays)} moves",
+                            flush=True,
+                        )
             browser.close()
 
 

@@ -198,6 +198,16 @@ class Painter {
     this.shown = surface(springs, this.n, scene.dim === 3 && rest.length > SURFACE_ONLY);
   }
 
+  /** The positions to draw: ``positions`` with particle ``hand.particle`` at ``hand.target``
+   * (into a buffer reused from frame to frame). */
+  place(positions, hand) {
+    if (this.placed?.length !== positions.length) this.placed = new Float32Array(positions.length);
+    this.placed.set(positions);
+    const d = this.scene.dim;
+    for (let k = 0; k < d; k++) this.placed[d * hand.particle + k] = hand.target[k];
+    return this.placed;
+  }
+
   draw(camera, positions, held) {
     const g = this.context, { width, height } = this.canvas;
     camera.project(positions, this.n, this.screen, this.depth);
@@ -402,10 +412,20 @@ class EnergyPanel {
 }
 
 /** What a view counted (for benchmarks and tests): frames (requestAnimationFrame calls),
- * frames drawn with positions, new positions received (updates), and delays (ms) from a mouse move to the held particle
- * arriving where it was sent. Each view is listed in `window.msdlabViews`. */
+ * frames drawn with positions, new positions received (updates), and the delays (ms) from a
+ * mouse move to the frame drawing the held particle at the hand (`drawDelays`) and to the
+ * first positions from the engine with it there (`engineDelays`). Each view is listed in
+ * `window.msdlabViews`. */
 function newStats() {
-  return { frames: 0, drawn: 0, updates: 0, delays: [], pending: null };
+  return { frames: 0, drawn: 0, updates: 0, drawDelays: [], engineDelays: [],
+    moved: null, pending: null };
+}
+
+/** Whether particle `p` of `x` (dimension `d`) is at `target`, to float32's precision. */
+function isAt(x, p, target, d) {
+  let miss = 0;
+  for (let k = 0; k < d; k++) miss = Math.max(miss, Math.abs(x[d * p + k] - target[k]));
+  return miss <= 1e-3 * (1 + Math.abs(target[0]));
 }
 
 /** A body view: canvas, camera, mouse and the drawing loop. `source` hands it
@@ -423,7 +443,9 @@ export function mountView(el, scene, arrays, source) {
   const camera = new Camera(scene, canvas.width, canvas.height);
   const painter = new Painter(canvas, scene, arrays.springs, arrays.rest, arrays.fixed);
   const stats = newStats();
-  const view = { root, canvas, status, energy, camera, painter, stats, held: null, alive: true };
+  // `hand`: the held particle and where the hand put it (world coordinates)
+  const view = { root, canvas, status, energy, camera, painter, stats, held: null, hand: null,
+    alive: true };
   window.msdlabViews = window.msdlabViews || [];
   window.msdlabViews.push(view);
   mouse(view, painter, source);
@@ -432,12 +454,18 @@ export function mountView(el, scene, arrays, source) {
     if (!view.alive) return;
     const positions = source.latest();
     if (positions) {
-      painter.draw(camera, positions, view.held);
-      stats.drawn++;
       if (positions !== last) {
         stats.updates++;
         checkDelay(stats, positions, scene.dim);
+        letGo(view, positions, scene.dim);
       }
+      // Grab pins the held particle to the hand at the engine's next step: draw it there
+      // now, not a round trip through the kernel later (only while the engine steps)
+      const hand = source.stepping?.() ? view.hand : null;
+      painter.draw(camera, hand ? painter.place(positions, hand) : positions, view.held);
+      stats.drawn++;
+      if (hand && stats.moved !== null) stats.drawDelays.push(performance.now() - stats.moved);
+      stats.moved = null;
       last = positions;
     }
     if (energy) energy.draw();
@@ -448,25 +476,39 @@ export function mountView(el, scene, arrays, source) {
   return view;
 }
 
-/** Time from a mouse move to the first frame with the held particle where it was sent. */
+/** Time from a mouse move to the first engine positions with the held particle where it
+ * was sent. */
 function checkDelay(stats, x, d) {
   if (!stats.pending) return;
   const [time, particle, target] = stats.pending;
-  let miss = 0;
-  for (let k = 0; k < d; k++) miss = Math.max(miss, Math.abs(x[d * particle + k] - target[k]));
-  if (miss <= 1e-3 * (1 + Math.abs(target[0]))) {
-    stats.delays.push(performance.now() - time);
+  if (isAt(x, particle, target, d)) {
+    stats.engineDelays.push(performance.now() - time);
     stats.pending = null;
   }
+}
+
+/** After a release, the page draws the particle at the hand until the engine has it there
+ * too (or for a second at most), so it does not jump back to a position a round trip old. */
+function letGo(view, x, d) {
+  const hand = view.hand;
+  if (hand?.released && (isAt(x, hand.particle, hand.target, d)
+      || performance.now() - hand.released > 1000)) view.hand = null;
 }
 
 function mouse(view, painter, source) {
   const { canvas, camera, stats } = view;
   let turning = null, depth = 0;
-  const at = (event) => {
+  const at = (event) => { // the canvas's pixel under the mouse (inside its border)
     const box = canvas.getBoundingClientRect();
-    return [(event.clientX - box.left) * (canvas.width / box.width),
-      (event.clientY - box.top) * (canvas.height / box.height)];
+    return [(event.clientX - box.left - canvas.clientLeft) * (canvas.width / canvas.clientWidth),
+      (event.clientY - box.top - canvas.clientTop) * (canvas.height / canvas.clientHeight)];
+  };
+  /** The hand at `target` (world) now: drawn at the next frame, sent to the engine. */
+  const hold = (particle, target, event) => {
+    const time = Math.min(event.timeStamp, performance.now()); // when the event was made
+    view.hand = { particle, target, released: null };
+    stats.moved = time;
+    stats.pending = [time, particle, target];
   };
   canvas.addEventListener("contextmenu", (event) => event.preventDefault());
   canvas.addEventListener("mousedown", (event) => {
@@ -476,18 +518,17 @@ function mouse(view, painter, source) {
       turning = camera.dim === 3 ? [px, py, camera.azimuth, camera.elevation] : null;
       return;
     }
+    // in 3-D the hand moves on the plane facing the camera through the particle
     view.held = nearest;
     depth = painter.depth[nearest];
-    const target = camera.unproject(px, py, depth);
-    stats.pending = [performance.now(), nearest, target];
-    source.grab(nearest, target);
+    hold(nearest, camera.unproject(px, py, depth), event);
+    source.grab(nearest, view.hand.target);
   });
   window.addEventListener("mousemove", (event) => {
     const [px, py] = at(event);
     if (view.held !== null) {
-      const target = camera.unproject(px, py, depth);
-      stats.pending = [performance.now(), view.held, target];
-      source.move(target);
+      hold(view.held, camera.unproject(px, py, depth), event);
+      source.move(view.hand.target);
     } else if (turning) {
       camera.azimuth = turning[2] - (px - turning[0]) * 0.01;
       const elevation = turning[3] + (py - turning[1]) * 0.01;
@@ -496,6 +537,7 @@ function mouse(view, painter, source) {
   });
   window.addEventListener("mouseup", () => {
     if (view.held !== null) source.release();
+    if (view.hand) view.hand.released = performance.now();
     view.held = null;
     turning = null;
   });
@@ -554,6 +596,7 @@ function render({ model, el }) {
     grab: (particle, target) => send({ type: "grab", particle, target }),
     move: (target) => send({ type: "move", target }),
     release: () => send({ type: "release" }),
+    stepping: () => model.get("running") && !model.get("error"),
   };
   const view = mountView(el, scene, arrays, source);
   const onPositions = () => (positions = typed(model.get("positions"), Float32Array));
