@@ -3,8 +3,9 @@
 Runs JupyterLab and headless Chromium (as tests/viz/test_widget_browser.py does), shows
 each case with `viz.show` in a fresh notebook, at 60 steps a second (the gallery's frames;
 the template cube's steps of dt = 0.4, whose real time would be 2.5 steps a second), and
-counts, over ``--seconds``, the frames the page drew (requestAnimationFrame callbacks) and
-the new positions it received from Python. For the mesh it then presses on a particle and
+counts, over ``--seconds``, the page's frames (requestAnimationFrame callbacks), the
+pictures it drew (in frames where positions, camera or hand changed) and the new positions
+it received from Python. For the mesh it then presses on a particle and
 moves the mouse 15 px every 0.3 s, and gives two delays from a mouse move (the event's
 time stamp): to the end of the frame that draws the held particle at the hand (the page
 draws it there itself, where `Grab` will pin it), and to the first positions from the
@@ -56,17 +57,17 @@ const frame = (t) => { n++; if (t - t0 < ms) requestAnimationFrame(frame);
   else done((1000 * n) / (t - t0)); };
 requestAnimationFrame(frame); })"""
 DELAYS = "() => {const s = window.msdlabViews.at(-1).stats; return [s.drawDelays, s.engineDelays];}"
-COUNTS = "() => {const v = window.msdlabViews.at(-1); return [v.stats.frames, v.stats.updates, \
+COUNTS = "() => {const s = window.msdlabViews.at(-1).stats; return [s.frames, s.drawn, s.updates, \
 performance.now()];}"
 
 
-def page_rate(page, seconds: float) -> tuple[float, float]:
-    """(frames drawn, position updates) a second in the page over ``seconds``."""
-    frames0, updates0, t0 = page.evaluate(COUNTS)
+def page_rate(page, seconds: float) -> np.ndarray:
+    """(frames, pictures drawn, position updates) a second in the page over ``seconds``:
+    the page draws a picture in a frame when something changed (positions, camera, hand)."""
+    *counts0, t0 = page.evaluate(COUNTS)
     time.sleep(seconds)
-    frames1, updates1, t1 = page.evaluate(COUNTS)
-    elapsed = (t1 - t0) / 1000
-    return (frames1 - frames0) / elapsed, (updates1 - updates0) / elapsed
+    *counts1, t1 = page.evaluate(COUNTS)
+    return (np.array(counts1) - counts0) / ((t1 - t0) / 1000)
 
 
 def empty_page_rate(browser, seconds: float = 3.0) -> float:
@@ -152,7 +153,7 @@ def main() -> None:
                 run_notebook(page, url, token, f"{key}.ipynb")
                 page.wait_for_function("() => window.msdlabViews?.at(-1)?.stats.updates > 20")
                 time.sleep(2)
-                fps, updates = page_rate(page, args.seconds)
+                fps, drawn_rate, updates = page_rate(page, args.seconds)
                 drawn, engine = drag_delays(page) if key == "mesh" else ([], [])
                 page.screenshot(path=f"/tmp/live_view_{key}.png")
                 page.close()
@@ -161,8 +162,9 @@ def main() -> None:
                 rows.append((label, fps, updates, drawn, engine, agg))
                 print(
                     f"{label}: page {fps:.1f} fps ({fps / ceiling:.0%} of an empty page's "
-                    f"{ceiling:.1f}), {updates:.1f} updates/s; matplotlib on Agg "
-                    f"{1000 * agg:.0f} ms/frame = {1 / agg:.1f} fps; load {load:.1f}",
+                    f"{ceiling:.1f}), {drawn_rate:.1f} pictures/s, {updates:.1f} updates/s; "
+                    f"matplotlib on Agg {1000 * agg:.0f} ms/frame = {1 / agg:.1f} fps; "
+                    f"load {load:.1f}",
                     flush=True,
                 )
                 for what, delays in (("drawn at the hand", drawn), ("engine there", engine)):

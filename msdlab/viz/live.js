@@ -196,6 +196,18 @@ class Painter {
     this.dense = rest.length > DENSE;
     if (this.dense) this.pixels = new Pixels(canvas, scene.colours);
     this.shown = surface(springs, this.n, scene.dim === 3 && rest.length > SURFACE_ONLY);
+    this.next = new Uint32Array(LEVELS);
+    // the walls' and floor's segments: their ends, and where they are on the screen
+    this.ends = Float32Array.from(scene.world.edges.flat(2));
+    this.endsScreen = new Float32Array((2 * this.ends.length) / scene.dim);
+    this.endsDepth = new Float32Array(this.ends.length / scene.dim);
+  }
+
+  /** The walls' and floor's segments on the screen: [x0, y0, x1, y1] per segment. */
+  projectWorld(camera) {
+    const { ends, endsScreen, endsDepth } = this;
+    camera.project(ends, endsDepth.length, endsScreen, endsDepth);
+    return endsScreen;
   }
 
   /** The positions to draw: ``positions`` with particle ``hand.particle`` at ``hand.target``
@@ -230,10 +242,9 @@ class Painter {
     const { springs, rest, screen, pixels } = this;
     const d = this.scene.dim, limit = this.scene.strain_limit;
     pixels.clear();
-    for (const [from, to] of this.scene.world.edges) {
-      const px = new Float32Array(4);
-      camera.project(new Float32Array([...from, ...to]), 2, px, new Float32Array(2));
-      pixels.line(px[0], px[1], px[2], px[3], pixels.dark);
+    const ends = this.projectWorld(camera);
+    for (let i = 0; i < ends.length; i += 4) {
+      pixels.line(ends[i], ends[i + 1], ends[i + 2], ends[i + 3], pixels.dark);
     }
     const { springs: shown, particles } = this.shown;
     for (let s = 0; s < shown.length; s++) {
@@ -273,7 +284,8 @@ class Painter {
       counts[levels[e] + 1]++;
     }
     for (let l = 1; l <= LEVELS; l++) counts[l] += counts[l - 1];
-    const next = counts.slice(0, LEVELS);
+    const next = this.next;
+    next.set(counts.subarray(0, LEVELS));
     for (let e = 0; e < rest.length; e++) order[next[levels[e]]++] = e;
   }
 
@@ -320,18 +332,15 @@ class Painter {
 
   /** The scene's walls (a box) and floor (a grid on its plane). */
   drawWorld(g, camera) {
-    const world = this.scene.world;
+    const ends = this.projectWorld(camera);
     g.strokeStyle = "#4d4d4d";
     g.lineWidth = 2;
-    for (const [from, to] of world.edges) {
-      const ends = new Float32Array([...from, ...to]);
-      const px = new Float32Array(4), depth = new Float32Array(2);
-      camera.project(ends, 2, px, depth);
-      g.beginPath();
-      g.moveTo(px[0], px[1]);
-      g.lineTo(px[2], px[3]);
-      g.stroke();
+    g.beginPath();
+    for (let i = 0; i < ends.length; i += 4) {
+      g.moveTo(ends[i], ends[i + 1]);
+      g.lineTo(ends[i + 2], ends[i + 3]);
     }
+    g.stroke();
   }
 }
 
@@ -363,6 +372,14 @@ class EnergyPanel {
     this.history.push([energy.time, sum, energy.kinetic + energy.elastic + energy.gravitational
       + (energy.other || 0)]);
     if (this.history.length > HISTORY) this.history.shift();
+    this.stale = true;
+  }
+
+  /** Draw the bars and the plot if new energies came since the last frame: redrawing the
+   * same picture would cost the page a canvas upload every frame for nothing. */
+  drawIfNew() {
+    if (this.stale !== false) this.draw();
+    this.stale = false;
   }
 
   draw() {
@@ -412,10 +429,10 @@ class EnergyPanel {
 }
 
 /** What a view counted (for benchmarks and tests): frames (requestAnimationFrame calls),
- * frames drawn with positions, new positions received (updates), and the delays (ms) from a
- * mouse move to the frame drawing the held particle at the hand (`drawDelays`) and to the
- * first positions from the engine with it there (`engineDelays`). Each view is listed in
- * `window.msdlabViews`. */
+ * pictures drawn (frames in which something changed), new positions received (updates),
+ * and the delays (ms) from a mouse move to the frame drawing the held particle at the hand
+ * (`drawDelays`) and to the first positions from the engine with it there (`engineDelays`).
+ * Each view is listed in `window.msdlabViews`. */
 function newStats() {
   return { frames: 0, drawn: 0, updates: 0, drawDelays: [], engineDelays: [],
     moved: null, pending: null };
@@ -449,7 +466,7 @@ export function mountView(el, scene, arrays, source) {
   window.msdlabViews = window.msdlabViews || [];
   window.msdlabViews.push(view);
   mouse(view, painter, source);
-  let last = null;
+  let last = null, shown = [];
   const frame = () => {
     if (!view.alive) return;
     const positions = source.latest();
@@ -462,13 +479,18 @@ export function mountView(el, scene, arrays, source) {
       // Grab pins the held particle to the hand at the engine's next step: draw it there
       // now, not a round trip through the kernel later (only while the engine steps)
       const hand = source.stepping?.() ? view.hand : null;
-      painter.draw(camera, hand ? painter.place(positions, hand) : positions, view.held);
-      stats.drawn++;
-      if (hand && stats.moved !== null) stats.drawDelays.push(performance.now() - stats.moved);
+      // drawn again only if something changed: the same picture would cost a canvas upload
+      const now = [positions, hand, view.held, camera.azimuth, camera.elevation, camera.zoom];
+      if (now.some((value, i) => value !== shown[i])) {
+        painter.draw(camera, hand ? painter.place(positions, hand) : positions, view.held);
+        stats.drawn++;
+        if (hand && stats.moved !== null) stats.drawDelays.push(performance.now() - stats.moved);
+        shown = now;
+      }
       stats.moved = null;
       last = positions;
     }
-    if (energy) energy.draw();
+    if (energy) energy.drawIfNew();
     stats.frames++;
     requestAnimationFrame(frame);
   };
