@@ -5,12 +5,13 @@ each case with `viz.show` in a fresh notebook, at 60 steps a second (the gallery
 the template cube's steps of dt = 0.4, whose real time would be 2.5 steps a second), and
 counts, over ``--seconds``, the page's frames (requestAnimationFrame callbacks), the
 pictures it drew (in frames where positions, camera or hand changed) and the new positions
-it received from Python. For the mesh it then presses on a particle and
-moves the mouse 15 px every 0.3 s, and gives two delays from a mouse move (the event's
-time stamp): to the end of the frame that draws the held particle at the hand (the page
-draws it there itself, where `Grab` will pin it), and to the first positions from the
-engine with the particle there (the page's request, the server, the kernel, a step, the
-positions back).
+it received from Python, and the CPU time Chromium's processes took (psutil, which
+ipykernel installs): what the page costs a loaded machine, whatever the frame rate.
+For the mesh it then presses on a particle and moves the mouse 15 px every 0.3 s, and
+gives two delays from a mouse move (the event's time stamp): to the end of the frame
+that draws the held particle at the hand (the page draws it there itself, where `Grab`
+will pin it), and to the first positions from the engine with the particle there (the
+page's request, the server, the kernel, a step, the positions back).
 The ceiling: requestAnimationFrame callbacks a second of an empty page in the same
 browser, measured before each case; and the machine's load average (`os.getloadavg`).
 Beside it, the matplotlib view measured on the Agg canvas alone: the time of one frame
@@ -36,6 +37,7 @@ from tempfile import TemporaryDirectory
 
 import nbformat
 import numpy as np
+import psutil
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "viz"))
 from browser import jupyterlab_server, launch, run_notebook
@@ -56,18 +58,36 @@ EMPTY_RATE = """(ms) => new Promise((done) => { let n = 0; const t0 = performanc
 const frame = (t) => { n++; if (t - t0 < ms) requestAnimationFrame(frame);
   else done((1000 * n) / (t - t0)); };
 requestAnimationFrame(frame); })"""
-DELAYS = "() => {const s = window.msdlabViews.at(-1).stats; return [s.drawDelays, s.engineDelays];}"
+# (an older live.js, before the page drew the hand itself, had only `delays`: the engine's)
+DELAYS = """() => { const s = window.msdlabViews.at(-1).stats;
+return [s.drawDelays ?? [], s.engineDelays ?? s.delays]; }"""
 COUNTS = "() => {const s = window.msdlabViews.at(-1).stats; return [s.frames, s.drawn, s.updates, \
 performance.now()];}"
 
 
+def browser_cpu() -> float:
+    """CPU seconds used so far by the Chromium processes this script started."""
+    total = 0.0
+    for child in psutil.Process().children(recursive=True):
+        try:
+            if "chrom" in child.name().lower():
+                total += sum(child.cpu_times()[:2])  # user, system
+        except psutil.NoSuchProcess:
+            pass
+    return total
+
+
 def page_rate(page, seconds: float) -> np.ndarray:
-    """(frames, pictures drawn, position updates) a second in the page over ``seconds``:
-    the page draws a picture in a frame when something changed (positions, camera, hand)."""
+    """(frames, pictures drawn, position updates) a second in the page over ``seconds``,
+    and the CPU time of Chromium (ms a second, all its processes): the page draws a picture
+    in a frame when something changed (positions, camera, hand)."""
     *counts0, t0 = page.evaluate(COUNTS)
+    cpu0 = browser_cpu()
     time.sleep(seconds)
     *counts1, t1 = page.evaluate(COUNTS)
-    return (np.array(counts1) - counts0) / ((t1 - t0) / 1000)
+    cpu = browser_cpu() - cpu0
+    elapsed = (t1 - t0) / 1000
+    return np.array([*((np.array(counts1) - counts0) / elapsed), 1000 * cpu / elapsed])
 
 
 def empty_page_rate(browser, seconds: float = 3.0) -> float:
@@ -153,7 +173,7 @@ def main() -> None:
                 run_notebook(page, url, token, f"{key}.ipynb")
                 page.wait_for_function("() => window.msdlabViews?.at(-1)?.stats.updates > 20")
                 time.sleep(2)
-                fps, drawn_rate, updates = page_rate(page, args.seconds)
+                fps, drawn_rate, updates, cpu = page_rate(page, args.seconds)
                 drawn, engine = drag_delays(page) if key == "mesh" else ([], [])
                 page.screenshot(path=f"/tmp/live_view_{key}.png")
                 page.close()
@@ -162,7 +182,8 @@ def main() -> None:
                 rows.append((label, fps, updates, drawn, engine, agg))
                 print(
                     f"{label}: page {fps:.1f} fps ({fps / ceiling:.0%} of an empty page's "
-                    f"{ceiling:.1f}), {drawn_rate:.1f} pictures/s, {updates:.1f} updates/s; "
+                    f"{ceiling:.1f}), {drawn_rate:.1f} pictures/s, {updates:.1f} updates/s, "
+                    f"Chromium's CPU {cpu:.0f} ms/s; "
                     f"matplotlib on Agg {1000 * agg:.0f} ms/frame = {1 / agg:.1f} fps; "
                     f"load {load:.1f}",
                     flush=True,
