@@ -474,8 +474,8 @@ export function mountView(el, scene, arrays, source) {
       if (positions !== last) {
         stats.updates++;
         checkDelay(stats, positions, scene.dim);
-        letGo(view, positions, scene.dim);
       }
+      letGo(view, positions, scene.dim);
       // Grab pins the held particle to the hand at the engine's next step: draw it there
       // now, not a round trip through the kernel later (only while the engine steps)
       const hand = source.stepping?.() ? view.hand : null;
