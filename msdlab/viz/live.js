@@ -196,6 +196,28 @@ class Painter {
     this.dense = rest.length > DENSE;
     if (this.dense) this.pixels = new Pixels(canvas, scene.colours);
     this.shown = surface(springs, this.n, scene.dim === 3 && rest.length > SURFACE_ONLY);
+    this.next = new Uint32Array(LEVELS);
+    // the walls' and floor's segments: their ends, and where they are on the screen
+    this.ends = Float32Array.from(scene.world.edges.flat(2));
+    this.endsScreen = new Float32Array((2 * this.ends.length) / scene.dim);
+    this.endsDepth = new Float32Array(this.ends.length / scene.dim);
+  }
+
+  /** The walls' and floor's segments on the screen: [x0, y0, x1, y1] per segment. */
+  projectWorld(camera) {
+    const { ends, endsScreen, endsDepth } = this;
+    camera.project(ends, endsDepth.length, endsScreen, endsDepth);
+    return endsScreen;
+  }
+
+  /** The positions to draw: ``positions`` with particle ``hand.particle`` at ``hand.target``
+   * (into a buffer reused from frame to frame). */
+  place(positions, hand) {
+    if (this.placed?.length !== positions.length) this.placed = new Float32Array(positions.length);
+    this.placed.set(positions);
+    const d = this.scene.dim;
+    for (let k = 0; k < d; k++) this.placed[d * hand.particle + k] = hand.target[k];
+    return this.placed;
   }
 
   draw(camera, positions, held) {
@@ -220,10 +242,9 @@ class Painter {
     const { springs, rest, screen, pixels } = this;
     const d = this.scene.dim, limit = this.scene.strain_limit;
     pixels.clear();
-    for (const [from, to] of this.scene.world.edges) {
-      const px = new Float32Array(4);
-      camera.project(new Float32Array([...from, ...to]), 2, px, new Float32Array(2));
-      pixels.line(px[0], px[1], px[2], px[3], pixels.dark);
+    const ends = this.projectWorld(camera);
+    for (let i = 0; i < ends.length; i += 4) {
+      pixels.line(ends[i], ends[i + 1], ends[i + 2], ends[i + 3], pixels.dark);
     }
     const { springs: shown, particles } = this.shown;
     for (let s = 0; s < shown.length; s++) {
@@ -263,7 +284,8 @@ class Painter {
       counts[levels[e] + 1]++;
     }
     for (let l = 1; l <= LEVELS; l++) counts[l] += counts[l - 1];
-    const next = counts.slice(0, LEVELS);
+    const next = this.next;
+    next.set(counts.subarray(0, LEVELS));
     for (let e = 0; e < rest.length; e++) order[next[levels[e]]++] = e;
   }
 
@@ -310,18 +332,15 @@ class Painter {
 
   /** The scene's walls (a box) and floor (a grid on its plane). */
   drawWorld(g, camera) {
-    const world = this.scene.world;
+    const ends = this.projectWorld(camera);
     g.strokeStyle = "#4d4d4d";
     g.lineWidth = 2;
-    for (const [from, to] of world.edges) {
-      const ends = new Float32Array([...from, ...to]);
-      const px = new Float32Array(4), depth = new Float32Array(2);
-      camera.project(ends, 2, px, depth);
-      g.beginPath();
-      g.moveTo(px[0], px[1]);
-      g.lineTo(px[2], px[3]);
-      g.stroke();
+    g.beginPath();
+    for (let i = 0; i < ends.length; i += 4) {
+      g.moveTo(ends[i], ends[i + 1]);
+      g.lineTo(ends[i + 2], ends[i + 3]);
     }
+    g.stroke();
   }
 }
 
@@ -353,6 +372,14 @@ class EnergyPanel {
     this.history.push([energy.time, sum, energy.kinetic + energy.elastic + energy.gravitational
       + (energy.other || 0)]);
     if (this.history.length > HISTORY) this.history.shift();
+    this.stale = true;
+  }
+
+  /** Draw the bars and the plot if new energies came since the last frame: redrawing the
+   * same picture would cost the page a canvas upload every frame for nothing. */
+  drawIfNew() {
+    if (this.stale !== false) this.draw();
+    this.stale = false;
   }
 
   draw() {
@@ -402,10 +429,20 @@ class EnergyPanel {
 }
 
 /** What a view counted (for benchmarks and tests): frames (requestAnimationFrame calls),
- * frames drawn with positions, new positions received (updates), and delays (ms) from a mouse move to the held particle
- * arriving where it was sent. Each view is listed in `window.msdlabViews`. */
+ * pictures drawn (frames in which something changed), new positions received (updates),
+ * and the delays (ms) from a mouse move to the frame drawing the held particle at the hand
+ * (`drawDelays`) and to the first positions from the engine with it there (`engineDelays`).
+ * Each view is listed in `window.msdlabViews`. */
 function newStats() {
-  return { frames: 0, drawn: 0, updates: 0, delays: [], pending: null };
+  return { frames: 0, drawn: 0, updates: 0, drawDelays: [], engineDelays: [],
+    moved: null, pending: null };
+}
+
+/** Whether particle `p` of `x` (dimension `d`) is at `target`, to float32's precision. */
+function isAt(x, p, target, d) {
+  let miss = 0;
+  for (let k = 0; k < d; k++) miss = Math.max(miss, Math.abs(x[d * p + k] - target[k]));
+  return miss <= 1e-3 * (1 + Math.abs(target[0]));
 }
 
 /** A body view: canvas, camera, mouse and the drawing loop. `source` hands it
@@ -423,24 +460,37 @@ export function mountView(el, scene, arrays, source) {
   const camera = new Camera(scene, canvas.width, canvas.height);
   const painter = new Painter(canvas, scene, arrays.springs, arrays.rest, arrays.fixed);
   const stats = newStats();
-  const view = { root, canvas, status, energy, camera, painter, stats, held: null, alive: true };
+  // `hand`: the held particle and where the hand put it (world coordinates)
+  const view = { root, canvas, status, energy, camera, painter, stats, held: null, hand: null,
+    alive: true };
   window.msdlabViews = window.msdlabViews || [];
   window.msdlabViews.push(view);
   mouse(view, painter, source);
-  let last = null;
+  let last = null, shown = [];
   const frame = () => {
     if (!view.alive) return;
     const positions = source.latest();
     if (positions) {
-      painter.draw(camera, positions, view.held);
-      stats.drawn++;
       if (positions !== last) {
         stats.updates++;
         checkDelay(stats, positions, scene.dim);
       }
+      letGo(view, positions, scene.dim);
+      // Grab pins the held particle to the hand at the engine's next step: draw it there
+      // now, not a round trip through the kernel later (only while the engine steps)
+      const hand = source.stepping?.() ? view.hand : null;
+      // drawn again only if something changed: the same picture would cost a canvas upload
+      const now = [positions, hand, view.held, camera.azimuth, camera.elevation, camera.zoom];
+      if (now.some((value, i) => value !== shown[i])) {
+        painter.draw(camera, hand ? painter.place(positions, hand) : positions, view.held);
+        stats.drawn++;
+        if (hand && stats.moved !== null) stats.drawDelays.push(performance.now() - stats.moved);
+        shown = now;
+      }
+      stats.moved = null;
       last = positions;
     }
-    if (energy) energy.draw();
+    if (energy) energy.drawIfNew();
     stats.frames++;
     requestAnimationFrame(frame);
   };
@@ -448,25 +498,39 @@ export function mountView(el, scene, arrays, source) {
   return view;
 }
 
-/** Time from a mouse move to the first frame with the held particle where it was sent. */
+/** Time from a mouse move to the first engine positions with the held particle where it
+ * was sent. */
 function checkDelay(stats, x, d) {
   if (!stats.pending) return;
   const [time, particle, target] = stats.pending;
-  let miss = 0;
-  for (let k = 0; k < d; k++) miss = Math.max(miss, Math.abs(x[d * particle + k] - target[k]));
-  if (miss <= 1e-3 * (1 + Math.abs(target[0]))) {
-    stats.delays.push(performance.now() - time);
+  if (isAt(x, particle, target, d)) {
+    stats.engineDelays.push(performance.now() - time);
     stats.pending = null;
   }
+}
+
+/** After a release, the page draws the particle at the hand until the engine has it there
+ * too (or for a second at most), so it does not jump back to a position a round trip old. */
+function letGo(view, x, d) {
+  const hand = view.hand;
+  if (hand?.released && (isAt(x, hand.particle, hand.target, d)
+      || performance.now() - hand.released > 1000)) view.hand = null;
 }
 
 function mouse(view, painter, source) {
   const { canvas, camera, stats } = view;
   let turning = null, depth = 0;
-  const at = (event) => {
+  const at = (event) => { // the canvas's pixel under the mouse (inside its border)
     const box = canvas.getBoundingClientRect();
-    return [(event.clientX - box.left) * (canvas.width / box.width),
-      (event.clientY - box.top) * (canvas.height / box.height)];
+    return [(event.clientX - box.left - canvas.clientLeft) * (canvas.width / canvas.clientWidth),
+      (event.clientY - box.top - canvas.clientTop) * (canvas.height / canvas.clientHeight)];
+  };
+  /** The hand at `target` (world) now: drawn at the next frame, sent to the engine. */
+  const hold = (particle, target, event) => {
+    const time = Math.min(event.timeStamp, performance.now()); // when the event was made
+    view.hand = { particle, target, released: null };
+    stats.moved = time;
+    stats.pending = [time, particle, target];
   };
   canvas.addEventListener("contextmenu", (event) => event.preventDefault());
   canvas.addEventListener("mousedown", (event) => {
@@ -476,18 +540,17 @@ function mouse(view, painter, source) {
       turning = camera.dim === 3 ? [px, py, camera.azimuth, camera.elevation] : null;
       return;
     }
+    // in 3-D the hand moves on the plane facing the camera through the particle
     view.held = nearest;
     depth = painter.depth[nearest];
-    const target = camera.unproject(px, py, depth);
-    stats.pending = [performance.now(), nearest, target];
-    source.grab(nearest, target);
+    hold(nearest, camera.unproject(px, py, depth), event);
+    source.grab(nearest, view.hand.target);
   });
   window.addEventListener("mousemove", (event) => {
     const [px, py] = at(event);
     if (view.held !== null) {
-      const target = camera.unproject(px, py, depth);
-      stats.pending = [performance.now(), view.held, target];
-      source.move(target);
+      hold(view.held, camera.unproject(px, py, depth), event);
+      source.move(view.hand.target);
     } else if (turning) {
       camera.azimuth = turning[2] - (px - turning[0]) * 0.01;
       const elevation = turning[3] + (py - turning[1]) * 0.01;
@@ -496,6 +559,7 @@ function mouse(view, painter, source) {
   });
   window.addEventListener("mouseup", () => {
     if (view.held !== null) source.release();
+    if (view.hand) view.hand.released = performance.now();
     view.held = null;
     turning = null;
   });
@@ -554,6 +618,7 @@ function render({ model, el }) {
     grab: (particle, target) => send({ type: "grab", particle, target }),
     move: (target) => send({ type: "move", target }),
     release: () => send({ type: "release" }),
+    stepping: () => model.get("running") && !model.get("error"),
   };
   const view = mountView(el, scene, arrays, source);
   const onPositions = () => (positions = typed(model.get("positions"), Float32Array));

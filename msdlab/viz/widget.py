@@ -117,6 +117,7 @@ class LiveView(anywidget.AnyWidget):
         self._thread: threading.Thread | None = None
         self._values: dict[str, float] = {}
         self._frames = 0
+        self._moved = False  # the hand moved since the last frame
         self.attach(sim)
         self.on_msg(self._on_message)
 
@@ -172,11 +173,15 @@ class LiveView(anywidget.AnyWidget):
                 self.energy = energies(sim, self._taken, self._level)
                 self.status = f"t = {sim.time:.4g}   steps {sim.step_count}"
 
-    def advance(self, seconds: float, budget: float = BUDGET) -> int:
+    def advance(self, seconds: float, budget: float = BUDGET, early: bool = False) -> int:
         """Step for ``seconds`` of wall-clock time at the pace (at most ``budget`` s of
         stepping: a slow engine runs slower than real time rather than falling behind);
-        stop with the diagnosis on a blow-up. The number of steps done."""
+        stop with the diagnosis on a blow-up. ``early``: a step now even if none is due yet
+        (the hand moved: `Grab` pins the particle at the next step), one step ahead of the
+        pace at most, taken from the steps owed later. The number of steps done."""
         self._owed += seconds * self.steps_per_second * self.speed
+        lent = 1.0 if early and 0.0 <= self._owed < 1.0 else 0.0
+        self._owed += lent
         done, start = 0, time.perf_counter()
         try:
             while self._owed >= 1.0 and time.perf_counter() - start < budget:
@@ -185,7 +190,7 @@ class LiveView(anywidget.AnyWidget):
                 done += 1
         except SimulationDiverged as error:
             self.running, self.error = False, str(error)
-        self._owed = min(self._owed, 1.0)  # what was not done in time is dropped
+        self._owed = min(self._owed, 1.0) - lent  # what was not done in time is dropped
         return done
 
     def do_pending(self) -> None:
@@ -201,9 +206,10 @@ class LiveView(anywidget.AnyWidget):
         """One round of the stepping thread: the page's requests, steps, a frame sent."""
         now = time.perf_counter()
         elapsed, self._clock = now - self._clock, now
+        self._moved = False
         self.do_pending()
         if self.running and not self.error:
-            self.advance(elapsed)
+            self.advance(elapsed, early=self._moved)
         self._frames += 1
         self.publish(energy=self._frames % ENERGY_EVERY == 0 or not self.running)
 
@@ -211,8 +217,8 @@ class LiveView(anywidget.AnyWidget):
     def _on_message(self, _widget: object, content: dict, buffers: list) -> None:
         """A request from the page, queued for the stepping thread (or done now if none)."""
         handlers = {
-            "grab": lambda: self.grab.hold(self.sim.body, content["particle"], content["target"]),
-            "move": lambda: self.grab.particle is not None and self.grab.move(content["target"]),
+            "grab": lambda: self._hold(content["particle"], content["target"]),
+            "move": lambda: self._hold(self.grab.particle, content["target"]),
             "release": lambda: self.grab.release(),
             "step": self.step_once,
             "reset": self.reset,
@@ -224,6 +230,16 @@ class LiveView(anywidget.AnyWidget):
             if self._thread is None:
                 self.do_pending()
             self._wake.set()  # a frame now: the hand should not wait for the next one
+
+    def _hold(self, particle: int | None, target: list[float]) -> None:
+        """The hand at ``target`` holding ``particle`` (none: the move of a hand let go)."""
+        if particle is None:
+            return
+        if particle != self.grab.particle:
+            self.grab.hold(self.sim.body, particle, target)
+        else:
+            self.grab.move(target)
+        self._moved = True
 
     def step_once(self) -> None:
         """One step, paused or not."""

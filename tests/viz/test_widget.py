@@ -44,6 +44,17 @@ def test_the_pace_is_the_scenes_and_the_speed_scales_it():
     assert physical.advance(0.1, budget=60) == 10  # real time: 1/dt steps a second
 
 
+def test_a_hands_move_is_stepped_at_once_and_the_pace_kept():
+    view = LiveView(gallery.mesh(), steps_per_second=60)
+    view.advance(0.5 / 60)  # half a step owed
+    ask(view, type="grab", particle=0, target=[0.0, 0.0])
+    assert view._moved
+    assert view.advance(0.0, early=True) == 1  # the step the hand waits for, now
+    assert view.advance(0.0, early=True) == 0  # one step ahead of the pace at most
+    assert view.advance(0.5 / 60) == 0  # the step taken early is not done again
+    assert view.advance(1 / 60) == 1
+
+
 def test_grab_move_release_keeps_the_hands_velocity():
     sim = gallery.mesh(gravity=0.0)
     view = LiveView(sim, steps_per_second=60)

@@ -95,6 +95,18 @@ def screen_of(page) -> np.ndarray:
     return np.array(screen).reshape(-1, 2) + (box["x"] + 1, box["y"] + 1)  # 1 px border
 
 
+def engine_screen(page, position: list[float]) -> np.ndarray:
+    """Page coordinates (px) of the engine's ``position`` through the widget's camera."""
+    box = page.locator(".msdlab-canvas").bounding_box()
+    screen = page.evaluate(
+        """(x) => { const out = new Float32Array(2), depth = new Float32Array(1);
+        window.msdlabViews.at(-1).camera.project(Float32Array.from(x), 1, out, depth);
+        return Array.from(out); }""",
+        position,
+    )
+    return np.array(screen) + (box["x"] + 1, box["y"] + 1)
+
+
 def test_the_widget_draws_drags_sets_and_adds_up(page_with_widget):
     page, state = page_with_widget
     # it draws: frames counted by requestAnimationFrame, with positions from the engine
@@ -116,11 +128,11 @@ def test_the_widget_draws_drags_sets_and_adds_up(page_with_widget):
         page.mouse.move(*(press + fraction * (release - press)))
         time.sleep(0.05)
 
-    def arrived():
+    def arrived():  # in the engine, not only on the page (which draws it at the hand)
         s = state()
         if not s or s["held"] != particle:
             return None
-        return np.abs(screen_of(page)[particle] - release).max() <= 2.0
+        return np.abs(engine_screen(page, s["positions"][particle]) - release).max() <= 2.0
 
     wait_until(arrived, 20, "the held particle reaching the mouse")
     page.mouse.up()
