@@ -11,9 +11,7 @@ a plain function of numbers ``update(x, v, a, dt, *coefficients) -> (x_new, v_ne
 (like `verlet_update`) and step with ``dynamics.advance(update, x, v, dt, *coefficients)``.
 On whole arrays that is ``update(x, v, dynamics.acceleration(x, v), dt, ...)``;
 the numba kernel compiles the same function into one loop with a = F/m, for
-any integrator, the engine's or a user's. Return what ``advance`` returns as it
-is: in a `Simulation` that loop has also pinned the fixed particles and done
-the rest of the step's end (`kernels.StepEnd`). A scheme that takes energy out
+any integrator, the engine's or a user's. A scheme that takes energy out
 on purpose by scaling the velocity (Verlet's λ) states its `velocity_factor`,
 and the ledger books that work.
 """

@@ -56,6 +56,10 @@ class Ground(Constraint):
             raise ValueError(f"ground friction is a fraction in [0, 1], got {friction}")
         self.friction = float(friction)
 
+    def normal_of(self, body: Body) -> np.ndarray:
+        """The floor's unit normal (d,) for ``body``: ``normal``, or +y by default."""
+        return np.array(_UP[body.dim], dtype=float) if self.normal is None else self.normal
+
     def check(self, body: Body) -> None:
         if self.normal is not None and len(self.normal) != body.dim:
             raise ValueError(

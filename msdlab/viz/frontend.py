@@ -81,7 +81,7 @@ def world_of(sim: Simulation, low: np.ndarray, high: np.ndarray) -> list:
             upper = np.where(np.isfinite(item.upper), item.upper, high)
             edges += box_edges(lower, upper)
         elif isinstance(item, Ground):
-            edges += floor_edges(item._normal(sim.body), item.height, low, high)
+            edges += floor_edges(item.normal_of(sim.body), item.height, low, high)
     return edges
 
 

@@ -349,6 +349,7 @@ class EnergyPanel {
   constructor(parent, unit) {
     this.canvas = element("canvas", { width: 260, height: 480 }, parent);
     this.canvas.className = "msdlab-energy";
+    this.canvas.style.maxWidth = "100%";
     this.unit = unit;
     this.history = [];
     this.bars = {};
@@ -449,12 +450,12 @@ function isAt(x, p, target, d) {
  * positions (`latest()`) and takes the user's grabs (`grab/move/release`). */
 export function mountView(el, scene, arrays, source) {
   const root = element("div", { className: "msdlab-live" }, el);
-  root.style.cssText = "font: 12px sans-serif; display: inline-block";
-  const row = element("div", {}, root);
-  row.style.display = "flex";
+  root.style.cssText = "font: 12px sans-serif; max-width: 100%";
+  const row = element("div", {}, root);  // the energy panel wraps below a narrow view
+  row.style.cssText = "display: flex; flex-wrap: wrap; align-items: flex-start; gap: 6px";
   const canvas = element("canvas", { width: scene.width, height: scene.height }, row);
   canvas.className = "msdlab-canvas";
-  canvas.style.cssText = "cursor: crosshair; border: 1px solid #ccc";
+  canvas.style.cssText = "cursor: crosshair; border: 1px solid #ccc; max-width: 100%; height: auto";
   const energy = scene.energy ? new EnergyPanel(row, scene.energy_unit) : null;
   const status = element("div", { className: "msdlab-status" }, root);
   const camera = new Camera(scene, canvas.width, canvas.height);

@@ -37,7 +37,7 @@ def up_of(sim: Simulation) -> str:
             return axis_of(force.g)
     for constraint in sim.constraints:
         if isinstance(constraint, Ground):
-            return axis_of(constraint._normal(sim.body))
+            return axis_of(constraint.normal_of(sim.body))
     return default_up(sim.body.dim)
 
 

@@ -44,7 +44,7 @@ def ground_level(sim: Simulation, up: int) -> float:
     the floor's, or the walls' bottom, else the lowest particle's now."""
     for item in sim.constraints:
         if isinstance(item, Ground):
-            return item.height / item._normal(sim.body)[up]
+            return item.height / item.normal_of(sim.body)[up]
         if isinstance(item, Walls) and np.isfinite(item.lower[up]):
             return float(item.lower[up])
     return float(sim.body.positions[:, up].min())
