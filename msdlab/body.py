@@ -10,7 +10,7 @@ from typing import Any, Generic, TypeVar
 import numpy as np
 
 from .errors import as_vectors, check_non_negative, check_positive
-from .lattice import grid_pair_blocks, grid_pair_count, grid_positions, neighbour_offsets
+from .lattice import GridSprings, grid_pair_blocks, grid_positions, neighbour_offsets
 from .particle import Particle
 from .spring import Spring
 from .tracked import TrackedArray
@@ -51,12 +51,13 @@ def _pin(body: Body, fixed: object, count: int) -> np.ndarray:
 class _Rows:
     """A body array as an attribute: a view of the used rows of a buffer that grows.
 
-    Reading ``body.<name>`` finds the view in the body's ``__dict__`` (this
-    descriptor has no ``__get__``), where `Body` puts it whenever the rows
-    change: the view is valid until the body grows. Assigning the whole array
-    goes through ``check(body, value, rows)``; without a check the array is
-    read-only. Spring values are `TrackedArray` views, so writes to them
-    count in ``body.parameters_version``.
+    Reading ``body.<name>`` finds the view in the body's ``__dict__``, where
+    `Body` puts it whenever the rows change: the view is valid until the body
+    grows. Only the spring arrays of a grid body that keeps its springs per
+    offset (`Body.grid_springs`) are missing there; reading one lays them out
+    first. Assigning the whole array goes through ``check(body, value, rows)``;
+    without a check the array is read-only. Spring values are `TrackedArray`
+    views, so writes to them count in ``body.parameters_version``.
     """
 
     def __init__(self, doc: str, check: Callable[[Body, Any, int], Any] | None = None) -> None:
@@ -65,6 +66,12 @@ class _Rows:
     def __set_name__(self, owner: type, name: str) -> None:
         self.name = name
         self.kind = "particles" if name in FIELDS["particles"] else "springs"
+
+    def __get__(self, body: Body | None, owner: type | None = None) -> Any:
+        if body is None:
+            return self
+        body.lay_out_springs()
+        return body.__dict__[self.name]
 
     def view(self, body: Body) -> np.ndarray:
         """The used rows of the body's buffer, as the attribute shows them."""
@@ -75,10 +82,11 @@ class _Rows:
             return TrackedArray.of(view, body._spring_values_edited)
         return view
 
-    def __set__(self, body: Body, value: object) -> None:
+    def assign(self, body: Body, value: object) -> None:
+        """``body.<name> = value``: check the whole array and write it into the rows."""
         if self.check is None:
             raise AttributeError(f"body.{self.name} is read-only; add springs to change it")
-        rows = body.__dict__[self.name]
+        rows = getattr(body, self.name)
         rows[...] = self.check(body, value, len(rows))
 
 
@@ -118,9 +126,10 @@ class Body:
         lambda body, c, n: _per_row("damping", c, n, "Use a dashpot coefficient c >= 0 (N·s/m)."),
     )
 
-    spring_values: tuple[np.ndarray, np.ndarray, np.ndarray]
-    """Stiffness (N/m), rest lengths (m) and dashpots (N·s/m) (E,) as plain arrays to read.
-    Write through `stiffness`, `rest_lengths` and `spring_damping`, which count edits."""
+    spring_values = _Rows(
+        "Stiffness (N/m), rest lengths (m) and dashpots (N·s/m) (E,) as plain arrays to read. "
+        "Write through `stiffness`, `rest_lengths` and `spring_damping`, which count edits."
+    )
 
     def __init__(self, dim: int | None = None) -> None:
         if dim not in (None, 2, 3):
@@ -129,6 +138,7 @@ class Body:
         self.grid_shape: tuple[int, ...] | None = None
         self.topology_version = 0  # grows whenever particles or springs are added
         self.parameters_version = 0  # grows whenever the spring values are edited
+        self.grid_springs: GridSprings | None = None  # `Body.grid`'s springs, until laid out
         self._size = {"particles": 0, "springs": 0}
         self._buffers: dict[str, np.ndarray] = {}
         self._capacity = {"particles": 0, "springs": 0}
@@ -146,6 +156,14 @@ class Body:
 
     def __len__(self) -> int:
         return self.n_particles
+
+    def __setattr__(self, name: str, value: object) -> None:
+        """``body.masses = 2.0`` (a whole array) is checked and written into its rows."""
+        rows = getattr(type(self), name, None)
+        if isinstance(rows, _Rows):
+            rows.assign(self, value)
+        else:
+            super().__setattr__(name, value)
 
     def _spring_values_edited(self) -> None:
         """Count an in-place write to the spring values (see `tracked.TrackedArray`)."""
@@ -271,6 +289,14 @@ class Body:
         )
 
     def _append(self, kind: str, count: int, **columns: object) -> np.ndarray:
+        """Add ``count`` rows of ``kind`` holding ``columns``; return their indices."""
+        if kind == "springs":
+            self.lay_out_springs()
+        indices = self._write(kind, count, **columns)
+        self.topology_version += 1
+        return indices
+
+    def _write(self, kind: str, count: int, **columns: object) -> np.ndarray:
         """Write ``columns`` into the next ``count`` rows of ``kind``; return their indices."""
         start = self._size[kind]
         if start + count > self._capacity[kind]:
@@ -278,17 +304,47 @@ class Body:
         for name, values in columns.items():
             self._buffers[name][start : start + count] = values
         self._size[kind] += count
-        self.topology_version += 1
         self._show(kind)
         return np.arange(start, start + count)
 
+    def lay_out_springs(self) -> None:
+        """Write the springs of `grid_springs` into per-spring arrays (a no-op without).
+
+        Reading any spring array does this first; the springs keep their order
+        and values, so nothing changes for the kernels (no version grows).
+        """
+        grid = self.grid_springs
+        if grid is None:
+            return
+        self.grid_springs = None
+        self._size["springs"] = 0
+        self._reserve("springs", grid.count)  # exactly: no regrowth
+        values = {"stiffness": grid.stiffness, "spring_damping": grid.damping}
+        for rest, pairs in zip(grid.rest_lengths, grid_pair_blocks(grid.shape, grid.offsets)):
+            ends = {"spring_a": pairs[:, 0], "spring_b": pairs[:, 1]}
+            self._write("springs", len(pairs), rest_lengths=rest, **ends, **values)
+
+    def _keep_grid_springs(self, grid: GridSprings) -> None:
+        """Use ``grid``'s springs, kept per offset, as the body's (it has none yet)."""
+        self.grid_springs = grid
+        self._size["springs"] = grid.count
+        self.topology_version += 1
+        self._show("springs")
+
     def _show(self, kind: str) -> None:
-        """Put the views of the used rows of ``kind`` (see `_Rows`) in the body's attributes."""
+        """Put the views of the used rows of ``kind`` (see `_Rows`) in the body's attributes;
+        a grid's springs kept per offset have none until they are laid out."""
+        if kind == "springs" and self.grid_springs is not None:
+            for name in (*FIELDS[kind], "spring_values"):
+                self.__dict__.pop(name, None)
+            return
         for name in FIELDS[kind]:
             self.__dict__[name] = getattr(Body, name).view(self)
         if kind == "springs":  # the same rows as plain arrays, for kernels to read
             used = self._size[kind]
-            self.spring_values = tuple(self._buffers[name][:used] for name in _SPRING_VALUES)
+            self.__dict__["spring_values"] = tuple(
+                self._buffers[name][:used] for name in _SPRING_VALUES
+            )
 
     def __getstate__(self) -> dict[str, Any]:
         """The body without its views (they would be pickled as copies, not views)."""
@@ -301,7 +357,7 @@ class Body:
 
     def _reserve(self, kind: str, capacity: int) -> None:
         """Grow the buffers of ``kind`` to hold ``capacity`` rows (their used rows kept)."""
-        used = self._size[kind]
+        used = self._size[kind] if kind == "particles" or self.grid_springs is None else 0
         for name, dtype in FIELDS[kind].items():
             columns = (self.dim or 3,) if name in ("positions", "velocities") else ()
             grown = np.empty((capacity, *columns), dtype)  # rows past `used` are never read
@@ -346,6 +402,7 @@ class Body:
         ``neighbours`` are squared distances in grid units: 1 makes axis springs
         (rest length = spacing), 2 face diagonals (√2·spacing), 3 body diagonals
         (√3·spacing). The grid is at rest: every spring starts at its rest length.
+        The springs are kept per offset (`grid_springs`) until a spring array is read.
         """
         shape = tuple(operator.index(n) for n in shape)
         if len(shape) not in (2, 3) or min(shape) < 1:
@@ -358,11 +415,8 @@ class Body:
         body = cls()
         body.add_particles(grid_positions(shape, spacing, origin), masses=mass)
         k, c = Body.stiffness.check(body, stiffness, 1), Body.spring_damping.check(body, damping, 1)
-        body._reserve("springs", grid_pair_count(shape, offsets))  # exactly: no regrowth
-        for offset, pairs in zip(offsets, grid_pair_blocks(shape, offsets)):  # valid by design
-            rest = spacing * math.sqrt(offset @ offset)
-            columns = {"spring_a": pairs[:, 0], "spring_b": pairs[:, 1], "rest_lengths": rest}
-            body._append("springs", len(pairs), stiffness=k, spring_damping=c, **columns)
+        rest = spacing * np.sqrt((offsets**2).sum(axis=1))
+        body._keep_grid_springs(GridSprings(shape, offsets, rest, float(k), float(c)))
         body.grid_shape = shape
         return body
 
@@ -370,8 +424,13 @@ class Body:
     def copy(self) -> Body:
         """An independent copy of the body (state and springs)."""
         body = Body(self.dim)
-        for kind, names in FIELDS.items():
-            body._append(kind, self._size[kind], **{name: getattr(self, name) for name in names})
+        particles = {name: getattr(self, name) for name in FIELDS["particles"]}
+        body._append("particles", self.n_particles, **particles)
+        if self.grid_springs is None:
+            springs = {name: getattr(self, name) for name in FIELDS["springs"]}
+            body._append("springs", self.n_springs, **springs)
+        else:
+            body._keep_grid_springs(self.grid_springs)
         body.grid_shape = self.grid_shape
         return body
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -76,3 +77,31 @@ def grid_pairs(shape: Sequence[int], offsets: np.ndarray) -> tuple[np.ndarray, n
     blocks = list(grid_pair_blocks(shape, offsets))
     kinds = np.repeat(np.arange(len(blocks)), [len(block) for block in blocks])
     return np.concatenate(blocks or [np.zeros((0, 2), np.int64)]), kinds.astype(np.int64)
+
+
+@dataclass(frozen=True)
+class GridSprings:
+    """The springs of a grid stored per neighbour offset, with no per-spring arrays.
+
+    Offset m joins every particle to the one at its grid coordinates plus
+    ``offsets[m]`` (M, d), by springs of rest length ``rest_lengths[m]`` (m),
+    ``stiffness`` k (N/m) and dashpot ``damping`` c (N·s/m), in the order of
+    `grid_pair_blocks`: `Body.grid` keeps its springs this way until their arrays
+    are first read.
+    """
+
+    shape: tuple[int, ...]
+    offsets: np.ndarray
+    rest_lengths: np.ndarray
+    stiffness: float
+    damping: float
+
+    @property
+    def count(self) -> int:
+        """Number of springs, Σ over offsets of Π max(0, n - |o|)."""
+        return grid_pair_count(self.shape, self.offsets)
+
+    def values(self) -> np.ndarray:
+        """Stiffness (N/m), rest length (m) and dashpot (N·s/m) of each offset (3, M)."""
+        uniform = np.ones(len(self.offsets))
+        return np.stack([self.stiffness * uniform, self.rest_lengths, self.damping * uniform])

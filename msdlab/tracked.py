@@ -59,7 +59,8 @@ class TrackedArray(np.ndarray):
         return tracked
 
     def __array_finalize__(self, parent: Any) -> None:
-        self.on_write = getattr(parent, "on_write", None)
+        """Views of a tracked array are tracked; copies (``copy``, ``flatten``) are not."""
+        self.on_write = getattr(parent, "on_write", None) if self.base is not None else None
 
     def _written(self) -> None:
         if self.on_write is not None:

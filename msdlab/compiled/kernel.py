@@ -25,6 +25,7 @@ from .edges import (
     spring_forces_serial,
 )
 from .gather import gather_parallel, gather_serial
+from .grid_sums import grid_sum_parallel, grid_sum_serial
 from .reductions import damping_work, finite
 from .stencil import (
     GridStencil,
@@ -135,7 +136,7 @@ class NumbaKernel:
             stencil = self._stencil if self._uniform else None
             if stencil is not None:
                 self._threads = numba.get_num_threads()
-                threads = len(body.spring_a) >= PARALLEL_MIN_GATHERED and self._threads > 1
+                threads = body.n_springs >= PARALLEL_MIN_GATHERED and self._threads > 1
                 gather = gather_parallel if threads else gather_serial
                 if self._scratch.shape != (10, len(x) + 2 * self._pad):
                     self._scratch = np.zeros((10, len(x) + 2 * self._pad))  # 2-D: x2 = v2 = 0
@@ -186,8 +187,11 @@ class NumbaKernel:
         if self._stencil is None:
             return None
         if body.parameters_version != self._values_version:
-            values = body.spring_values
-            self._uniform = uniform_blocks(*values, self._stencil.starts, self._stencil_values)
+            if body.grid_springs is not None:  # one value per offset by construction
+                self._stencil_values[...], self._uniform = body.grid_springs.values(), True
+            else:
+                values, starts = body.spring_values, self._stencil.starts
+                self._uniform = uniform_blocks(*values, starts, self._stencil_values)
             self._values_version = body.parameters_version
             if self._uniform:
                 self._triple_values = triple_values(self._stencil_values, self._triples[1])
@@ -198,10 +202,24 @@ class NumbaKernel:
         ``least`` of them (default `PARALLEL_MIN_SPRINGS`)."""
         self._threads = numba.get_num_threads()
         least = PARALLEL_MIN_SPRINGS if least is None else least
-        return len(body.spring_a) >= least and self._threads > 1
+        return body.n_springs >= least and self._threads > 1
+
+    def _grid_sum(self, body: Body, x: np.ndarray, v: np.ndarray, power: bool) -> float | None:
+        """The springs' energy (J), or with ``power`` their dashpot power (W), summed by offset
+        for a grid that keeps its springs per offset (`grid_sums`); None for other bodies."""
+        stencil = None if body.grid_springs is None else self.grid_stencil(body)
+        if stencil is None:
+            return None
+        grid_sum = grid_sum_parallel if self._parallel(body) else grid_sum_serial
+        return grid_sum(x, v, stencil.shape, stencil.offsets, self._stencil_values, power)
 
     def dashpot_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
         """Power (W) the dashpots take out of the body at (x, v), always >= 0."""
+        if body.grid_springs is not None and body.grid_springs.damping == 0.0:
+            return 0.0
+        power = self._grid_sum(body, x, v, True)
+        if power is not None:
+            return power
         a, b, damping = body.spring_a, body.spring_b, body.spring_values[2]
         if self._damped[0] != (body.topology_version, body.parameters_version):
             self._damped = ((body.topology_version, body.parameters_version), damping.any())
@@ -213,6 +231,9 @@ class NumbaKernel:
 
     def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
         """Energy (J) stored in the springs (or in the given ones) at positions x."""
+        energy = None if springs is not None else self._grid_sum(body, x, x, False)
+        if energy is not None:
+            return energy
         arrays = (body.spring_a, body.spring_b, *body.spring_values[:2])
         if springs is not None:
             return elastic_energy_serial(x, *(array[springs] for array in arrays))

@@ -15,6 +15,7 @@ import numba
 import numpy as np
 
 from ..body import Body
+from ..lattice import grid_pair_count
 
 # Particles a gather block holds (whole grid rows): long inner loops, enough blocks for threads.
 GATHER_BLOCK = 4096
@@ -40,15 +41,23 @@ class GridStencil:
 def grid_stencil(body: Body) -> GridStencil | None:
     """The grid stencil the springs of ``body`` form, or None if they form none.
 
-    Needs ``body.grid_shape`` and springs in blocks of one offset each, every
-    block holding all the pairs of its offset in grid order (checked block by
-    block, not assumed). Whether the spring values are uniform per block is
-    for the caller to check, as they may change at any step.
+    A grid that keeps its springs per offset (`Body.grid_springs`) forms one
+    by construction. Otherwise it needs ``body.grid_shape`` and springs in
+    blocks of one offset each, every block holding all the pairs of its offset
+    in grid order (checked block by block, not assumed). Whether the spring
+    values are uniform per block is for the caller to check, as they may
+    change at any step.
     """
-    shape = body.grid_shape
+    grid = body.grid_springs
+    shape = body.grid_shape if grid is None else grid.shape
     if shape is None or math.prod(shape) != body.n_particles or body.n_springs == 0:
         return None
     padded = (1,) * (3 - len(shape)) + tuple(shape)
+    if grid is not None:
+        offsets = np.zeros((len(grid.offsets), 3), dtype=np.int64)
+        offsets[:, 3 - len(shape) :] = grid.offsets
+        counts = [grid_pair_count(shape, offset[None]) for offset in grid.offsets]
+        return GridStencil(np.array(padded), offsets, np.cumsum([0, *counts]))
     index = np.arange(body.n_particles, dtype=np.int64).reshape(padded)
     a, b = body.spring_a, body.spring_b
     offsets, starts = [], [0]

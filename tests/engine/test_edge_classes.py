@@ -132,6 +132,7 @@ def test_reading_the_values_keeps_the_classes_and_writing_counts() -> None:
         assert_close_to_numpy(body, kernel)
     version = body.parameters_version
     _ = body.stiffness * 2.0, held.sum(), body.spring_values[0][3]
+    _ = np.unique(body.stiffness), np.sort(held), body.rest_lengths.copy().sort()  # copies
     assert body.parameters_version == version
 
 
