@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import ast
 import contextlib
+import dataclasses
 import importlib.util
 import json
 import random
@@ -81,17 +82,24 @@ class Mutant:
     new: str
     source: str
     original: str
+    place: str = ""  # "2nd of 3 on the line" when ``old`` occurs more than once on its line
+
+    @property
+    def change(self) -> str:
+        """``old -> new``, with the `place` of ``old`` if the line holds it more than once."""
+        return f"{self.old} -> {self.new}" + (f" ({self.place})" if self.place else "")
 
     @property
     def label(self) -> str:
-        return f"line {self.line}: {self.old} -> {self.new}"
+        return f"line {self.line}: {self.change}"
 
     def claims(self) -> tuple[str, str]:
-        """How `EQUIVALENT_FILE` names it (no line number): ``function: old -> new``, and
-        ``function: <the line's code>`` for all mutants of its line."""
+        """How `EQUIVALENT_FILE` names it (no line number): ``function: old -> new`` (with
+        its place, e.g. ``(2nd of 3 on the line)``, if ``old`` occurs more than once on the
+        line), and ``function: <the line's code>`` for all mutants of its line."""
         function = definition_at(self.source, self.line)
         line = self.original_line.strip()
-        return f"{function}: {self.old} -> {self.new}", f"{function}: {line}"
+        return f"{function}: {self.change}", f"{function}: {line}"
 
     @property
     def original_line(self) -> str:
@@ -372,7 +380,22 @@ def mutants(source: str, task: int) -> list[Mutant]:
             if key not in found:
                 changed = _replace(source, node, new)
                 found[key] = Mutant(task, node.lineno, old, new, changed, source)
-    return sorted(found.values(), key=lambda m: (m.line, m.old, m.new))
+    # The same text at several places of a line ("0" in (0, 0, 0)) makes mutants with the
+    # same "old -> new": each is told apart by its place, so none hides another's outcome.
+    columns: dict[tuple[int, str], set[int]] = {}
+    for (line, column, _), mutant in found.items():
+        columns.setdefault((line, mutant.old), set()).add(column)
+    for (line, column, new), mutant in found.items():
+        places = sorted(columns[(line, mutant.old)])
+        if len(places) > 1:
+            place = f"{_ordinal(places.index(column) + 1)} of {len(places)} on the line"
+            found[(line, column, new)] = dataclasses.replace(mutant, place=place)
+    return sorted(found.values(), key=lambda m: (m.line, m.old, m.place, m.new))
+
+
+def _ordinal(number: int) -> str:
+    suffix = "th" if 10 <= number % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(number % 10)
+    return f"{number}{suffix or 'th'}"
 
 
 def _replacements(node: ast.AST) -> Iterator[ast.AST]:

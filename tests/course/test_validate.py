@@ -45,6 +45,20 @@ def test_mutants_change_only_the_solution_blocks_one_thing_at_a_time():
         compile(mutant.source, "mutant", "exec")
 
 
+def test_the_same_text_twice_on_a_line_gives_mutants_told_apart():
+    source = "def f(x):\n    ### BEGIN SOLUTION\n    return x[0] - x[0]\n    ### END SOLUTION\n"
+    found = validate.mutants(source, 1)
+    labels = [m.label for m in found]
+    assert len(labels) == len(set(labels))  # one label per mutant: none hides another's outcome
+    assert {
+        "line 3: 0 -> 1 (1st of 2 on the line)",
+        "line 3: 0 -> 1 (2nd of 2 on the line)",
+    } <= set(labels)
+    (second,) = [m for m in found if m.label == "line 3: 0 -> 1 (2nd of 2 on the line)"]
+    assert second.source.splitlines()[2].strip() == "return x[0] - x[1]"
+    assert second.claims()[0] == "f: 0 -> 1 (2nd of 2 on the line)"
+
+
 def test_validate_reports_solution_template_and_kills(capsys):
     reports = validate.validate(PROJECT_ROOT, [5], sample=4, seed=1)
     (report,) = reports
