@@ -28,26 +28,8 @@ print(run.energies.table(rows=5))
 
 # %%
 # The body at the end of the run, each spring coloured by its strain.
-viz.plot_body(
-    sim.body,
-    view=scene.view,
-    up=scene.up,
-    spheres=viz.spheres_of(sim),
-    colour=scene.colour,
-    title=scene.name,
-)
+viz.plot_scene(scene, sim)
 
 # %%
 # The whole run as an animation.
-viz.save_animation(
-    run,
-    "rope.gif",
-    max_frames=30,
-    dpi=50,
-    view=scene.view,
-    up=scene.up,
-    spheres=viz.spheres_of(sim),
-    time_unit=scene.unit,
-    title=scene.name,
-    colour=scene.colour,
-)
+viz.save_scene_animation(scene, sim, run, "rope.gif", max_frames=30, dpi=50)

@@ -119,19 +119,9 @@ def run(args: argparse.Namespace) -> int:
         return 1
     print(trajectory.energies.table(rows=10))
     if args.save is not None:
-        from ..viz import save_animation, spheres_of
+        from ..viz import save_scene_animation
 
-        path = save_animation(
-            trajectory,
-            args.save,
-            max_frames=scene.frames,
-            view=scene.view,
-            up=scene.up,
-            spheres=spheres_of(sim),
-            time_unit=scene.unit,
-            title=scene.name,
-            colour=scene.colour,
-        )
+        path = save_scene_animation(scene, sim, trajectory, args.save)
         print(f"animation written to {path.resolve()}")
     if args.show:
         from ..viz import show
