@@ -357,7 +357,7 @@ class Body:
 
     def _reserve(self, kind: str, capacity: int) -> None:
         """Grow the buffers of ``kind`` to hold ``capacity`` rows (their used rows kept)."""
-        used = self._size[kind] if kind == "particles" or self.grid_springs is None else 0
+        used = self._size[kind]
         for name, dtype in FIELDS[kind].items():
             columns = (self.dim or 3,) if name in ("positions", "velocities") else ()
             grown = np.empty((capacity, *columns), dtype)  # rows past `used` are never read
