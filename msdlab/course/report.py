@@ -212,4 +212,8 @@ def _full_message(check: CheckResult) -> str:
 
 
 def _shorten(text: str, width: int) -> str:
-    return text if len(text) <= width else text[: width - 1] + "…"
+    """``text`` cut to ``width`` characters with "…", keeping a " (hidden)" mark whole."""
+    if len(text) <= width:
+        return text
+    mark = " (hidden)" if text.endswith(" (hidden)") else ""
+    return text[: width - 1 - len(mark)] + "…" + mark

@@ -64,7 +64,7 @@ def test_an_endless_loop_is_stopped_and_named(capsys, tmp_path):
     with (tmp_path / "task1.py").open("a") as handle:
         handle.write("\ndef particle_count(n=N):\n    while True:\n        pass\n")
     assert main(["check", "1", "--impl", str(tmp_path), "--call-timeout", "0.5"]) == 1
-    out = capsys.readouterr().out
+    out = " ".join(capsys.readouterr().out.split())  # as wrapped to any terminal's width
     assert "task1.py: particle_count did not return within 0.5 s (check particle_count)" in out
     assert "total: 8/9 points" in out  # the other checks do not wait for it
 

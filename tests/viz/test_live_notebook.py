@@ -108,12 +108,13 @@ def test_a_dragged_particle_follows_the_mouse_in_jupyterlab(jupyterlab, tmp_path
                 return None
 
             state = wait_until(settled, 40, "the mesh settling in the live view")
-            box = canvas.bounding_box()
             width, height = state["figure"]
-            scale = np.array([box["width"] / width, box["height"] / height])
 
             def on_page(pixel) -> np.ndarray:
-                """Page coordinates (y down) of a figure pixel (y up)."""
+                """Page coordinates (y down) of a figure pixel (y up), where the canvas is now
+                (the notebook's layout may still move it, e.g. when an output appears)."""
+                box = canvas.bounding_box()
+                scale = np.array([box["width"] / width, box["height"] / height])
                 return np.array([box["x"], box["y"] + box["height"]]) + scale * (1, -1) * pixel
 
             pixels = np.array(state["pixels"])
@@ -143,6 +144,7 @@ def test_a_dragged_particle_follows_the_mouse_in_jupyterlab(jupyterlab, tmp_path
                 if not last_held:
                     raise
                 held = last_held[-1]  # the assertions below say where it is
+            on_screen = on_page(np.array(held["pixels"][particle]))
             page.mouse.up()
         except Exception:
             page.screenshot(path=tmp_path / "page.png")
@@ -150,6 +152,5 @@ def test_a_dragged_particle_follows_the_mouse_in_jupyterlab(jupyterlab, tmp_path
         finally:
             browser.close()
     assert held["held"] == particle  # the particle under the mouse was taken
-    on_screen = on_page(np.array(held["pixels"][particle]))
     assert np.linalg.norm(on_screen - press) > 100.0  # it came along
     np.testing.assert_allclose(on_screen, release, atol=3.0)  # and sits under the mouse
