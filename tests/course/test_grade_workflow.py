@@ -332,3 +332,10 @@ def test_array_references_are_read_back_bit_for_bit(tmp_path, monkeypatch):
     first, again = frames(3.0), frames(3.0)
     assert len(calls) == 1 and again.dtype == first.dtype and again.shape == (2, 2)
     assert again.tobytes() == first.tobytes()  # every bit, the sign of -0.0 included
+
+
+def test_a_narrow_table_shortens_names_but_keeps_the_hidden_mark():
+    long_name = "steps_to_floor_for_any_start_height_and_gravity"
+    checks = [CheckResult(f"t::{long_name}", long_name, 1, 2, True, "passed")]
+    row = CheckReport("submission", checks).table(width=80).splitlines()[1]
+    assert "…" in row and row.split("  ")[0].endswith("… (hidden)")
