@@ -145,6 +145,7 @@ class Body:
         self._reserve("particles", 0)
         self._reserve("springs", 0)
         self._incidence: tuple[int, np.ndarray, np.ndarray] | None = None
+        self._new_state: tuple[np.ndarray, ...] = ()  # see `new_state`
 
     @property
     def n_particles(self) -> int:
@@ -323,6 +324,29 @@ class Body:
         for rest, pairs in zip(grid.rest_lengths, grid_pair_blocks(grid.shape, grid.offsets)):
             ends = {"spring_a": pairs[:, 0], "spring_b": pairs[:, 1]}
             self._write("springs", len(pairs), rest_lengths=rest, **ends, **values)
+
+    def new_state(self) -> tuple[np.ndarray, np.ndarray]:
+        """Empty arrays (N, d) for the next positions and velocities, for a kernel to write
+        a step's new state into: `store_state` then makes them the body's own, uncopied."""
+        shape = (self._size["particles"], self.dim or 3)
+        self.__dict__["_new_state"] = (np.empty(shape), np.empty(shape))
+        return self._new_state
+
+    def store_state(self, positions: np.ndarray, velocities: np.ndarray) -> None:
+        """Make ``positions`` (m) and ``velocities`` (m/s), (N, d), the body's state.
+
+        The arrays of the last `new_state` become the body's own; others are copied
+        in. Arrays read from the body before may then keep the old state.
+        """
+        new, self.__dict__["_new_state"] = self._new_state, ()
+        adopt = new and positions is new[0] and velocities is new[1]
+        if adopt and len(positions) == self._size["particles"]:
+            self._buffers["positions"] = self.__dict__["positions"] = positions
+            self._buffers["velocities"] = self.__dict__["velocities"] = velocities
+            self._capacity["particles"] = self._size["particles"]  # adding particles regrows all
+        else:
+            self.positions[...] = positions
+            self.velocities[...] = velocities
 
     def _keep_grid_springs(self, grid: GridSprings) -> None:
         """Use ``grid``'s springs, kept per offset, as the body's (it has none yet)."""

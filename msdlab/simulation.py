@@ -127,8 +127,9 @@ class Simulation:
         """Advance the body by one step of ``dt``.
 
         Integrate, apply the constraints, book the energy each mechanism took out,
-        check for divergence, and store the new state in the body (whose
-        ``positions`` and ``velocities`` are then the new state).
+        check for divergence, and store the new state in the body: read
+        ``body.positions`` and ``body.velocities`` again after a step, as arrays
+        read before may still hold the old state.
         """
         body, dt = self.body, self._dt
         x, v = body.positions, body.velocities
@@ -140,9 +141,10 @@ class Simulation:
             removed.append((constraint.ledger_name, constraint.apply(state)))
         if self.ledger:  # after the constraints: the integrator's damping works at the final v
             self._book(x, v, v_new, removed)
-        self._check_divergence(x, x_new, v_new)
-        x[...] = x_new
-        v[...] = v_new
+        stretched = self.max_stretch is not None and self.dynamics.max_stretch > self.max_stretch
+        if stretched or not self.dynamics.springs.finite(x_new, v_new):
+            raise self._divergence(x, x_new, v_new)
+        body.store_state(x_new, v_new)
         self.time += dt
         self.step_count += 1
 
@@ -274,16 +276,15 @@ class Simulation:
         potential = sum(f.potential_energy(body, x, particles) for f in self.forces)
         return float(kinetic + potential + dynamics.elastic_energy(x, touching))
 
-    def _check_divergence(self, x: np.ndarray, x_new: np.ndarray, v_new: np.ndarray) -> None:
-        """Raise `SimulationDiverged` if the new state is not finite or a spring is
-        stretched past ``max_stretch`` times its rest length."""
-        finite = self.dynamics.springs.finite(x_new, v_new)
-        stretched = self.max_stretch is not None and self.dynamics.max_stretch > self.max_stretch
-        if not finite or stretched:
-            body, integrator, dt, forces = self.body, self.integrator, self._dt, self.forces
-            blowup = (self.initial_positions, x, x_new, v_new)
-            diagnosis = describe_blowup(body, integrator, dt, forces, *blowup)
-            raise SimulationDiverged(self.step_count, self.time, diagnosis)
+    def _divergence(
+        self, x: np.ndarray, x_new: np.ndarray, v_new: np.ndarray
+    ) -> SimulationDiverged:
+        """The error for a step from positions x to a state (x_new, v_new) that is not finite
+        or stretches a spring past ``max_stretch`` times its rest length, with its diagnosis."""
+        body, integrator, dt, forces = self.body, self.integrator, self._dt, self.forces
+        blowup = (self.initial_positions, x, x_new, v_new)
+        diagnosis = describe_blowup(body, integrator, dt, forces, *blowup)
+        return SimulationDiverged(self.step_count, self.time, diagnosis)
 
     def _trajectory(self, frames: list, ledger: EnergyLedger) -> Trajectory:
         velocities = (

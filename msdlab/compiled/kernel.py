@@ -136,7 +136,7 @@ class NumbaKernel:
             stencil = self._stencil if self._uniform else None
             if stencil is not None:
                 self._threads = numba.get_num_threads()
-                threads = body.n_springs >= PARALLEL_MIN_GATHERED and self._threads > 1
+                threads = stencil.starts[-1] >= PARALLEL_MIN_GATHERED and self._threads > 1
                 gather = gather_parallel if threads else gather_serial
                 if self._scratch.shape != (10, len(x) + 2 * self._pad):
                     self._scratch = np.zeros((10, len(x) + 2 * self._pad))  # 2-D: x2 = v2 = 0
@@ -319,7 +319,7 @@ class NumbaKernel:
         if compiled is None and update not in _FAILED:
             compiled = _ADVANCES[update, threads] = compile_advance(update, threads)
         if compiled is not None:
-            x_new, v_new = np.empty_like(x), np.empty_like(v)
+            x_new, v_new = body.new_state()
             try:
                 masses, fixed = body.masses, body.fixed
                 compiled(

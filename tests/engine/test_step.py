@@ -98,6 +98,47 @@ def test_the_body_holds_the_new_state_after_each_step() -> None:
     assert sim.step_count == 1 and sim.time == sim.dt
 
 
+class Reusing(msd.Integrator):
+    """Velocity Verlet writing into two buffers of its own, the same ones every step."""
+
+    def __init__(self) -> None:
+        self.buffers: tuple[np.ndarray, ...] = ()
+
+    def step(self, x, v, dt, dynamics):
+        if not self.buffers:
+            self.buffers = (np.empty_like(x), np.empty_like(v))
+        x_new, v_new = self.buffers
+        a = dynamics.acceleration(x, v)
+        np.add(v, 0.5 * dt * a, out=v_new)
+        np.add(x, dt * v_new, out=x_new)
+        v_new += 0.5 * dt * dynamics.acceleration(x_new, v + dt * a)
+        return x_new, v_new
+
+
+def test_an_integrator_reusing_its_buffers_steps_as_one_making_new_arrays() -> None:
+    bodies = [falling_body(3, 4), falling_body(3, 4)]
+    sims = [
+        msd.Simulation(body, scheme, forces=[msd.Gravity(GRAVITY), msd.Ground()])
+        for body, scheme in zip(bodies, (Reusing(), msd.VelocityVerlet()))
+    ]
+    for sim in sims:
+        sim.run(steps=30)
+    np.testing.assert_array_equal(bodies[0].positions, bodies[1].positions)
+    np.testing.assert_array_equal(bodies[0].velocities, bodies[1].velocities)
+    assert sims[0].dissipated["ground"] == sims[1].dissipated["ground"]
+
+
+def test_a_particle_pinned_between_steps_stays_put() -> None:
+    body = falling_body(3, 4)
+    sim = msd.Simulation(body, msd.Verlet(0.01), forces=[msd.Gravity(GRAVITY)])
+    sim.run(steps=3)
+    body.fixed[5] = True  # zeroes its velocity in the body's current arrays
+    where = body.positions[5].copy()
+    sim.run(steps=3)
+    np.testing.assert_array_equal(body.positions[5], where)
+    np.testing.assert_array_equal(body.velocities[5], 0.0)
+
+
 class Poison(msd.Constraint):
     """A broken constraint: it makes one velocity NaN at step 5."""
 
