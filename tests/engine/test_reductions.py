@@ -20,11 +20,12 @@ def test_damping_work_is_the_readable_sum_to_rounding(kernel: str) -> None:
     assert got == pytest.approx(expected, rel=1e-12)
 
 
+@pytest.mark.parametrize("order", ["C", "F"])
 @pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
 @pytest.mark.parametrize("where", ["x", "v"])
-def test_finite_sees_one_bad_coordinate(kernel: str, bad: float, where: str) -> None:
+def test_finite_sees_one_bad_coordinate(kernel: str, bad: float, where: str, order: str) -> None:
     springs = make_kernel(kernel)
-    x, v = np.full((50, 3), 1e300), np.zeros((50, 3))  # large but finite: still finite
+    x, v = np.full((50, 3), 1e300, order=order), np.zeros((50, 3), order=order)  # still finite
     assert springs.finite(x, v)
     (x if where == "x" else v)[37, 2] = bad
     assert not springs.finite(x, v)
