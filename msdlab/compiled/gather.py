@@ -111,6 +111,49 @@ def _push_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, values
 
 
 @numba.njit(cache=True, error_model="numpy")
+def _push_one(xs, vs, fs, squared, column, first, stop, shift, values, kept, pad):
+    """`_push_three` for a triple holding one spring: to the neighbours at p + ``shift``,
+    masked by ``column``, with the values (4,) ``values``, f/|d| kept in ``kept``; the
+    other two would be computed for nothing."""
+    x0, x1, x2 = xs
+    f0, f1, f2 = fs
+    k, rest, c, w = values[0], values[1], values[2], values[3]
+    power = 0.0
+    if c == 0.0:  # vector registers, as in `_push_three`
+        for i in range(first, stop):
+            p, r, q = numba.uint64(i), numba.uint64(i - first), numba.uint64(i + shift)
+            a, a0, a1, a2, la = _pull(x0[p], x1[p], x2[p], x0, x1, x2, q, column[r], k, rest)
+            f0[p], f1[p], f2[p] = f0[p] + a * a0, f1[p] + a * a1, f2[p] + a * a2
+            kept[numba.uint64(i - first + pad)] = a
+            squared[p] = max(squared[p], la * w)
+        return power
+    v0, v1, v2 = vs
+    for i in range(first, stop):
+        p, r, q = numba.uint64(i), numba.uint64(i - first), numba.uint64(i + shift)
+        y, u = (x0[p], x1[p], x2[p]), (v0[p], v1[p], v2[p])
+        a, a0, a1, a2, la, pa = _pull_damped(*y, *u, xs, vs, q, column[r], k, rest, c)
+        f0[p], f1[p], f2[p] = f0[p] + a * a0, f1[p] + a * a1, f2[p] + a * a2
+        kept[numba.uint64(i - first + pad)] = a
+        squared[p] = max(squared[p], la * w)
+        power += pa
+    return power
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _react_one(xs, fs, kept, first, stop, shift, pad):
+    """`_react` for a triple holding one spring (see `_push_one`)."""
+    x0, x1, x2 = xs
+    f0, f1, f2 = fs
+    kept[pad + stop - first :] = 0.0
+    for i in range(first + shift, stop + shift):
+        q, p = numba.uint64(i), numba.uint64(i - shift)
+        a = kept[numba.uint64(i - shift - first + pad)]
+        f0[q] -= a * (x0[p] - x0[q])
+        f1[q] -= a * (x1[p] - x1[q])
+        f2[q] -= a * (x2[p] - x2[q])
+
+
+@numba.njit(cache=True, error_model="numpy")
 def _react(xs, fs, scales, first, stop, shifts, pad):
     """Add to each neighbour q = p + ``shifts[j]`` of particles p = ``first`` to ``stop - 1``
     the opposite of the force its spring exerts on p (eq. 1.1), -(f/|d|)·(x_p - x_q),
@@ -169,6 +212,13 @@ def _push_rows(scratch, pad, columns, shape, triples, rows_of, o2s, values, plan
         first, stop = (plane * n1 + lo) * n2 + pad, (plane * n1 + hi) * n2 + pad
         masks = (rows_of[t, 0], rows_of[t, 1], rows_of[t, 2])
         shifts = (shift + o2s[t, 0], shift + o2s[t, 1], shift + o2s[t, 2])
+        if masks[1] == len(columns) - 1:  # one spring (they come first, see `stencil_triples`)
+            column, one = columns[masks[0]], values[t, 0]
+            power += _push_one(
+                xs, vs, fs, scratch[9], column, first, stop, shifts[0], one, scales[0], pad
+            )
+            _react_one(xs, fs, scales[0], first, stop, shifts[0], pad)
+            continue
         power += _push_three(
             xs, vs, fs, scratch[9], columns, masks, first, stop, shifts, values[t], scales, pad
         )

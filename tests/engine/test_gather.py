@@ -53,6 +53,7 @@ def assert_agree(body: msd.Body, numba_kernel: NumbaKernel) -> None:
         ((6, 5, 4), (1, 2, 3, 4)),
         ((7, 5), (1, 2)),
         ((1, 1, 5), (1,)),
+        ((4, 5, 6), (1,)),  # every triple holds one spring
         ((170, 100), (1, 2)),  # 2-D: five blocks of rows, taken as planes are in 3-D
     ],
 )
