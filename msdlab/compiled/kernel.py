@@ -26,7 +26,7 @@ from .edges import (
 )
 from .gather import gather_parallel, gather_serial
 from .grid_sums import grid_sum_parallel, grid_sum_serial
-from .reductions import damping_work, finite
+from .reductions import damping_work, damping_work_parallel, finite
 from .stencil import (
     GridStencil,
     column_masks,
@@ -60,6 +60,10 @@ _ADVANCES: dict[tuple[Callable, bool], Callable] = {}
 
 _FAILED: set[Callable] = set()  # updates numba cannot compile: they run on arrays
 
+# `damping_work` without and with threads, the same sums. (A threaded `finite` was no
+# faster within a step: waking the threads cost what they saved.)
+_DAMPING_WORK = {False: damping_work, True: damping_work_parallel}
+
 
 class NumbaKernel:
     """The compiled spring kernel for one body, with what it needs kept between calls.
@@ -71,7 +75,8 @@ class NumbaKernel:
     (``body.topology_version``) and re-checked when their values are edited
     (``body.parameters_version``, counted by the body's tracked arrays), so
     edits count at once. ``springs`` (indices) restricts a computation to some
-    springs, on one thread, in the body's order.
+    springs, on one thread, in the body's order. `damping_work` runs on threads
+    after an `advance` of a body big enough to share out.
     """
 
     def __init__(self) -> None:
@@ -315,6 +320,7 @@ class NumbaKernel:
         """`advance` with F = ``forces`` plus the spring forces ``pending`` (see
         `advance.compile_advance`)."""
         threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
+        self.damping_work = _DAMPING_WORK[threads]  # for the ledger at the end of this step
         compiled = None if update in _FAILED else _ADVANCES.get((update, threads))
         if compiled is None and update not in _FAILED:
             compiled = _ADVANCES[update, threads] = compile_advance(update, threads)

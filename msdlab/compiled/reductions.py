@@ -1,12 +1,16 @@
 """Sums over the state at the end of a step, compiled: one pass each, no temporary arrays.
 
-The same quantities as the numpy kernel's (`kernels.finite`, `equations.damping_work`),
-summed particle by particle, so they may differ from numpy's sums in the last bits.
+The same quantities as the numpy kernel's (`kernels.finite`, `equations.damping_work`).
+The work is summed over blocks of `BLOCK` particles, then over the blocks in order, so
+one thread and several give the same sum; it may differ from numpy's in the last bits.
 """
 
 from __future__ import annotations
 
 import numba
+import numpy as np
+
+BLOCK = 4096  # particles per partial sum
 
 
 @numba.njit(cache=True, fastmath={"reassoc"})
@@ -22,12 +26,33 @@ def finite(x, v):
 
 
 @numba.njit(cache=True)
-def damping_work(masses, v_before, v_after, factor):
-    """`equations.damping_work`: (1 - factor)·½ Σ m v_before·(v_before + v_after) (J)."""
+def _kick_dots(masses, v_before, v_after, block):
+    """Σ m v_before·(v_before + v_after) (kg·m²/s²) over the particles of ``block``."""
     total = 0.0
-    for i in range(len(masses)):
+    for i in range(block * BLOCK, min(len(masses), (block + 1) * BLOCK)):
         dot = 0.0
         for q in range(v_before.shape[1]):
             dot += v_before[i, q] * (v_before[i, q] + v_after[i, q])
         total += masses[i] * dot
+    return total
+
+
+@numba.njit(cache=True)
+def damping_work(masses, v_before, v_after, factor):
+    """`equations.damping_work`: (1 - factor)·½ Σ m v_before·(v_before + v_after) (J)."""
+    total = 0.0
+    for block in range((len(masses) + BLOCK - 1) // BLOCK):
+        total += _kick_dots(masses, v_before, v_after, block)
+    return (1.0 - factor) * (0.5 * total)
+
+
+@numba.njit(cache=True, parallel=True)
+def damping_work_parallel(masses, v_before, v_after, factor):
+    """`damping_work`, the blocks shared between the threads, summed in the same order."""
+    sums = np.empty((len(masses) + BLOCK - 1) // BLOCK)
+    for block in numba.prange(len(sums)):
+        sums[block] = _kick_dots(masses, v_before, v_after, block)
+    total = 0.0
+    for block in range(len(sums)):
+        total += sums[block]
     return (1.0 - factor) * (0.5 * total)

@@ -29,3 +29,20 @@ def test_finite_sees_one_bad_coordinate(kernel: str, bad: float, where: str, ord
     assert springs.finite(x, v)
     (x if where == "x" else v)[37, 2] = bad
     assert not springs.finite(x, v)
+
+
+def test_threads_give_the_same_damping_work(kernel: str) -> None:
+    if kernel == "numpy":
+        pytest.skip("threads are the numba kernel's")
+    from msdlab.compiled import reductions
+
+    rng = np.random.default_rng(2)
+    count = 3 * reductions.BLOCK + 17
+    masses, v, v_new = (
+        rng.random(count) + 0.5,
+        rng.normal(size=(count, 3)),
+        rng.normal(size=(count, 3)),
+    )
+    serial = reductions.damping_work(masses, v, v_new, 0.97)
+    assert reductions.damping_work_parallel(masses, v, v_new, 0.97) == serial
+    assert serial == pytest.approx(msd.energy.damping_work(masses, v, v_new, 0.97), rel=1e-12)
