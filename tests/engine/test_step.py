@@ -132,7 +132,7 @@ def test_a_particle_pinned_between_steps_stays_put() -> None:
     body = falling_body(3, 4)
     sim = msd.Simulation(body, msd.Verlet(0.01), forces=[msd.Gravity(GRAVITY)])
     sim.run(steps=3)
-    body.fixed[5] = True  # zeroes its velocity in the body's current arrays
+    body.fixed[5] = True  # in the body's arrays of now, taken over from the kernel
     where = body.positions[5].copy()
     sim.run(steps=3)
     np.testing.assert_array_equal(body.positions[5], where)
