@@ -329,6 +329,7 @@ class Body:
         """Empty arrays (N, d) for the next positions and velocities, for a kernel to write
         a step's new state into: `store_state` then makes them the body's own, uncopied."""
         shape = (self._size["particles"], self.dim or 3)
+        # straight into __dict__: `__setattr__` only checks body arrays, and this is every step
         self.__dict__["_new_state"] = (np.empty(shape), np.empty(shape))
         return self._new_state
 

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 import msdlab as msd
+from msdlab.compiled import reductions
 from msdlab.spring_kernel import make_kernel
 
 
@@ -34,8 +35,6 @@ def test_finite_sees_one_bad_coordinate(kernel: str, bad: float, where: str, ord
 def test_threads_give_the_same_damping_work(kernel: str) -> None:
     if kernel == "numpy":
         pytest.skip("threads are the numba kernel's")
-    from msdlab.compiled import reductions
-
     rng = np.random.default_rng(2)
     count = 3 * reductions.BLOCK + 17
     masses, v, v_new = (
