@@ -33,7 +33,7 @@ class Dynamics:
         self.springs: SpringKernel = make_kernel(kernel)
         self.max_stretch = 0.0  # largest |d|/l seen in the last force evaluation
         self._pattern: JacobianPattern | None = None
-        self._buffer = np.zeros((0, 0))  # the forces of `advance`, used up within each call
+        self._buffer = np.zeros((0, 0))  # scratch forces of `advance` and `acceleration`
 
     @property
     def kernel(self) -> str:
@@ -71,8 +71,21 @@ class Dynamics:
                 force.add_to(self.body, x, v, total)
 
     def acceleration(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """Acceleration of each particle (N, d) in m/s²; zero for fixed particles."""
-        return self.springs.to_acceleration(self.body, self.force(x, v))
+        """Acceleration of each particle (N, d) in m/s²; zero for fixed particles.
+
+        When every force is a uniform field g (gravity), the kernel computes
+        a = F/m + g of the springs' F in one go (`SpringKernel.acceleration`).
+        """
+        field = np.zeros(x.shape[1])  # Σ g (m/s²) of the uniform fields
+        for force in self.forces:
+            g = force.uniform_acceleration(self.body)
+            if g is None:  # a force of its own kind: added to the others, then divided
+                return self.springs.to_acceleration(self.body, self.force(x, v))
+            field += g
+        if self._buffer.shape != x.shape:
+            self._buffer = np.empty_like(x)
+        a, self.max_stretch, _ = self.springs.acceleration(self.body, x, v, self._buffer, field)
+        return a
 
     def advance(
         self, update: Update, x: np.ndarray, v: np.ndarray, dt: float, *coefficients: float

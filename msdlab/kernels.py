@@ -150,6 +150,19 @@ class NumpyKernel:
         """Accelerations a = F/m (N, d) in m/s² from forces (N, d); 0 for fixed particles."""
         return equations.acceleration(forces, body.masses[:, None], ~body.fixed[:, None])
 
+    @staticmethod
+    def acceleration(
+        body: Body, x: np.ndarray, v: np.ndarray, forces: np.ndarray, field: np.ndarray
+    ) -> tuple[np.ndarray, float, float]:
+        """a = (F + m·g)/m (N, d) in m/s², F the spring forces put into ``forces`` (cleared
+        first) and g = ``field`` (d,), 0 for fixed particles; with the largest stretch and
+        the dashpot power (W)."""
+        forces.fill(0.0)
+        _, stretch, power = _spring_forces_and_power(body, x, v, forces)
+        masses = body.masses[:, None]
+        total = forces + masses * field if field.any() else forces
+        return equations.acceleration(total, masses, ~body.fixed[:, None]), stretch, power
+
     def advance(
         self,
         update: Callable,

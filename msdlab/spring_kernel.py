@@ -55,6 +55,12 @@ class SpringKernel(Protocol):
     ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """∂F/∂x and ∂F/∂v of the springs on ``pattern`` (see `kernels.spring_jacobians`)."""
 
+    def acceleration(
+        self, body: Body, x: np.ndarray, v: np.ndarray, forces: np.ndarray, field: np.ndarray
+    ) -> tuple[np.ndarray, float, float]:
+        """a = (F + m·g)/m (N, d), F the spring forces, g = ``field`` (d,) in m/s², 0 for fixed;
+        with the largest stretch and the dashpot power (W). ``forces`` (N, d) is scratch."""
+
     def to_acceleration(self, body: Body, forces: np.ndarray) -> np.ndarray:
         """Accelerations a = F/m (N, d) from forces (N, d), 0 for fixed (may reuse ``forces``)."""
 

@@ -13,7 +13,8 @@ then sums them per particle. `NumbaKernel` compiles the same functions
   once per process and update. When the springs' forces are all the forces
   (`NumbaKernel.advance_with_springs`), the spring forces not yet summed (the
   edge loop's threads' buffers, or the gather's forces by coordinate) are
-  added in that loop too, not in a pass of their own;
+  added in that loop too, not in a pass of their own. `advance.accelerations` is
+  the same loop without an update, for `Dynamics.acceleration`;
 - `kernel`: `NumbaKernel`, which keeps what a body needs between calls and
   picks the loops.
 

@@ -2,7 +2,8 @@
 
 `compile_advance` turns an update such as `integrators.verlet_update` into a
 loop that computes a = F/m (plus gravity's g) and the update together, and adds
-the spring forces the spring loops left pending in the same pass.
+the spring forces the spring loops left pending in the same pass. `accelerations`
+is that loop without an update: a = F/m (plus g) alone.
 """
 
 from __future__ import annotations
@@ -22,6 +23,35 @@ def divide_by_masses(forces, masses, fixed):
             forces[i, q] = acceleration(forces[i, q], masses[i], not fixed[i])
 
 
+@numba.njit(cache=True, inline="always")
+def particle_acceleration(i, q, forces, pending, field, masses, fixed):
+    """a = (F + m·g)/m (m/s²) of particle i along q, 0 if fixed, with F = ``forces`` (none
+    if it has no rows) plus the spring forces ``pending`` (see `compile_advance`)."""
+    partial, by_coordinate, pad = pending
+    total = forces[i, q] if len(forces) > 0 else 0.0
+    for t in range(len(partial)):
+        total += partial[t, i, q]
+    if len(by_coordinate) > 0:
+        total += by_coordinate[q, pad + i]
+    return acceleration(total + masses[i] * field[q], masses[i], not fixed[i])
+
+
+@numba.njit(cache=True)
+def accelerations(forces, pending, field, masses, fixed, out):
+    """Write into ``out`` (N, d) every particle's `particle_acceleration` (m/s²)."""
+    for i in range(len(masses)):
+        for q in range(out.shape[1]):
+            out[i, q] = particle_acceleration(i, q, forces, pending, field, masses, fixed)
+
+
+@numba.njit(cache=True, parallel=True)
+def accelerations_parallel(forces, pending, field, masses, fixed, out):
+    """`accelerations`, the particles split between the threads."""
+    for i in numba.prange(len(masses)):
+        for q in range(out.shape[1]):
+            out[i, q] = particle_acceleration(i, q, forces, pending, field, masses, fixed)
+
+
 def compile_advance(update: Callable, threads: bool) -> Callable:
     """A loop over the particles doing a = (F + m·g)/m then ``update`` per coordinate.
 
@@ -38,18 +68,9 @@ def compile_advance(update: Callable, threads: bool) -> Callable:
 
     @numba.njit(parallel=threads)
     def advance(x, v, forces, pending, field, masses, fixed, dt, coefficients, x_new, v_new):
-        partial, by_coordinate, pad = pending
-        loaded = len(forces) > 0
-        gathered = len(by_coordinate) > 0
         for i in numba.prange(len(masses)):
-            free = not fixed[i]
             for q in range(x.shape[1]):
-                total = forces[i, q] if loaded else 0.0
-                for t in range(len(partial)):
-                    total += partial[t, i, q]
-                if gathered:
-                    total += by_coordinate[q, pad + i]
-                a = acceleration(total + masses[i] * field[q], masses[i], free)
+                a = particle_acceleration(i, q, forces, pending, field, masses, fixed)
                 x_new[i, q], v_new[i, q] = scalar(x[i, q], v[i, q], a, dt, *coefficients)
 
     return advance

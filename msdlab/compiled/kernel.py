@@ -13,7 +13,7 @@ import scipy.sparse as sp
 
 from .. import equations
 from ..body import Body
-from .advance import compile_advance, divide_by_masses
+from .advance import accelerations, accelerations_parallel, compile_advance, divide_by_masses
 from .edges import (
     dashpot_power_parallel,
     dashpot_power_serial,
@@ -264,6 +264,22 @@ class NumbaKernel:
         """Turn forces (N, d) into accelerations a = F/m in place (0 for fixed); return them."""
         divide_by_masses(forces, body.masses, body.fixed)
         return forces
+
+    def acceleration(
+        self, body: Body, x: np.ndarray, v: np.ndarray, forces: np.ndarray, field: np.ndarray
+    ) -> tuple[np.ndarray, float, float]:
+        """a = (F + m·g)/m (N, d) in m/s², F the spring forces and g = ``field`` (d,), 0 for
+        fixed particles; with the largest stretch and the dashpot power (W). The spring
+        forces are summed in the loop that divides (as in `advance_with_springs`);
+        ``forces`` is scratch."""
+        stretch, power, pending = self._spring_forces(body, x, v, forces, None, reduce=False)
+        if len(pending[1]):  # the gather's forces by coordinate are all of F
+            forces = forces[:0]
+        threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
+        out = np.empty_like(x)
+        loop = accelerations_parallel if threads else accelerations
+        loop(forces, pending, field, body.masses, body.fixed, out)
+        return out, stretch, power
 
     def advance(
         self,

@@ -102,6 +102,36 @@ def test_accelerations_include_forces_and_subsets(dim: int) -> None:
     assert_close(
         dynamics.acceleration_of(particles, x, v), expected[particles], np.abs(expected).max()
     )
+    drag = Dynamics(body, [msd.Gravity(g), msd.ViscousDamping(0.4)])  # not a uniform field
+    dragged = np.where(body.fixed[:, None], 0.0, expected - 0.4 * v / body.masses[:, None])
+    assert_close(drag.acceleration(x, v), dragged, np.abs(expected).max())
+
+
+@pytest.mark.parametrize("threaded", [False, True])
+@pytest.mark.parametrize(("dim", "uniform"), [(3, False), (3, True), (2, True)])
+def test_acceleration_is_forces_then_division(
+    threaded: bool, dim: int, uniform: bool, kernel: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The kernel's a = (F + m·g)/m, bit for bit what adding the forces and dividing
+    gives (the numba kernel sums the spring forces in its dividing loop), with the
+    stretch and power of `add_spring_forces`."""
+    if threaded:
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
+        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_PARTICLES", 0)
+    body = deformed_body(dim, seed=8)
+    if uniform:
+        body.stiffness[:] = 30.0
+        body.spring_damping[:] = 0.3
+    x, v, field = body.positions, body.velocities, np.array([0.0, -9.81, 0.0][:dim])
+    springs = spring_kernel.make_kernel(kernel)
+    forces = np.zeros_like(x)
+    sums = springs.add_spring_forces(body, x, v, forces, None)
+    expected = springs.to_acceleration(body, forces + body.masses[:, None] * field)
+    scratch = np.full_like(x, 7.0)  # its content is not read
+    a, *fused_sums = springs.acceleration(body, x, v, scratch, field)
+    np.testing.assert_array_equal(a, expected)
+    assert tuple(fused_sums) == sums
 
 
 def object_update(x: float, v: float, a: float, dt: float) -> tuple[float, float]:
