@@ -25,7 +25,7 @@ def measure(n: int, integrator: str) -> dict:
     import resource
 
     import msdlab as msd
-    from msdlab.cli import configure_process
+    from msdlab.process import configure_process
 
     configure_process()
 

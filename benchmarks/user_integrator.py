@@ -27,9 +27,9 @@ from pathlib import Path
 import numpy as np
 
 import msdlab as msd
-from msdlab.cli import configure_process
+from msdlab.process import configure_process
 
-configure_process()  # the thread wait policy the command line uses
+configure_process()  # the process settings of the command line
 
 SOLUTION = Path(__file__).resolve().parents[1] / "solutions" / "task5.py"
 

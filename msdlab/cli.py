@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from collections.abc import Sequence
 
 from .commands import COMMANDS
+from .process import configure_process
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -19,16 +19,6 @@ def build_parser() -> argparse.ArgumentParser:
     for command in COMMANDS:
         command.register(subparsers)
     return parser
-
-
-def configure_process() -> None:
-    """Process-wide settings, made by the command line, never by importing msdlab.
-
-    Waiting threads sleep instead of spinning (``OMP_WAIT_POLICY=PASSIVE``): a
-    spinning thread keeps waiting work off a shared core (a 0.5 ms step took 30 ms).
-    A value the user set is kept.
-    """
-    os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 
 def main(argv: Sequence[str] | None = None) -> int:

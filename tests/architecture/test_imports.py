@@ -12,7 +12,7 @@ The layers, lowest first; a module may import its own layer and the layers below
 4. ``msdlab.viz``
 5. ``msdlab.instructor``
 6. ``msdlab.commands``
-7. ``msdlab.cli`` and ``msdlab.__main__``
+7. ``msdlab.cli``, the process settings it makes (``msdlab.process``) and ``msdlab.__main__``
 
 Imports under ``if TYPE_CHECKING:`` are for type hints only and are not counted.
 """
@@ -35,6 +35,7 @@ LAYERS = {
     "instructor": 5,
     "commands": 6,
     "cli": 7,
+    "process": 7,
     "__main__": 7,
 }
 # The one import made inside a function in the core: the optional compiled backend.
