@@ -9,7 +9,7 @@ import os
 import platform
 
 # glibc's malloc: arrays below this many bytes come from the heap, ...
-MMAP_THRESHOLD = 4 * 2**20
+MMAP_THRESHOLD = 32 * 2**20
 # ... which keeps up to this many freed bytes at its top instead of returning them.
 TRIM_THRESHOLD = 64 * 2**20
 _MALLOPT = {

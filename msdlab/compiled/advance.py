@@ -24,15 +24,32 @@ def divide_by_masses(forces, masses, fixed):
 
 
 @numba.njit(cache=True, inline="always")
-def particle_acceleration(i, q, forces, pending, field, masses, fixed):
-    """a = (F + m·g)/m (m/s²) of particle i along q, 0 if fixed, with F = ``forces`` (none
-    if it has no rows) plus the spring forces ``pending`` (see `compile_advance`)."""
-    partial, by_coordinate, pad = pending
-    total = forces[i, q] if len(forces) > 0 else 0.0
+def gathered_force(i, q, forces, pending):
+    """Force (N) on particle i along q when the grid gather's forces by coordinate are all
+    of it: ``by_coordinate[q, pad + i]`` of ``pending`` (see `compile_advance`)."""
+    _, by_coordinate, pad = pending
+    return by_coordinate[q, pad + i]
+
+
+@numba.njit(cache=True, inline="always")
+def summed_force(i, q, forces, pending):
+    """Force (N) on particle i along q: ``forces`` plus the threads' partial forces of
+    ``pending``, in the order the edge loop adds them (see `compile_advance`)."""
+    partial = pending[0]
+    total = forces[i, q]
     for t in range(len(partial)):
         total += partial[t, i, q]
-    if len(by_coordinate) > 0:
-        total += by_coordinate[q, pad + i]
+    return total
+
+
+@numba.njit(cache=True, inline="always")
+def particle_acceleration(i, q, forces, pending, field, masses, fixed):
+    """a = (F + m·g)/m (m/s²) of particle i along q, 0 if fixed, F from ``forces`` and the
+    spring forces ``pending`` (`gathered_force` or `summed_force`)."""
+    gathered = len(pending[1]) > 0
+    total = (
+        gathered_force(i, q, forces, pending) if gathered else summed_force(i, q, forces, pending)
+    )
     return acceleration(total + masses[i] * field[q], masses[i], not fixed[i])
 
 
@@ -52,25 +69,27 @@ def accelerations_parallel(forces, pending, field, masses, fixed, out):
             out[i, q] = particle_acceleration(i, q, forces, pending, field, masses, fixed)
 
 
-def compile_advance(update: Callable, threads: bool) -> Callable:
+def compile_advance(update: Callable, threads: bool, gathered: bool) -> Callable:
     """A loop over the particles doing a = (F + m·g)/m then ``update`` per coordinate.
 
-    F is ``forces`` ((0, d): none) plus the spring forces not yet added to it, in the order the
-    spring loops would add them: the threads' ``partial`` forces (T, N, d; T = 0
-    if none, see `edges.spring_forces_parallel`), then the gather's forces by
-    coordinate, particle i at ``by_coordinate[q, pad + i]`` (none if it has no
-    rows, see `gather.gather_parallel`). The new state goes to ``x_new`` and
-    ``v_new``. With ``threads`` the particles are split between the threads
-    (each writes only its own rows). numba compiles it at its first call,
-    which raises a numba error if it cannot.
+    ``pending`` = (partial, by_coordinate, pad) holds the spring forces not yet
+    added up. With ``gathered``, F is the grid gather's forces by coordinate,
+    particle i at ``by_coordinate[q, pad + i]`` (see `gather.gather_parallel`);
+    else F is ``forces`` plus the threads' ``partial`` forces (T, N, d; T = 0 if
+    none, see `edges.spring_forces_parallel`), in the order the edge loop adds
+    them. The new state goes to ``x_new`` and ``v_new``. With ``threads`` the
+    particles are split between the threads (each writes only its own rows).
+    numba compiles it at its first call, which raises a numba error if it cannot.
     """
     scalar = numba.njit(update)
+    force = gathered_force if gathered else summed_force
 
     @numba.njit(parallel=threads)
     def advance(x, v, forces, pending, field, masses, fixed, dt, coefficients, x_new, v_new):
         for i in numba.prange(len(masses)):
             for q in range(x.shape[1]):
-                a = particle_acceleration(i, q, forces, pending, field, masses, fixed)
+                total = force(i, q, forces, pending) + masses[i] * field[q]
+                a = acceleration(total, masses[i], not fixed[i])
                 x_new[i, q], v_new[i, q] = scalar(x[i, q], v[i, q], a, dt, *coefficients)
 
     return advance

@@ -55,8 +55,9 @@ SPRING_CLASSES = 65_536
 # gather's forces by coordinate (d, N + 2·pad) and that pad (see `advance.compile_advance`).
 Pending = tuple[np.ndarray, np.ndarray, int]
 
-# One compiled loop per update function (threaded or not), for the whole process.
-_ADVANCES: dict[tuple[Callable, bool], Callable] = {}
+# One compiled loop per update function (threaded or not, gathered forces or not), for the
+# whole process.
+_ADVANCES: dict[tuple[Callable, bool, bool], Callable] = {}
 
 _FAILED: set[Callable] = set()  # updates numba cannot compile: they run on arrays
 
@@ -337,9 +338,10 @@ class NumbaKernel:
         `advance.compile_advance`)."""
         threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
         self.damping_work = _DAMPING_WORK[threads]  # for the ledger at the end of this step
-        compiled = None if update in _FAILED else _ADVANCES.get((update, threads))
+        loop = (update, threads, len(pending[1]) > 0)  # the last: the gather's forces pending
+        compiled = None if update in _FAILED else _ADVANCES.get(loop)
         if compiled is None and update not in _FAILED:
-            compiled = _ADVANCES[update, threads] = compile_advance(update, threads)
+            compiled = _ADVANCES[loop] = compile_advance(*loop)
         if compiled is not None:
             x_new, v_new = body.new_state()
             try:
