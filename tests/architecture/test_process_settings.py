@@ -14,11 +14,11 @@ from msdlab import cli, process
 SETTINGS = ("OMP_WAIT_POLICY", "MALLOC_MMAP_THRESHOLD_", "MALLOC_TRIM_THRESHOLD_")
 
 # A step of an integrator written with numpy arrays, as a page-fault count: temporaries of
-# 0.6 MB (a 30³ body's positions) made and freed the same way every step.
+# a body's positions made and freed the same way every step.
 FAULTS_PER_STEP = """
 import resource, numpy as np
 {configure}
-x = np.ones((27_000, 3)); v = np.ones_like(x)
+x = np.ones(({particles}, 3)); v = np.ones_like(x)
 def step():
     old = x - v * 1e-3
     new = 2.0 * x - old + np.ones_like(x) * 1e-6
@@ -60,17 +60,22 @@ def test_the_command_line_sets_them_unless_the_user_did(monkeypatch: pytest.Monk
 
 
 @pytest.mark.skipif(platform.libc_ver()[0] != "glibc", reason="a glibc malloc setting")
-def test_freed_memory_is_kept_for_the_next_step() -> None:
+@pytest.mark.parametrize("particles", [27_000, 216_000])  # 30³ and 60³: 0.6 and 5.2 MB
+def test_freed_memory_is_kept_for_the_next_step(particles: int) -> None:
     """With `process.keep_freed_memory` the temporaries of a step reuse the memory of the
-    last step's instead of faulting in fresh pages (147 pages an array), and child
-    processes inherit the setting."""
+    last step's instead of faulting in fresh pages, and child processes inherit it."""
     configure = "from msdlab.process import keep_freed_memory; keep_freed_memory()"
-    assert float(run(FAULTS_PER_STEP.format(configure=configure))) < 5
-    child = FAULTS_PER_STEP.format(configure="")
+    step = FAULTS_PER_STEP.format(configure=configure, particles=particles)
+    assert float(run(step)) < 5
+    child = FAULTS_PER_STEP.format(configure="", particles=particles)
     inherited = f"""{configure}
 import subprocess, sys
 print(subprocess.run([sys.executable, "-c", {child!r}], capture_output=True, text=True).stdout)
 """
     assert float(run(inherited)) < 5
-    user_set = "import os; os.environ['MALLOC_TRIM_THRESHOLD_'] = '131072'\n" + configure
-    assert run(user_set + "\nprint(os.environ.get('MALLOC_MMAP_THRESHOLD_'))") == "None"
+
+
+def test_a_setting_of_the_user_is_kept() -> None:
+    user_set = "import os; os.environ['MALLOC_TRIM_THRESHOLD_'] = '131072'\n"
+    configure = "from msdlab.process import keep_freed_memory; keep_freed_memory()\n"
+    assert run(user_set + configure + "print(os.environ.get('MALLOC_MMAP_THRESHOLD_'))") == "None"
