@@ -37,6 +37,7 @@ def test_the_readme_cube_is_drawn_with_y_up_unless_told_otherwise():
     run = sim.run(steps=50, record_every=10)
     animation = viz.animate(run, max_frames=3)
     assert animation._fig.axes[0]._vertical_axis == 1  # y is the screen's vertical
+    assert animation.to_jshtml().count("data:image/png;base64") == 3  # drawn, not just built
     figure = viz.plot_body(sim)
     assert figure.axes[0]._vertical_axis == 1
     assert viz.plot_body(sim, up="z").axes[0]._vertical_axis == 2
