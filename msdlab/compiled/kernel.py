@@ -51,13 +51,12 @@ PARALLEL_MIN_GATHERED = 250_000
 SPRING_CLASSES = 65_536
 
 
-# Spring forces not yet added to the force buffer: the threads' buffers (T, N, d), the
-# gather's forces by coordinate (d, N + 2·pad) and that pad (see `advance.compile_advance`).
-Pending = tuple[np.ndarray, np.ndarray, int]
+# Spring forces not all added up: an (N, d) array of them (the force buffer, or the gather's
+# forces by coordinate seen transposed) and the threads' buffers (T, N, d) still to add to it.
+Pending = tuple[np.ndarray, np.ndarray]
 
-# One compiled loop per update function (threaded or not, gathered forces or not), for the
-# whole process.
-_ADVANCES: dict[tuple[Callable, bool, bool], Callable] = {}
+# One compiled loop per update function (threaded or not), for the whole process.
+_ADVANCES: dict[tuple[Callable, bool], Callable] = {}
 
 _FAILED: set[Callable] = set()  # updates numba cannot compile: they run on arrays
 
@@ -84,7 +83,7 @@ class NumbaKernel:
         self._version = -1
         self._a = self._b = np.zeros(0, dtype=np.int32)
         self._partial: np.ndarray | None = None
-        self._none: Pending = (np.zeros((0, 0, 0)), np.zeros((0, 0)), 0)  # no spring forces pending
+        self._no_partial = np.zeros((0, 0, 0))  # no threads' buffers pending
         self._threads = 1
         self._stencil_version = -1
         self._stencil: GridStencil | None = None
@@ -128,13 +127,13 @@ class NumbaKernel:
         springs: np.ndarray | None,
         reduce: bool,
     ) -> tuple[float, float, Pending]:
-        """`add_spring_forces`, and the spring forces still to add to ``out`` (see
-        `advance.compile_advance`): none with ``reduce``, else the threads' buffers of
-        `edges.spring_forces_parallel` or the gather's forces by coordinate; without
-        ``reduce`` ``out`` is scratch: the edge loops clear it, the gather leaves it."""
-        if self._none[0].shape[1:] != x.shape:
-            self._none = (np.zeros((0, *x.shape)), np.zeros((0, 0)), 0)
-        none = self._none
+        """`add_spring_forces`, and where the spring forces are (`Pending`): ``out`` with
+        ``reduce``; else ``out`` plus the threads' buffers of `edges.spring_forces_parallel`,
+        or the gather's forces by coordinate. Without ``reduce`` ``out`` is scratch: the
+        edge loops clear it, the gather leaves it."""
+        if self._no_partial.shape[1:] != x.shape:
+            self._no_partial = np.zeros((0, *x.shape))
+        none = self._no_partial
         if springs is None:
             versions = (body.topology_version, body.parameters_version)
             if (self._stencil_version, self._values_version) != versions:
@@ -152,21 +151,22 @@ class NumbaKernel:
                 squares, powers = gather(x, v, *layout, self._scratch, out, reduce)
                 stretch, power = math.sqrt(squares.max()), float(powers.sum())  # any threads
                 if reduce:
-                    return stretch, power, none
-                return stretch, power, (none[0], self._scratch[6 : 6 + x.shape[1]], self._pad)
+                    return stretch, power, (out, none)
+                by_coordinate = self._scratch[6 : 6 + x.shape[1], self._pad : self._pad + len(x)]
+                return stretch, power, (by_coordinate.T, none)
         if springs is not None:
             a, b, k, rest, c = (body.spring_a, body.spring_b, *body.spring_values)
             a, b, k, rest, c = (array[springs] for array in (a, b, k, rest, c))
-            return *spring_forces_serial(x, v, a, b, None, k, rest, c, out), none
+            return *spring_forces_serial(x, v, a, b, None, k, rest, c, out), (out, none)
         arrays = self._edge_list(body)
         if not self._parallel(body):
             if not reduce:
                 out.fill(0.0)
-            return *spring_forces_serial(x, v, *arrays, out), none
+            return *spring_forces_serial(x, v, *arrays, out), (out, none)
         if self._partial is None or self._partial.shape[1:] != x.shape:
             self._partial = np.empty((self._threads - 1, *x.shape))
         sums = spring_forces_parallel(x, v, *arrays, self._partial, out, reduce)
-        return *sums, none if reduce else (self._partial, none[1], 0)
+        return *sums, (out, none if reduce else self._partial)
 
     def grid_stencil(self, body: Body) -> GridStencil | None:
         """The body's grid stencil if its forces can be gathered by offset now, else None.
@@ -273,13 +273,11 @@ class NumbaKernel:
         fixed particles; with the largest stretch and the dashpot power (W). The spring
         forces are summed in the loop that divides (as in `advance_with_springs`);
         ``forces`` is scratch."""
-        stretch, power, pending = self._spring_forces(body, x, v, forces, None, reduce=False)
-        if len(pending[1]):  # the gather's forces by coordinate are all of F
-            forces = forces[:0]
+        stretch, power, (forces, partial) = self._spring_forces(body, x, v, forces, None, False)
         threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
         out = np.empty_like(x)
         loop = accelerations_parallel if threads else accelerations
-        loop(forces, pending, field, body.masses, body.fixed, out)
+        loop(forces, partial, field, body.masses, body.fixed, out)
         return out, stretch, power
 
     def advance(
@@ -298,8 +296,8 @@ class NumbaKernel:
 
         An update numba cannot compile warns once and runs on whole arrays.
         """
-        pending = (np.zeros((0, *x.shape)), np.zeros((0, 0)), 0)  # no spring forces
-        return self._advance(update, body, x, v, forces, pending, field, dt, coefficients)
+        no_partial = np.zeros((0, *x.shape))
+        return self._advance(update, body, x, v, forces, no_partial, field, dt, coefficients)
 
     def advance_with_springs(
         self,
@@ -313,13 +311,11 @@ class NumbaKernel:
         coefficients: tuple[float, ...],
     ) -> tuple[np.ndarray, np.ndarray, float, float]:
         """The spring forces, then `advance`: (x_new, v_new, largest stretch, dashpot power W).
-        The threads' partial spring forces, or the gather's, are added to F in the
-        update's loop, not in a pass of their own; ``forces`` is scratch, its content
-        not read (the gather does not touch it, so the loop does not read it)."""
-        stretch, power, pending = self._spring_forces(body, x, v, forces, None, reduce=False)
-        if len(pending[1]):  # the gather's forces by coordinate are all of F
-            forces = forces[:0]
-        x_new, v_new = self._advance(update, body, x, v, forces, pending, field, dt, coefficients)
+        The threads' partial spring forces are added to F in the update's loop, not in a
+        pass of their own, and the gather's are read where it left them; ``forces`` is
+        scratch, its content not read."""
+        stretch, power, (forces, partial) = self._spring_forces(body, x, v, forces, None, False)
+        x_new, v_new = self._advance(update, body, x, v, forces, partial, field, dt, coefficients)
         return x_new, v_new, stretch, power
 
     def _advance(
@@ -329,25 +325,24 @@ class NumbaKernel:
         x: np.ndarray,
         v: np.ndarray,
         forces: np.ndarray,
-        pending: Pending,
+        partial: np.ndarray,
         field: np.ndarray,
         dt: float,
         coefficients: tuple[float, ...],
     ) -> tuple[np.ndarray, np.ndarray]:
-        """`advance` with F = ``forces`` plus the spring forces ``pending`` (see
+        """`advance` with F = ``forces`` plus the threads' ``partial`` forces (see
         `advance.compile_advance`)."""
         threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
         self.damping_work = _DAMPING_WORK[threads]  # for the ledger at the end of this step
-        loop = (update, threads, len(pending[1]) > 0)  # the last: the gather's forces pending
-        compiled = None if update in _FAILED else _ADVANCES.get(loop)
+        compiled = None if update in _FAILED else _ADVANCES.get((update, threads))
         if compiled is None and update not in _FAILED:
-            compiled = _ADVANCES[loop] = compile_advance(*loop)
+            compiled = _ADVANCES[update, threads] = compile_advance(update, threads)
         if compiled is not None:
             x_new, v_new = body.new_state()
             try:
                 masses, fixed = body.masses, body.fixed
                 compiled(
-                    x, v, forces, pending, field, masses, fixed, dt, coefficients, x_new, v_new
+                    x, v, forces, partial, field, masses, fixed, dt, coefficients, x_new, v_new
                 )
                 return x_new, v_new
             except numba.core.errors.NumbaError as error:
@@ -358,7 +353,7 @@ class NumbaKernel:
                     RuntimeWarning,
                     stacklevel=5,
                 )
-        return _advance_on_arrays(update, body, x, v, forces, pending, field, dt, coefficients)
+        return _advance_on_arrays(update, body, x, v, forces, partial, field, dt, coefficients)
 
     def _edge_list(self, body: Body) -> tuple[np.ndarray | None, ...]:
         """Ends a, b of all springs sorted by (a, b), each one's class (or None) and the
@@ -421,19 +416,15 @@ def _advance_on_arrays(
     x: np.ndarray,
     v: np.ndarray,
     forces: np.ndarray,
-    pending: Pending,
+    partial: np.ndarray,
     field: np.ndarray,
     dt: float,
     coefficients: tuple[float, ...],
 ) -> tuple[np.ndarray, np.ndarray]:
     """`NumbaKernel._advance` for an update numba cannot compile: on whole arrays, with the
-    pending spring forces added in the order of the compiled loop."""
-    partial, by_coordinate, pad = pending
-    forces = forces if len(forces) else np.zeros_like(x)
+    threads' partial forces added in the order of the compiled loop."""
     for part in partial:
         forces = forces + part  # in the order of `edges.spring_forces_parallel`
-    if len(by_coordinate):
-        forces = forces + by_coordinate[:, pad : pad + len(x)].T
     masses, free = body.masses[:, None], ~body.fixed[:, None]
     a = equations.acceleration(forces + masses * field, masses, free)
     return update(x, v, a, dt, *coefficients)
