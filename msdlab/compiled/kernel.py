@@ -273,7 +273,9 @@ class NumbaKernel:
         fixed particles; with the largest stretch and the dashpot power (W). The spring
         forces are summed in the loop that divides (as in `advance_with_springs`);
         ``forces`` is scratch."""
-        stretch, power, (forces, partial) = self._spring_forces(body, x, v, forces, None, False)
+        stretch, power, (forces, partial) = self._spring_forces(
+            body, x, v, forces, None, reduce=False
+        )
         threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
         out = np.empty_like(x)
         loop = accelerations_parallel if threads else accelerations
@@ -314,7 +316,9 @@ class NumbaKernel:
         The threads' partial spring forces are added to F in the update's loop, not in a
         pass of their own, and the gather's are read where it left them; ``forces`` is
         scratch, its content not read."""
-        stretch, power, (forces, partial) = self._spring_forces(body, x, v, forces, None, False)
+        stretch, power, (forces, partial) = self._spring_forces(
+            body, x, v, forces, None, reduce=False
+        )
         x_new, v_new = self._advance(update, body, x, v, forces, partial, field, dt, coefficients)
         return x_new, v_new, stretch, power
 
