@@ -107,6 +107,21 @@ def test_accelerations_include_forces_and_subsets(dim: int) -> None:
     assert_close(drag.acceleration(x, v), dragged, np.abs(expected).max())
 
 
+def fused_case(
+    dim: int, uniform: bool, threaded: bool, monkeypatch: pytest.MonkeyPatch, seed: int
+) -> msd.Body:
+    """A `deformed_body` for the fused kernel calls: with ``uniform`` spring values (the numba
+    kernel gathers them by offset), and with ``threaded`` every loop shared between threads."""
+    if threaded:
+        for least in ("SPRINGS", "GATHERED", "PARTICLES"):
+            monkeypatch.setattr(f"msdlab.compiled.kernel.PARALLEL_MIN_{least}", 0)
+    body = deformed_body(dim, seed=seed)
+    if uniform:
+        body.stiffness[:] = 30.0
+        body.spring_damping[:] = 0.3
+    return body
+
+
 @pytest.mark.parametrize("threaded", [False, True])
 @pytest.mark.parametrize(("dim", "uniform"), [(3, False), (3, True), (2, True)])
 def test_acceleration_is_forces_then_division(
@@ -115,14 +130,7 @@ def test_acceleration_is_forces_then_division(
     """The kernel's a = (F + m·g)/m, bit for bit what adding the forces and dividing
     gives (the numba kernel sums the spring forces in its dividing loop), with the
     stretch and power of `add_spring_forces`."""
-    if threaded:
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_PARTICLES", 0)
-    body = deformed_body(dim, seed=8)
-    if uniform:
-        body.stiffness[:] = 30.0
-        body.spring_damping[:] = 0.3
+    body = fused_case(dim, uniform, threaded, monkeypatch, seed=8)
     x, v, field = body.positions, body.velocities, np.array([0.0, -9.81, 0.0][:dim])
     springs = spring_kernel.make_kernel(kernel)
     forces = np.zeros_like(x)
@@ -150,14 +158,7 @@ def test_advance_with_springs_is_forces_then_advance(
     """The forces, the update and the stretch and power, bit for bit (the numba kernel adds
     its threads' partial forces, or the grid gather's forces, in the update's loop instead
     of a pass of their own). With ``uniform`` spring values the numba kernel gathers."""
-    if threaded:
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_PARTICLES", 0)
-    body = deformed_body(dim, seed=6)
-    if uniform:
-        body.stiffness[:] = 30.0
-        body.spring_damping[:] = 0.3
+    body = fused_case(dim, uniform, threaded, monkeypatch, seed=6)
     x, v, field = body.positions, body.velocities, np.array([0.0, -9.81, 0.0][:dim])
     springs = spring_kernel.make_kernel(kernel)
     if kernel == "numba":
