@@ -60,8 +60,7 @@ _ADVANCES: dict[tuple[Callable, bool], Callable] = {}
 
 _FAILED: set[Callable] = set()  # updates numba cannot compile: they run on arrays
 
-# `damping_work` without and with threads, the same sums. (A threaded `finite` was no
-# faster within a step: waking the threads cost what they saved.)
+# `damping_work` without and with threads, the same sums.
 _DAMPING_WORK = {False: damping_work, True: damping_work_parallel}
 
 

@@ -11,18 +11,33 @@ import numba
 import numpy as np
 
 BLOCK = 4096  # particles per partial sum
+PARALLEL_MIN_VALUES = 60_000  # coordinates of x for which `finite` uses the threads
 
 
-@numba.njit(cache=True, fastmath={"reassoc"})
+@numba.njit(cache=True, parallel=True, fastmath={"reassoc"})
 def finite(x, v):
     """Whether every coordinate of positions ``x`` and velocities ``v`` (N, d) is finite:
     0·u is 0 for a finite u and NaN for an infinite or NaN one, and a sum of them is 0
-    in any order, so the loop may add them on vector registers."""
+    in any order, so the loop may add them on vector registers, and for a big state
+    (`PARALLEL_MIN_VALUES`) on the threads. One loop reads both arrays: two streams at
+    once read memory faster than one after the other."""
+    xs, vs = _same_size(x.ravel(), v.ravel())
     zero = 0.0
-    for values in (x.ravel(), v.ravel()):
-        for i in range(len(values)):
-            zero += 0.0 * values[i]
+    if len(xs) < PARALLEL_MIN_VALUES:
+        for i in range(len(xs)):
+            zero += 0.0 * xs[i] + 0.0 * vs[i]
+    else:
+        for i in numba.prange(len(xs)):
+            zero += 0.0 * xs[i] + 0.0 * vs[i]
     return zero == 0.0
+
+
+@numba.njit(cache=True)
+def _same_size(xs, vs):
+    """``xs`` and ``vs``, after checking that they have as many values."""
+    if len(xs) != len(vs):
+        raise ValueError("positions and velocities must have the same shape")
+    return xs, vs
 
 
 @numba.njit(cache=True)

@@ -32,6 +32,24 @@ def test_finite_sees_one_bad_coordinate(kernel: str, bad: float, where: str, ord
     assert not springs.finite(x, v)
 
 
+@pytest.mark.parametrize("count", [10, reductions.PARALLEL_MIN_VALUES // 3 + 1])
+@pytest.mark.parametrize("where", ["x", "v"])
+def test_finite_sees_a_bad_coordinate_anywhere(count: int, where: str) -> None:
+    """The compiled check, on one thread and on the threads: every place is looked at."""
+    rng = np.random.default_rng(count)
+    x, v = rng.normal(size=(count, 3)), rng.normal(size=(count, 3))
+    assert reductions.finite(x, v)
+    for row in (0, count // 2, count - 1, *rng.integers(count, size=5)):
+        bad = (x if where == "x" else v).copy()
+        bad[row, rng.integers(3)] = np.nan
+        assert not reductions.finite(*((bad, v) if where == "x" else (x, bad)))
+
+
+def test_finite_refuses_arrays_of_different_sizes() -> None:
+    with pytest.raises(ValueError, match="same shape"):
+        reductions.finite(np.zeros((4, 3)), np.zeros((5, 3)))
+
+
 def test_threads_give_the_same_damping_work(kernel: str) -> None:
     if kernel == "numpy":
         pytest.skip("threads are the numba kernel's")
