@@ -26,7 +26,7 @@ from .edges import (
 )
 from .gather import gather_parallel, gather_serial
 from .grid_sums import grid_sum_parallel, grid_sum_serial
-from .reductions import damping_work, damping_work_parallel, finite
+from .reductions import PARALLEL_MIN_PARTICLES, damping_work, finite
 from .stencil import (
     GridStencil,
     column_masks,
@@ -39,9 +39,9 @@ from .stencil import (
 if TYPE_CHECKING:
     from ..jacobian import JacobianPattern
 
-# Below this many springs (particles for the update) one thread is faster than waking the others.
+# Below this many springs (particles for the update, `PARALLEL_MIN_PARTICLES`) one thread is
+# faster than waking the others.
 PARALLEL_MIN_SPRINGS = 50_000
-PARALLEL_MIN_PARTICLES = 20_000
 
 # The gather wakes the threads four times a step: it waits for more springs (about 28³ grid).
 PARALLEL_MIN_GATHERED = 250_000
@@ -60,9 +60,6 @@ _ADVANCES: dict[tuple[Callable, bool], Callable] = {}
 
 _FAILED: set[Callable] = set()  # updates numba cannot compile: they run on arrays
 
-# `damping_work` without and with threads, the same sums.
-_DAMPING_WORK = {False: damping_work, True: damping_work_parallel}
-
 
 class NumbaKernel:
     """The compiled spring kernel for one body, with what it needs kept between calls.
@@ -74,8 +71,8 @@ class NumbaKernel:
     (``body.topology_version``) and re-checked when their values are edited
     (``body.parameters_version``, counted by the body's tracked arrays), so
     edits count at once. ``springs`` (indices) restricts a computation to some
-    springs, on one thread, in the body's order. `damping_work` runs on threads
-    after an `advance` of a body big enough to share out.
+    springs, on one thread, in the body's order. `finite` and `damping_work` run
+    on the threads for a body big enough to share out.
     """
 
     def __init__(self) -> None:
@@ -336,7 +333,6 @@ class NumbaKernel:
         """`advance` with F = ``forces`` plus the threads' ``partial`` forces (see
         `advance.compile_advance`)."""
         threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
-        self.damping_work = _DAMPING_WORK[threads]  # for the ledger at the end of this step
         compiled = None if update in _FAILED else _ADVANCES.get((update, threads))
         if compiled is None and update not in _FAILED:
             compiled = _ADVANCES[update, threads] = compile_advance(update, threads)

@@ -11,7 +11,7 @@ import numba
 import numpy as np
 
 BLOCK = 4096  # particles per partial sum
-PARALLEL_MIN_VALUES = 60_000  # coordinates of x for which `finite` uses the threads
+PARALLEL_MIN_PARTICLES = 20_000  # from here a pass over the state runs on the threads
 
 
 @numba.njit(cache=True, parallel=True, fastmath={"reassoc"})
@@ -19,11 +19,11 @@ def finite(x, v):
     """Whether every coordinate of positions ``x`` and velocities ``v`` (N, d) is finite:
     0·u is 0 for a finite u and NaN for an infinite or NaN one, and a sum of them is 0
     in any order, so the loop may add them on vector registers, and for a big state
-    (`PARALLEL_MIN_VALUES`) on the threads. One loop reads both arrays: two streams at
+    (`PARALLEL_MIN_PARTICLES`) on the threads. One loop reads both arrays: two streams at
     once read memory faster than one after the other."""
     xs, vs = _same_size(x.ravel(), v.ravel())
     zero = 0.0
-    if len(xs) < PARALLEL_MIN_VALUES:
+    if len(x) < PARALLEL_MIN_PARTICLES:
         for i in range(len(xs)):
             zero += 0.0 * xs[i] + 0.0 * vs[i]
     else:
@@ -52,21 +52,20 @@ def _kick_dots(masses, v_before, v_after, block):
     return total
 
 
-@numba.njit(cache=True)
-def damping_work(masses, v_before, v_after, factor):
-    """`equations.damping_work`: (1 - factor)·½ Σ m v_before·(v_before + v_after) (J)."""
-    total = 0.0
-    for block in range((len(masses) + BLOCK - 1) // BLOCK):
-        total += _kick_dots(masses, v_before, v_after, block)
-    return (1.0 - factor) * (0.5 * total)
-
-
 @numba.njit(cache=True, parallel=True)
-def damping_work_parallel(masses, v_before, v_after, factor):
-    """`damping_work`, the blocks shared between the threads, summed in the same order."""
+def damping_work(masses, v_before, v_after, factor):
+    """`equations.damping_work`: (1 - factor)·½ Σ m v_before·(v_before + v_after) (J).
+
+    Summed by blocks of `BLOCK` particles, on the threads for a big state
+    (`PARALLEL_MIN_PARTICLES`), then over the blocks in order: the same sum either way.
+    """
     sums = np.empty((len(masses) + BLOCK - 1) // BLOCK)
-    for block in numba.prange(len(sums)):
-        sums[block] = _kick_dots(masses, v_before, v_after, block)
+    if len(masses) < PARALLEL_MIN_PARTICLES:
+        for block in range(len(sums)):
+            sums[block] = _kick_dots(masses, v_before, v_after, block)
+    else:
+        for block in numba.prange(len(sums)):
+            sums[block] = _kick_dots(masses, v_before, v_after, block)
     total = 0.0
     for block in range(len(sums)):
         total += sums[block]

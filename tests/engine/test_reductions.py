@@ -32,7 +32,7 @@ def test_finite_sees_one_bad_coordinate(kernel: str, bad: float, where: str, ord
     assert not springs.finite(x, v)
 
 
-@pytest.mark.parametrize("count", [10, reductions.PARALLEL_MIN_VALUES // 3 + 1])
+@pytest.mark.parametrize("count", [10, reductions.PARALLEL_MIN_PARTICLES + 1])
 @pytest.mark.parametrize("where", ["x", "v"])
 def test_finite_sees_a_bad_coordinate_anywhere(count: int, where: str) -> None:
     """The compiled check, on one thread and on the threads: every place is looked at."""
@@ -50,16 +50,20 @@ def test_finite_refuses_arrays_of_different_sizes() -> None:
         reductions.finite(np.zeros((4, 3)), np.zeros((5, 3)))
 
 
-def test_threads_give_the_same_damping_work(kernel: str) -> None:
-    if kernel == "numpy":
-        pytest.skip("threads are the numba kernel's")
-    rng = np.random.default_rng(2)
-    count = 3 * reductions.BLOCK + 17
+@pytest.mark.parametrize(
+    "count", [3 * reductions.BLOCK + 17, reductions.PARALLEL_MIN_PARTICLES + 5]
+)
+def test_damping_work_sums_its_blocks_in_order(count: int) -> None:
+    """One thread or several (past `PARALLEL_MIN_PARTICLES`): the blocks in the same order."""
+    rng = np.random.default_rng(count)
     masses, v, v_new = (
         rng.random(count) + 0.5,
         rng.normal(size=(count, 3)),
         rng.normal(size=(count, 3)),
     )
-    serial = reductions.damping_work(masses, v, v_new, 0.97)
-    assert reductions.damping_work_parallel(masses, v, v_new, 0.97) == serial
-    assert serial == pytest.approx(msd.energy.damping_work(masses, v, v_new, 0.97), rel=1e-12)
+    total = 0.0
+    for block in range(-(-count // reductions.BLOCK)):
+        total += reductions._kick_dots(masses, v, v_new, block)
+    got = reductions.damping_work(masses, v, v_new, 0.97)
+    assert got == (1.0 - 0.97) * (0.5 * total)
+    assert got == pytest.approx(msd.energy.damping_work(masses, v, v_new, 0.97), rel=1e-12)
