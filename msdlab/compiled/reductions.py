@@ -21,7 +21,9 @@ def finite(x, v):
     in any order, so the loop may add them on vector registers, and for a big state
     (`PARALLEL_MIN_PARTICLES`) on the threads. One loop reads both arrays: two streams at
     once read memory faster than one after the other."""
-    xs, vs = _same_size(x.ravel(), v.ravel())
+    xs, vs = x.ravel(), v.ravel()
+    if len(xs) != len(vs):  # the loop reads both up to len(xs), unchecked
+        raise ValueError("positions and velocities must have the same shape")
     zero = 0.0
     if len(x) < PARALLEL_MIN_PARTICLES:
         for i in range(len(xs)):
@@ -30,14 +32,6 @@ def finite(x, v):
         for i in numba.prange(len(xs)):
             zero += 0.0 * xs[i] + 0.0 * vs[i]
     return zero == 0.0
-
-
-@numba.njit(cache=True)
-def _same_size(xs, vs):
-    """``xs`` and ``vs``, after checking that they have as many values."""
-    if len(xs) != len(vs):
-        raise ValueError("positions and velocities must have the same shape")
-    return xs, vs
 
 
 @numba.njit(cache=True)
