@@ -13,7 +13,14 @@ The machine is shared, so the three run interleaved in batches of about
 0.15 s; a ratio is a user's batch over the engine's batch next to it, median
 and range over the repeats.
 
-    python benchmarks/user_integrator.py [--n 30] [--repeats 9]
+``--parts`` times task 5's step by parts instead: its ``dynamics.acceleration``
+and its own array operations (its ``step`` given an acceleration made before),
+each alone, plus what `Simulation.step` adds to ``msd.Verlet``'s own step
+(constraints, ledger, divergence check, storing). Their sum over ``msd.Verlet``
+is the ratio task 5 would have if its parts ran inside the step as fast as
+alone, i.e. without what they evict from each other's cache.
+
+    python benchmarks/user_integrator.py [--n 30] [--repeats 9] [--parts]
 """
 
 from __future__ import annotations
@@ -75,11 +82,65 @@ def batch_time(step: Callable[[], None], steps: int) -> float:
     return (time.perf_counter() - start) / steps
 
 
+class GivenAcceleration:
+    """Stands for `msd.Dynamics` with an acceleration (m/s²) computed before."""
+
+    def __init__(self, acceleration: np.ndarray) -> None:
+        self.given = acceleration
+
+    def acceleration(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return self.given
+
+
+def parts(n: int, repeats: int) -> None:
+    """Print where task 5's step goes, next to a whole `msd.Verlet` step (ms, medians)."""
+    engine, task5 = simulation(n, msd.Verlet(0.01)), simulation(n, task5_damped_verlet()(0.01))
+    for sim in (engine, task5):
+        sim.step()
+    body, dynamics = task5.body, task5.dynamics
+    given = GivenAcceleration(dynamics.acceleration(body.positions, body.velocities))
+    steps = max(3, round(0.15 / batch_time(engine.step, 3)))
+
+    def alone(sim: msd.Simulation, dynamics: object) -> Callable[[], object]:
+        state = (sim.body.positions, sim.body.velocities)
+        return lambda: sim.integrator.step(*state, sim.dt, dynamics)
+
+    timed = {
+        "msd.Verlet: Simulation.step": engine.step,
+        "msd.Verlet: its step alone": alone(engine, engine.dynamics),
+        "task 5: Simulation.step": task5.step,
+        "task 5: dynamics.acceleration": lambda: dynamics.acceleration(
+            body.positions, body.velocities
+        ),
+        "task 5: its array operations": alone(task5, given),
+    }
+    times: dict[str, list[float]] = {name: [] for name in timed}
+    for _ in range(repeats):
+        for name, call in timed.items():
+            times[name].append(batch_time(call, steps))
+    ms = {name: 1e3 * float(np.median(values)) for name, values in times.items()}
+    verlet = ms["msd.Verlet: Simulation.step"]
+    rest = verlet - ms["msd.Verlet: its step alone"]  # constraints, ledger, check, store
+    floor = ms["task 5: dynamics.acceleration"] + ms["task 5: its array operations"] + rest
+    print(f"{n}³ grid, {body.n_springs:,} springs, {steps} steps per batch, ms (medians)")
+    for name, value in ms.items():
+        print(f"{name:<32} {value:6.3f}")
+    print(f"{'task 5 parts + msd.Verlet rest':<32} {floor:6.3f}")
+    print(
+        f"task 5 ÷ msd.Verlet {ms['task 5: Simulation.step'] / verlet:.2f}; "
+        f"its parts timed alone {floor / verlet:.2f}"
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=30)
     parser.add_argument("--repeats", type=int, default=9)
+    parser.add_argument("--parts", action="store_true", help="split task 5's step")
     args = parser.parse_args()
+    if args.parts:
+        parts(args.n, args.repeats)
+        return
     contenders = {
         "msd.Verlet(0.01)": simulation(args.n, msd.Verlet(0.01)),
         "advance (user)": simulation(args.n, UserVerlet(0.01)),
