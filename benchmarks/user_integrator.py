@@ -18,7 +18,8 @@ and its own array operations (its ``step`` given an acceleration made before),
 each alone, plus what `Simulation.step` adds to ``msd.Verlet``'s own step
 (constraints, ledger, divergence check, storing). Their sum over ``msd.Verlet``
 is the ratio task 5 would have if its parts ran inside the step as fast as
-alone, i.e. without what they evict from each other's cache.
+alone, i.e. without what they evict from each other's cache; the array
+operations are also timed right after writing 2, 4 and 6 MiB elsewhere.
 
     python benchmarks/user_integrator.py [--n 30] [--repeats 9] [--parts]
 """
@@ -92,6 +93,19 @@ class GivenAcceleration:
         return self.given
 
 
+def timed_after(write: np.ndarray, call: Callable[[], object]) -> Callable[[], float]:
+    """``call``, after writing the whole of ``write`` (evicting that much of the cache);
+    returns the seconds ``call`` took."""
+
+    def write_then_call() -> float:
+        write.fill(1.0)
+        start = time.perf_counter()
+        call()
+        return time.perf_counter() - start
+
+    return write_then_call
+
+
 def parts(n: int, repeats: int) -> None:
     """Print where task 5's step goes, next to a whole `msd.Verlet` step (ms, medians)."""
     engine, task5 = simulation(n, msd.Verlet(0.01)), simulation(n, task5_damped_verlet()(0.01))
@@ -105,6 +119,7 @@ def parts(n: int, repeats: int) -> None:
         state = (sim.body.positions, sim.body.velocities)
         return lambda: sim.integrator.step(*state, sim.dt, dynamics)
 
+    ops = "task 5: its array operations"
     timed = {
         "msd.Verlet: Simulation.step": engine.step,
         "msd.Verlet: its step alone": alone(engine, engine.dynamics),
@@ -112,16 +127,21 @@ def parts(n: int, repeats: int) -> None:
         "task 5: dynamics.acceleration": lambda: dynamics.acceleration(
             body.positions, body.velocities
         ),
-        "task 5: its array operations": alone(task5, given),
+        ops: alone(task5, given),
     }
-    times: dict[str, list[float]] = {name: [] for name in timed}
+    written = {f"  after writing {mib} MiB": mib * 2**20 // 8 for mib in (2, 4, 6)}
+    buffer = np.zeros(max(written.values()))
+    times: dict[str, list[float]] = {name: [] for name in (*timed, *written)}
     for _ in range(repeats):
         for name, call in timed.items():
             times[name].append(batch_time(call, steps))
+        for name, size in written.items():
+            call = timed_after(buffer[:size], timed[ops])
+            times[name].append(float(np.mean([call() for _ in range(steps)])))
     ms = {name: 1e3 * float(np.median(values)) for name, values in times.items()}
     verlet = ms["msd.Verlet: Simulation.step"]
     rest = verlet - ms["msd.Verlet: its step alone"]  # constraints, ledger, check, store
-    floor = ms["task 5: dynamics.acceleration"] + ms["task 5: its array operations"] + rest
+    floor = ms["task 5: dynamics.acceleration"] + ms[ops] + rest
     print(f"{n}³ grid, {body.n_springs:,} springs, {steps} steps per batch, ms (medians)")
     for name, value in ms.items():
         print(f"{name:<32} {value:6.3f}")
