@@ -138,17 +138,21 @@ def parts(n: int, repeats: int) -> None:
         for name, size in written.items():
             call = timed_after(buffer[:size], timed[ops])
             times[name].append(float(np.mean([call() for _ in range(steps)])))
-    ms = {name: 1e3 * float(np.median(values)) for name, values in times.items()}
+    print(f"{n}³ grid, {body.n_springs:,} springs, {steps} steps per batch, ms (medians)")
+    print_parts({name: 1e3 * float(np.median(values)) for name, values in times.items()})
+
+
+def print_parts(ms: dict[str, float]) -> None:
+    """Print `parts`' times (ms) and task 5's ratio to `msd.Verlet`, whole and by parts."""
     verlet = ms["msd.Verlet: Simulation.step"]
     rest = verlet - ms["msd.Verlet: its step alone"]  # constraints, ledger, check, store
-    floor = ms["task 5: dynamics.acceleration"] + ms[ops] + rest
-    print(f"{n}³ grid, {body.n_springs:,} springs, {steps} steps per batch, ms (medians)")
+    by_parts = ms["task 5: dynamics.acceleration"] + ms["task 5: its array operations"] + rest
     for name, value in ms.items():
         print(f"{name:<32} {value:6.3f}")
-    print(f"{'task 5 parts + msd.Verlet rest':<32} {floor:6.3f}")
+    print(f"{'task 5 parts + msd.Verlet rest':<32} {by_parts:6.3f}")
     print(
         f"task 5 ÷ msd.Verlet {ms['task 5: Simulation.step'] / verlet:.2f}; "
-        f"its parts timed alone {floor / verlet:.2f}"
+        f"its parts timed alone {by_parts / verlet:.2f}"
     )
 
 
