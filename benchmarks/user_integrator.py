@@ -106,6 +106,13 @@ def timed_after(write: np.ndarray, call: Callable[[], object]) -> Callable[[], f
     return write_then_call
 
 
+VERLET_STEP = "msd.Verlet: Simulation.step"
+VERLET_ALONE = "msd.Verlet: its step alone"
+TASK5_STEP = "task 5: Simulation.step"
+TASK5_ACCELERATION = "task 5: dynamics.acceleration"
+TASK5_OPS = "task 5: its array operations"
+
+
 def parts(n: int, repeats: int) -> None:
     """Print where task 5's step goes, next to a whole `msd.Verlet` step (ms, medians)."""
     engine, task5 = simulation(n, msd.Verlet(0.01)), simulation(n, task5_damped_verlet()(0.01))
@@ -119,15 +126,12 @@ def parts(n: int, repeats: int) -> None:
         state = (sim.body.positions, sim.body.velocities)
         return lambda: sim.integrator.step(*state, sim.dt, dynamics)
 
-    ops = "task 5: its array operations"
     timed = {
-        "msd.Verlet: Simulation.step": engine.step,
-        "msd.Verlet: its step alone": alone(engine, engine.dynamics),
-        "task 5: Simulation.step": task5.step,
-        "task 5: dynamics.acceleration": lambda: dynamics.acceleration(
-            body.positions, body.velocities
-        ),
-        ops: alone(task5, given),
+        VERLET_STEP: engine.step,
+        VERLET_ALONE: alone(engine, engine.dynamics),
+        TASK5_STEP: task5.step,
+        TASK5_ACCELERATION: lambda: dynamics.acceleration(body.positions, body.velocities),
+        TASK5_OPS: alone(task5, given),
     }
     written = {f"  after writing {mib} MiB": mib * 2**20 // 8 for mib in (2, 4, 6)}
     buffer = np.zeros(max(written.values()))
@@ -136,7 +140,7 @@ def parts(n: int, repeats: int) -> None:
         for name, call in timed.items():
             times[name].append(batch_time(call, steps))
         for name, size in written.items():
-            call = timed_after(buffer[:size], timed[ops])
+            call = timed_after(buffer[:size], timed[TASK5_OPS])
             times[name].append(float(np.mean([call() for _ in range(steps)])))
     print(f"{n}³ grid, {body.n_springs:,} springs, {steps} steps per batch, ms (medians)")
     print_parts({name: 1e3 * float(np.median(values)) for name, values in times.items()})
@@ -144,14 +148,14 @@ def parts(n: int, repeats: int) -> None:
 
 def print_parts(ms: dict[str, float]) -> None:
     """Print `parts`' times (ms) and task 5's ratio to `msd.Verlet`, whole and by parts."""
-    verlet = ms["msd.Verlet: Simulation.step"]
-    rest = verlet - ms["msd.Verlet: its step alone"]  # constraints, ledger, check, store
-    by_parts = ms["task 5: dynamics.acceleration"] + ms["task 5: its array operations"] + rest
+    verlet = ms[VERLET_STEP]
+    rest = verlet - ms[VERLET_ALONE]  # constraints, ledger, check, store
+    by_parts = ms[TASK5_ACCELERATION] + ms[TASK5_OPS] + rest
     for name, value in ms.items():
         print(f"{name:<32} {value:6.3f}")
     print(f"{'task 5 parts + msd.Verlet rest':<32} {by_parts:6.3f}")
     print(
-        f"task 5 ÷ msd.Verlet {ms['task 5: Simulation.step'] / verlet:.2f}; "
+        f"task 5 ÷ msd.Verlet {ms[TASK5_STEP] / verlet:.2f}; "
         f"its parts timed alone {by_parts / verlet:.2f}"
     )
 
