@@ -131,8 +131,9 @@ def test_a_dragged_particle_follows_the_mouse_in_jupyterlab(jupyterlab, tmp_path
                 time.sleep(0.05)
             # held still: the particle comes to sit under the mouse (a busy machine
             # delivers the last mouse events and draws the frames late). A hand at rest
-            # trembles: under load the particle has stayed at the drag's last-but-one
-            # mouse position, and a later move of the mouse brings it.
+            # trembles: about once a second the mouse moves a pixel and back, which sends
+            # its position again if the drag's last move did not arrive (seen once, under
+            # load: the particle stayed at the last-but-one position for 20 s).
             last_held: list[dict] = []
             polls = itertools.count(1)
 
