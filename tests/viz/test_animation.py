@@ -4,6 +4,7 @@ import base64
 import json
 import re
 import shutil
+import subprocess
 import zlib
 
 import numpy as np
@@ -77,10 +78,22 @@ def test_mp4_without_ffmpeg_says_what_to_do(rope_run, tmp_path, monkeypatch):
     assert not (tmp_path / "rope.mp4").exists()
 
 
-@pytest.mark.skipif(shutil.which("ffmpeg") is None, reason="ffmpeg is not installed")
-def test_mp4_with_ffmpeg(rope_run, tmp_path):
-    path = viz.save_animation(rope_run, tmp_path / "rope.mp4", max_frames=4, dpi=40)
-    assert path.stat().st_size > 1000
+@pytest.mark.skipif(
+    shutil.which("ffprobe") is None, reason="ffmpeg is not installed (apt-get install ffmpeg)"
+)
+def test_mp4_with_ffmpeg_has_the_frames_at_the_pace_and_size_asked(rope_run, tmp_path):
+    path = viz.save_animation(rope_run, tmp_path / "rope.mp4", max_frames=4, fps=10, dpi=40)
+    streams = "stream=nb_read_frames,width,r_frame_rate"
+    probe = subprocess.run(
+        ["ffprobe", "-v", "error", "-count_frames", "-show_entries", streams, "-of", "json", path],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    (stream,) = json.loads(probe.stdout)["streams"]
+    assert int(stream["nb_read_frames"]) == 4
+    assert stream["r_frame_rate"] == "10/1"
+    assert stream["width"] == 320  # 640 px at the default 80 dpi
 
 
 def test_unknown_file_type_names_the_formats(rope_run, tmp_path):
