@@ -7,8 +7,9 @@ any other value is a Dask scheduler's address (``tcp://host:8786``), whose
 result or, after its retries, its error, in the order of the calls:
 
 - a call that raises runs again, up to ``retries`` times;
-- a local process that dies (killed, out of memory) breaks its pool: the calls it was
-  running count one attempt each and run again in a new pool;
+- a local process that dies (killed, out of memory) breaks its pool, and every call the
+  pool was running fails with it: those calls run again one at a time in a new pool, so
+  the call that kills its worker is known, and only it counts an attempt;
 - on Dask the scheduler does both (``retries`` for errors, and a worker that dies makes it
   run the call on another one; a call that keeps killing workers ends in ``KilledWorker``).
 """
@@ -91,12 +92,37 @@ def run_all(
             with dask_executor(address, retries) as pool:
                 collect(pool, function, calls, range(len(calls)), finished, retries=0)
         else:
-            attempts: Counter[int] = Counter()
-            while len(results) < len(calls):
-                left = [i for i in range(len(calls)) if i not in results]
-                with ProcessPoolExecutor(workers, mp_context=_START) as pool:
-                    collect(pool, function, calls, left, finished, retries, attempts, workers)
+            run_locally(workers, function, calls, results, finished, retries)
     return [results[i] for i in range(len(calls))]
+
+
+def run_locally(
+    workers: int,
+    function: Callable[..., Any],
+    calls: Sequence[Call],
+    results: dict[int, Any],
+    finished: Done,
+    retries: int,
+) -> None:
+    """Run the calls not in ``results`` on ``workers`` local processes (see the module
+    docstring): a pool that breaks is replaced, and the calls it was running (suspects)
+    then run one at a time, before the others go on side by side."""
+    attempts: Counter[int] = Counter()
+    suspects: set[int] = set()
+    while len(results) < len(calls):
+        left = [i for i in range(len(calls)) if i not in results]
+        alone = [i for i in left if i in suspects]
+        with ProcessPoolExecutor(workers, mp_context=_START) as pool:
+            in_flight = 1 if alone else workers
+            ran, error = collect(
+                pool, function, calls, alone or left, finished, retries, attempts, in_flight
+            )
+        if len(ran) > 1:  # which of them broke the pool is not known
+            suspects.update(ran)
+        elif ran:  # it ran alone: its worker died running it
+            attempts[ran[0]] += 1
+            if attempts[ran[0]] > retries:
+                finished(ran[0], error)
 
 
 def collect(
@@ -108,10 +134,10 @@ def collect(
     retries: int,
     attempts: Counter[int] | None = None,
     in_flight: int | None = None,
-) -> None:
+) -> tuple[list[int], BrokenProcessPool | None]:
     """Run the calls at ``indices`` on ``pool``, at most ``in_flight`` at a time, calling
-    ``finished`` with each outcome; returns early if the pool breaks (its unfinished calls
-    are then left for a new pool, those it was running with one attempt more)."""
+    ``finished`` with each outcome (a call that raises runs again, up to ``retries``
+    times). If the pool breaks, return at once the calls it was running and its error."""
     attempts = Counter() if attempts is None else attempts
     waiting = list(reversed(indices))
     running: dict[Future, int] = {}
@@ -124,16 +150,12 @@ def collect(
         for future in ended:
             index = running.pop(future)
             error = future.exception()
+            if isinstance(error, BrokenProcessPool):
+                return [index, *running.values()], error
             if error is not None:
                 attempts[index] += 1
-            if isinstance(error, BrokenProcessPool):
-                for other in running.values():
-                    attempts[other] += 1
-                for i in (index, *running.values()):
-                    if attempts[i] > retries:
-                        finished(i, error)
-                return
             if error is not None and attempts[index] <= retries:
                 waiting.append(index)
             else:
                 finished(index, future.result() if error is None else error)
+    return [], None

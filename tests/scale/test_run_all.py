@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import os
 import signal
+import time
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 import pytest
@@ -30,6 +32,19 @@ def always_dies(x: int) -> int:
 
 def _one_killer(x: int) -> int:
     return always_dies(x) if x == 1 else square(x)
+
+
+def kills_beside(x: int, started: str) -> int:
+    """Call 0 kills its worker once another call has started (so that one is running when
+    the pool breaks); the others take half a second."""
+    if x != 0:
+        Path(started).touch()
+        time.sleep(0.5)
+        return x * x
+    deadline = time.monotonic() + 10.0
+    while not Path(started).exists() and time.monotonic() < deadline:
+        time.sleep(0.01)
+    return always_dies(x)
 
 
 def refuses_two(x: int) -> int:
@@ -64,6 +79,15 @@ def test_a_call_that_always_kills_its_worker_gets_its_error_and_the_rest_their_r
     outcomes = run_all("local:2", _one_killer, calls, label="killer", retries=1)
     assert outcomes[0] == 0 and outcomes[2] == 4
     assert "process" in str(outcomes[1]).lower(), outcomes[1]
+
+
+@pytest.mark.parametrize("retries", [0, 1, 2])
+def test_calls_running_beside_a_killer_are_not_charged_its_deaths(tmp_path, retries):
+    """Each time call 0 kills its worker, call 1 is running in the same pool."""
+    calls = [((x,), {"started": str(tmp_path / "started")}) for x in range(3)]
+    outcomes = run_all("local:2", kills_beside, calls, label="beside", retries=retries)
+    assert isinstance(outcomes[0], BrokenProcessPool)
+    assert outcomes[1:] == [1, 4]
 
 
 def test_a_call_that_raises_is_run_again(tmp_path: Path) -> None:
