@@ -112,17 +112,18 @@ def run_locally(
     while len(results) < len(calls):
         left = [i for i in range(len(calls)) if i not in results]
         alone = [i for i in left if i in suspects]
+        in_flight = 1 if alone else workers
         with ProcessPoolExecutor(workers, mp_context=_START) as pool:
-            in_flight = 1 if alone else workers
             ran, error = collect(
                 pool, function, calls, alone or left, finished, retries, attempts, in_flight
             )
         if len(ran) > 1:  # which of them broke the pool is not known
             suspects.update(ran)
         elif ran:  # it ran alone: its worker died running it
-            attempts[ran[0]] += 1
-            if attempts[ran[0]] > retries:
-                finished(ran[0], error)
+            (culprit,) = ran
+            attempts[culprit] += 1
+            if attempts[culprit] > retries:
+                finished(culprit, error)
 
 
 def collect(
