@@ -9,7 +9,7 @@ from typing import Any, Generic, TypeVar
 
 import numpy as np
 
-from .errors import as_vectors, check_non_negative, check_positive
+from .errors import as_vectors, check_non_negative, check_positive, shown
 from .lattice import GridSprings, grid_pair_blocks, grid_positions, neighbour_offsets
 from .particle import Particle
 from .spring import Spring
@@ -133,7 +133,7 @@ class Body:
 
     def __init__(self, dim: int | None = None) -> None:
         if dim not in (None, 2, 3):
-            raise ValueError(f"a body is 2-D or 3-D, got dim = {dim!r}")
+            raise ValueError(f"a body is 2-D or 3-D, got dim = {shown(dim)}")
         self.dim = dim
         self.grid_shape: tuple[int, ...] | None = None
         self.topology_version = 0  # grows whenever particles or springs are added

@@ -21,11 +21,20 @@ class SimulationDiverged(RuntimeError):
         super().__init__(f"simulation diverged in step {step} (t = {time:.6g} s): {diagnosis}")
 
 
+def shown(value: object) -> str:
+    """``value`` as an error message shows it: numbers and arrays plainly (``-5.0``,
+    ``[0.0, -9.81]``), never as numpy reprs such as ``np.float64(-5.0)``."""
+    if isinstance(value, (np.generic, np.ndarray)):
+        value = value.tolist()
+    return repr(value)
+
+
 def check_positive(name: str, value: float, hint: str = "") -> float:
     """``value`` as a float if it is finite and > 0, else ValueError."""
     number = float(value)
     if not math.isfinite(number) or number <= 0:
-        raise ValueError(f"{name} must be a positive finite number, got {value!r}. {hint}".strip())
+        message = f"{name} must be a positive finite number, got {shown(value)}."
+        raise ValueError(f"{message} {hint}".strip())
     return number
 
 
@@ -40,7 +49,7 @@ def check_non_negative(
         first = int(np.flatnonzero(bad)[0])
         where = f" at index {first}" if array.ndim else ""
         rule = ">= 0" if zero else "> 0"
-        message = f"{name} must be finite and {rule}, got {array.ravel()[first]!r}{where}."
+        message = f"{name} must be finite and {rule}, got {shown(array.ravel()[first])}{where}."
         raise ValueError(f"{message} {hint}".strip())
     return array
 

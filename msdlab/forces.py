@@ -9,7 +9,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .body import Body
-from .errors import check_non_negative
+from .errors import check_non_negative, shown
 
 
 class Force(ABC):
@@ -60,7 +60,7 @@ class Gravity(Force):
     def __init__(self, g: Sequence[float] = (0.0, -9.81, 0.0)) -> None:
         self.g = np.asarray(g, dtype=float)
         if self.g.ndim != 1 or len(self.g) not in (2, 3) or not np.all(np.isfinite(self.g)):
-            raise ValueError(f"gravity must be a finite 2- or 3-vector in m/s², got {g!r}")
+            raise ValueError(f"gravity must be a finite 2- or 3-vector in m/s², got {shown(g)}")
 
     def check(self, body: Body) -> None:
         if len(self.g) != body.dim:

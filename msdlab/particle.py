@@ -5,13 +5,15 @@ from __future__ import annotations
 import numpy as np
 
 from .bound import Bound, Field
-from .errors import check_finite_array, check_positive
+from .errors import check_finite_array, check_positive, shown
 
 
 def _coordinates(value: object) -> np.ndarray:
     vector = np.array(value, dtype=float)
     if vector.ndim != 1 or len(vector) not in (2, 3):
-        raise ValueError(f"a particle position or velocity needs 2 or 3 coordinates, got {value!r}")
+        raise ValueError(
+            f"a particle position or velocity needs 2 or 3 coordinates, got {shown(value)}"
+        )
     check_finite_array("particle position and velocity", vector[None])
     return vector
 

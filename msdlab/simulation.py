@@ -15,7 +15,7 @@ from .body import Body
 from .constraint import Constraint, StepState
 from .dynamics import Dynamics
 from .energy import EnergyLedger, kinetic_energy
-from .errors import SimulationDiverged, check_finite_array, check_positive
+from .errors import SimulationDiverged, check_finite_array, check_positive, shown
 from .forces import Force
 from .integrators import Integrator, Verlet
 from .stability import describe_blowup
@@ -48,9 +48,10 @@ class Simulation:
 
     ``forces`` holds `Force` objects (gravity, contact, ...) and `Constraint`
     objects (ground, drag, walls, ...), applied in the given order after each
-    integrator step. Each step keeps the fixed particles in place, keeps an energy
-    ledger, and raises `SimulationDiverged` in the step where the state stops
-    being finite or a spring is stretched past ``max_stretch`` times its rest length.
+    integrator step; one of them alone needs no list. Each step keeps the fixed
+    particles in place, keeps an energy ledger, and raises `SimulationDiverged` in the
+    step where the state stops being finite or a spring is stretched past
+    ``max_stretch`` times its rest length.
     ``kernel`` picks the spring kernel, "numba" or "numpy" (see `Dynamics`).
     ``ledger=False`` skips booking the energy each mechanism takes out (its cost
     matters for small bodies in contact); frames still record the energies, and
@@ -62,7 +63,7 @@ class Simulation:
         body: Body,
         integrator: Integrator | None = None,
         dt: float = 1e-3,
-        forces: Sequence[Force | Constraint] = (),
+        forces: Force | Constraint | Sequence[Force | Constraint] = (),
         *,
         max_stretch: float | None = 100.0,
         kernel: str | None = None,
@@ -91,15 +92,16 @@ class Simulation:
         self.ledger = ledger
         self.constraints: list[Constraint] = []
         field_forces: list[Force] = []
-        for item in forces:
+        for item in _as_list(forces):
             if isinstance(item, Force):
                 field_forces.append(item)
             elif isinstance(item, Constraint):
                 self.constraints.append(item)
             else:
                 raise TypeError(
-                    f"{item!r} is neither a msdlab.Force (Gravity, SphereContact, ...) "
-                    "nor a msdlab.Constraint (Ground, Drag, Walls, ...)"
+                    f"forces holds a {type(item).__name__}, which is neither a msdlab.Force "
+                    "(Gravity, SphereContact, ...) nor a msdlab.Constraint (Ground, Drag, "
+                    "Walls, ...)"
                 )
             item.check(body)
         self.dynamics = Dynamics(body, field_forces, kernel=kernel)
@@ -212,7 +214,7 @@ class Simulation:
         """
         steps = self._count_steps(steps, duration)
         if isinstance(record_every, bool) or not isinstance(record_every, int) or record_every < 1:
-            raise ValueError(f"record_every must be an integer >= 1, got {record_every!r}")
+            raise ValueError(f"record_every must be an integer >= 1, got {shown(record_every)}")
         start = dict(self.dissipated)
         ledger = EnergyLedger()
         frames: list[tuple[int, float, np.ndarray, np.ndarray | None]] = []
@@ -259,7 +261,7 @@ class Simulation:
                 )
             return round(duration / self.dt)
         if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 0:
-            raise ValueError(f"steps must be an integer >= 0, got {steps!r}")
+            raise ValueError(f"steps must be an integer >= 0, got {shown(steps)}")
         return int(steps)
 
     def _energy(self, x: np.ndarray, v: np.ndarray, particles: np.ndarray) -> float:
@@ -306,3 +308,16 @@ class Simulation:
             f"<Simulation {self.body!r}, {self.integrator!r}, dt={self.dt:g} s, "
             f"t={self.time:g} s, forces={items}>"
         )
+
+
+def _as_list(forces: object) -> list:
+    """The ``forces`` argument as a list; one force or constraint alone is a list of one."""
+    if isinstance(forces, (Force, Constraint)):
+        return [forces]
+    try:
+        return list(forces)
+    except TypeError:
+        raise TypeError(
+            "forces must be a list of msdlab.Force and msdlab.Constraint objects, e.g. "
+            f"[msd.Gravity((0, -9.81, 0)), msd.Ground()], got a {type(forces).__name__}"
+        ) from None

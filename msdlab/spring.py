@@ -9,7 +9,7 @@ import numpy as np
 
 from . import equations
 from .bound import Bound, Field
-from .errors import check_non_negative, check_positive
+from .errors import check_non_negative, check_positive, shown
 
 
 def _stiffness(value: float) -> float:
@@ -57,7 +57,7 @@ class Spring(Bound):
             self._own.update(a=operator.index(a), b=operator.index(b))
         except TypeError:
             raise TypeError(
-                f"a spring joins two particle indices (int), got {a!r} and {b!r}; "
+                f"a spring joins two particle indices (int), got {shown(a)} and {shown(b)}; "
                 "use the value returned by body.add_particle(...)"
             ) from None
         if a == b:

@@ -140,3 +140,36 @@ def test_whole_array_assignments_and_spring_values_are_checked():
     with pytest.raises(AttributeError, match="read-only"):
         body.spring_a = [1]
     assert body.stiffness[0] == 5.0 and body.n_springs == 1  # nothing changed by the failures
+
+
+def test_a_single_force_needs_no_list_and_a_wrong_one_is_named():
+    alone = msd.Simulation(body_2d(), msd.Verlet(), dt=0.1, forces=msd.Gravity((0, -9.81)))
+    listed = msd.Simulation(body_2d(), msd.Verlet(), dt=0.1, forces=[msd.Gravity((0, -9.81))])
+    alone.run(steps=3)
+    listed.run(steps=3)
+    assert np.array_equal(alone.body.positions, listed.body.positions)
+    assert len(alone.forces) == 1
+    with pytest.raises(TypeError, match=r"forces must be a list .* got a float"):
+        msd.Simulation(body_2d(), msd.Verlet(), dt=0.1, forces=9.81)
+    with pytest.raises(TypeError, match=r"forces holds a ndarray, which is neither"):
+        msd.Simulation(body_2d(), msd.Verlet(), dt=0.1, forces=[np.array([0, -9.81])])
+
+
+@pytest.mark.parametrize(
+    ("make", "plain"),
+    [
+        (lambda: msd.Body.grid((2, 2), spacing=0.1, stiffness=np.float64(-5.0)), "got -5.0."),
+        (lambda: msd.Body.grid((2, 2), spacing=0.1, stiffness=-5.0), "got -5.0."),
+        (lambda: msd.Simulation(body_2d(), dt=np.float64(-0.1)), "got -0.1."),
+        (lambda: msd.Gravity(np.array([0.0, np.nan])), "got [0.0, nan]"),
+        (lambda: msd.Simulation(body_2d(), dt=0.1).run(steps=np.int64(-2)), "got -2"),
+        (lambda: msd.Particle(position=np.array([1.0])), "got [1.0]"),
+        (lambda: msd.Spring(np.float64(0.5), 1), "got 0.5 and 1"),
+    ],
+)
+def test_numbers_in_messages_are_plain_not_numpy_reprs(make, plain):
+    with pytest.raises((ValueError, TypeError)) as raised:
+        make()
+    message = str(raised.value)
+    assert plain in message
+    assert "np." not in message and "array(" not in message
