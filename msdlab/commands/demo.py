@@ -56,10 +56,16 @@ def run(args: argparse.Namespace) -> int:
         view=scene.view,
         up=scene.up,
         time_unit=scene.unit,
+        energy_unit=scene.energy_unit,
         title="jelly cube",
     )
     energy_plot = args.out / "demo_energy.png"
-    figure = plot_energy(trajectory.energies, time_unit=scene.unit, save=energy_plot)
+    figure = plot_energy(
+        trajectory.energies,
+        time_unit=scene.unit,
+        energy_unit=scene.energy_unit,
+        save=energy_plot,
+    )
     plt.close(figure)
     print(f"animation:   {animation.resolve()}")
     print(f"energy plot: {energy_plot.resolve()}")

@@ -22,6 +22,7 @@ class Scene:
     view: tuple[float, float] = (45.0, 30.0)  # azimuth, elevation (degrees) of 3-D views
     up: str = "z"  # the vertical axis
     unit: str = "s"  # of time
+    energy_unit: str = "J"
     colour: str = "strain"  # what the springs' colour shows in animations: strain or sag
 
     def settings(self) -> dict[str, object]:
@@ -48,7 +49,9 @@ SCENES: dict[str, Scene] = {
             frames=60,
             view=(-30.0, 20.0),
             up="y",
-            unit="s",  # the template's units read as SI: s, m, kg, so energies in J
+            # the template's own units: dt = 0.4 and g = -0.001 are not seconds and m/s²
+            unit="template units",
+            energy_unit="template units",
         ),
         Scene(
             "trampoline",

@@ -33,7 +33,12 @@ def plot_scene(scene: Scene, sim: Simulation, **options: Any) -> Figure:
 def save_scene_animation(
     scene: Scene, sim: Simulation, run: Trajectory, path: str | Path, **options: Any
 ) -> Path:
-    """`save_animation` of ``run`` (a run of ``sim``) as ``scene`` is drawn, with its time
-    unit and number of frames (``options`` override)."""
-    drawn = {**scene_options(scene, sim), "time_unit": scene.unit, "max_frames": scene.frames}
+    """`save_animation` of ``run`` (a run of ``sim``) as ``scene`` is drawn, with its units
+    of time and energy and number of frames (``options`` override)."""
+    drawn = {
+        **scene_options(scene, sim),
+        "time_unit": scene.unit,
+        "energy_unit": scene.energy_unit,
+        "max_frames": scene.frames,
+    }
     return save_animation(run, path, **{**drawn, **options})

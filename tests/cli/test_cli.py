@@ -2,12 +2,14 @@
 
 import io
 import os
+import re
 import subprocess
 import sys
 import time
 
 import pytest
 from matplotlib.animation import FFMpegWriter
+from matplotlib.text import Text
 from PIL import Image
 
 from msdlab.cli import main
@@ -121,6 +123,20 @@ def test_demo_writes_animation_and_plot(tmp_path, capsys):
     for name in ("demo.gif", "demo_energy.png"):
         assert (tmp_path / name).stat().st_size > 1000
         assert str((tmp_path / name).resolve()) in out
+
+
+def test_demo_names_the_template_units_not_seconds_and_joules(tmp_path, capsys, monkeypatch):
+    """The demo runs the brief's setting (dt = 0.4, g = -0.001 in the template's units): its
+    animation's clock and energy plot must not claim seconds or joules."""
+    shown: list[str] = []
+    set_text = Text.set_text
+    monkeypatch.setattr(Text, "set_text", lambda self, s: (shown.append(str(s)), set_text(self, s)))
+    args = ["demo", "--out", str(tmp_path), "--size", "3", "--steps", "10", "--frames", "2"]
+    assert main(args) == 0
+    assert "time (template units)" in shown and "energy (template units)" in shown
+    titles = [text for text in shown if text.startswith("jelly cube")]
+    assert titles and all(re.search(r"t = [\d.]+ template units", t) for t in titles)
+    assert not [t for t in shown if re.search(r"\(s\)|\(J\)| J$|t = [\d.]+ s\b", t)]
 
 
 def test_progress_bar_only_for_runs_that_take_a_moment():
