@@ -91,3 +91,15 @@ def test_saved_outputs_keep_the_text_joined_and_drop_pictures():
     assert [dict(output) for output in cell.outputs] == [
         {"output_type": "stream", "name": "stdout", "text": "1\n2\n"}
     ]
+
+
+def test_jupyterlabs_checkpoints_are_not_left_untracked():
+    """Opening a notebook in JupyterLab writes notebooks/.ipynb_checkpoints/: git ignores it."""
+    import shutil
+    import subprocess
+
+    if shutil.which("git") is None or not (ROOT / ".git").exists():
+        pytest.skip("not a git checkout")
+    checkpoint = "notebooks/.ipynb_checkpoints/task2-checkpoint.ipynb"
+    ignored = subprocess.run(["git", "check-ignore", "-q", checkpoint], cwd=ROOT)
+    assert ignored.returncode == 0, f"git would list {checkpoint} as untracked"
