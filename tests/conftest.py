@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import PurePosixPath
 
 import pytest
@@ -9,6 +10,17 @@ from hypothesis import settings
 
 settings.register_profile("ci", deadline=None, max_examples=50, print_blob=True)
 settings.load_profile("ci")
+
+
+@pytest.hookimpl(tryfirst=True)  # before the course plugin reads the choice
+def pytest_configure(config: pytest.Config) -> None:
+    """The project's tests check the reference answers: the course checks run in this
+    process (tests/tasks) are asked for solutions/ unless --impl or $MSDLAB_IMPL chose."""
+    if config.pluginmanager.hasplugin("msdlab") and not (
+        config.getoption("impl") or os.environ.get("MSDLAB_IMPL")
+    ):
+        config.option.impl = "solutions"
+
 
 # Folders whose test files share a session fixture: the built docs site, a Dask scheduler.
 SHARED = {"tests/docs", "tests/scale"}

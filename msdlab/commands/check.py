@@ -1,7 +1,8 @@
 """``msdlab check [TASK]``: run the checks of one task (or all) on your task files and score them.
 
 The checks (tests/tasks) run in a fresh pytest process on a folder laid out
-like assignments/ (default: ./assignments, else the course's assignments/); each
+like assignments/ (default: your assignments/; the reference answers only when
+asked: --impl solutions or MSDLAB_IMPL=solutions); each
 call into your files may take --call-timeout seconds. The table shows each
 check, its points, pass or fail and what the check saw (a long message once,
 below it); the last line says what the hidden checks, which run only when your
@@ -16,6 +17,7 @@ import tempfile
 from pathlib import Path
 
 from ..course import TASKS, manifest
+from ..course.loader import ENV_IMPL
 from ..course.report import CheckReport
 from ..course.runner import (
     CALL_TIMEOUT,
@@ -23,6 +25,7 @@ from ..course.runner import (
     ChecksDidNotRun,
     checks_folder,
     implementation_folder,
+    implementation_spec,
     install_command,
     missing_test_tools,
     run_checks,
@@ -43,8 +46,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--impl",
         default=None,
-        help="folder with your task1.py ... task5.py, or 'assignments' / 'solutions' "
-        "(default: ./assignments if it exists, else the course's assignments/)",
+        help="folder with your task1.py ... task5.py, or 'assignments' / 'solutions' (default: "
+        "$MSDLAB_IMPL, else the assignments/ of the course folder you are in)",
     )
     parser.add_argument(
         "--checks",
@@ -80,7 +83,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"  {install_command(Path.cwd())}")
         return 2
     checks = checks_folder(args.checks, Path.cwd())
-    folder = implementation_folder(args.impl, Path.cwd())
+    spec = implementation_spec(args.impl)
+    folder = implementation_folder(spec, Path.cwd())
     hidden = args.hidden
     if hidden and not any(checks.glob(HIDDEN_FILES)):
         print("The hidden checks are not in this copy of the course: they run when your work")
@@ -88,6 +92,8 @@ def run(args: argparse.Namespace) -> int:
         hidden = False
     scope = f"task {task}" if task else "all tasks"
     print(f"msdlab check: {scope} on {folder}")
+    if spec == "solutions":
+        print(f"  (the reference answers, not your task files: asked by --impl or ${ENV_IMPL})")
     with tempfile.TemporaryDirectory(prefix="msdlab-check-") as scratch:
         points = Path(scratch) / manifest.FILE_NAME
         try:

@@ -5,6 +5,8 @@ is `msdlab.instructor`, which the student bundle does not contain.)
 
 - `loader`: load the task modules of a submission (a folder laid out like ``assignments/``).
 - `feedback`: the physics messages of failing checks.
+- `failure`: a failure in the course's words: the line of the task file that raised, the
+  input a property check failed on.
 - `oracles`: what the public checks compare with besides the engine (the template's loop,
   energies, engine-made variants of typical mistakes); no answers.
 - `runner`: run the checks in a fresh pytest process (``msdlab check``, the notebooks).

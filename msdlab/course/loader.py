@@ -22,6 +22,8 @@ from typing import Any, Protocol
 from . import call_limit
 
 NAMED = ("solutions", "assignments")
+ENV_IMPL = "MSDLAB_IMPL"
+"""The environment variable that names the task files to check when ``--impl`` does not."""
 
 
 class SubmissionError(Exception):
@@ -117,9 +119,17 @@ def resolve(spec: str | Path, root: Path) -> Path:
     return Path(text).expanduser().resolve()
 
 
-def default_spec(root: Path) -> str:
-    """'solutions' where the course root has them (an instructor's checkout), else 'assignments'."""
-    return "solutions" if (root / "solutions").is_dir() else "assignments"
+DEFAULT = "assignments"
+"""The task files checked when nothing asks for others: the student's, even in a checkout that
+holds ``solutions/`` (the reference answers are checked only when asked: ``--impl solutions``,
+``$MSDLAB_IMPL``)."""
+
+
+def describe(spec: str | Path) -> str:
+    """How outputs name an ``--impl`` value: the reference answers say that they are."""
+    if str(spec) == "solutions":
+        return "solutions (the reference answers, not your task files)"
+    return str(spec)
 
 
 def course_root(start: Path) -> Path:

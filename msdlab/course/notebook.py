@@ -10,9 +10,10 @@
         a = task2.spring_acceleration(x, spacing, stiffness)
     course.check(2)  # the checks of task 2, with their messages
 
-The task files are those of ``Course(spec)``, else of ``$MSDLAB_IMPL``, else
-``solutions/`` where the course folder has them (an instructor's checkout) and
-``assignments/`` where it does not (a student's bundle), as for ``pytest --impl``.
+The task files are those of ``Course(spec)``, else of ``$MSDLAB_IMPL``, else the
+student's ``assignments/`` (even in a checkout that holds ``solutions/``), as for
+``pytest --impl`` and ``msdlab check``; `Course.label` says when they are the reference
+answers.
 """
 
 from __future__ import annotations
@@ -74,7 +75,7 @@ class Course:
 
     def __init__(self, spec: str | None = None, start: Path | None = None) -> None:
         self.root = loader.course_root(Path.cwd() if start is None else start)
-        self.spec = spec or os.environ.get(ENV_IMPL) or loader.default_spec(self.root)
+        self.spec = spec or os.environ.get(ENV_IMPL) or loader.DEFAULT
         self.folder = loader.resolve(self.spec, self.root)
         if not self.folder.is_dir():
             raise loader.SubmissionError(
@@ -85,12 +86,13 @@ class Course:
 
     @property
     def label(self) -> str:
-        """The task files' folder as the user would name it."""
-        return self.spec if self.spec in loader.NAMED else self._shown(self.folder)
+        """The task files' folder as the user would name it ('solutions' says that they are
+        the reference answers)."""
+        return loader.describe(self.spec if self.spec in loader.NAMED else self._shown(self.folder))
 
     def task(self, number: int) -> LiveTask:
         """Task ``number``'s file of this course's implementation."""
-        return LiveTask(self.folder, number, self.label)
+        return LiveTask(self.folder, number, self._shown(self.folder))
 
     @contextmanager
     def attempt(self) -> Iterator[None]:
@@ -160,7 +162,7 @@ class Course:
                 name = getattr(code, "co_qualname", code.co_name)  # co_qualname: Python 3.11+
                 where = f"{name} ({self._shown(path)})"
             tb = tb.tb_next
-        return where or self.label
+        return where or self._shown(self.folder)
 
     def _todo(self, number: int, where: str, todo: str) -> str:
         """The note on an unwritten function: in full the first time, then one line."""

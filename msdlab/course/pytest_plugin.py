@@ -1,9 +1,9 @@
 """pytest plugin of the course checks (registered as the ``pytest11`` entry point ``msdlab``).
 
 - ``--impl=solutions|assignments|PATH`` chooses the implementation under test
-  (fallback: the ``MSDLAB_IMPL`` environment variable; default: ``solutions``
-  where the course root has them, else ``assignments``). PATH is a folder laid
-  out like ``assignments/``.
+  (fallback: the ``MSDLAB_IMPL`` environment variable; default: ``assignments``,
+  the student's files, even where the course root holds ``solutions/``). PATH is a
+  folder laid out like ``assignments/``. The header names the files under test.
 - Fixtures ``implementation`` (see `msdlab.course.loader`) and ``task1`` ...
   ``task5`` (the task modules). Override ``implementation`` in a conftest to
   load submissions another way.
@@ -31,10 +31,10 @@ from typing import Any
 
 import pytest
 
-from . import TASKS, call_limit, delegation, loader, manifest
+from . import TASKS, call_limit, delegation, failure, loader, manifest
 from .report import CheckReport, CheckResult
 
-ENV_IMPL = "MSDLAB_IMPL"
+ENV_IMPL = loader.ENV_IMPL
 _REPORT = pytest.StashKey[CheckReport]()
 _STARTED = pytest.StashKey[float]()
 _GRADED = pytest.StashKey[tuple[int, int, bool]]()
@@ -61,7 +61,7 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         default=None,
         metavar="IMPL",
         help="implementation under test: 'solutions', 'assignments' or a folder laid out "
-        f"like assignments/ (default: ${ENV_IMPL}, else solutions where they exist)",
+        f"like assignments/ (default: ${ENV_IMPL}, else {loader.DEFAULT})",
     )
     group.addoption(
         "--allow-delegation",
@@ -103,8 +103,12 @@ def pytest_configure(config: pytest.Config) -> None:
 
 def implementation_spec(config: pytest.Config) -> str:
     """The ``--impl`` value in force: the option, else $MSDLAB_IMPL, else the default."""
-    spec = config.getoption("impl") or os.environ.get(ENV_IMPL)
-    return spec or loader.default_spec(loader.course_root(config.rootpath))
+    return config.getoption("impl") or os.environ.get(ENV_IMPL) or loader.DEFAULT
+
+
+def pytest_report_header(config: pytest.Config) -> str:
+    """'msdlab: checking ...' at the top of pytest's output: whose task files are checked."""
+    return f"msdlab: checking the task files of {loader.describe(implementation_spec(config))}"
 
 
 @pytest.fixture(scope="session")
@@ -225,7 +229,7 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo):
         result.outcome, result.message = "skipped", _skip_reason(report)
     elif report.failed:
         result.outcome = "failed" if report.when == "call" else "error"
-        result.exception, result.message = _describe(call)
+        result.exception, result.message = _describe(call, _task_folder(item))
     elif report.when == "call":
         result.outcome = "passed"
 
@@ -249,9 +253,8 @@ def pytest_terminal_summary(terminalreporter, config: pytest.Config) -> None:
         earned, points = sum(c.earned for c in checks), sum(c.points for c in checks)
         parts.append(f"task{number} {earned}/{points}")
     terminalreporter.write_sep("-", "msdlab points")
-    terminalreporter.write_line(
-        f"{report.implementation}: {report.earned}/{report.points} points ({', '.join(parts)})"
-    )
+    earned = f"{report.earned}/{report.points} points ({', '.join(parts)})"
+    terminalreporter.write_line(f"{loader.describe(report.implementation)}: {earned}")
 
 
 def _result(item: pytest.Item, graded: tuple[int, int, bool]) -> CheckResult:
@@ -261,19 +264,23 @@ def _result(item: pytest.Item, graded: tuple[int, int, bool]) -> CheckResult:
     return CheckResult(item.nodeid, name, task, points, hidden, outcome="error")
 
 
-def _describe(call: pytest.CallInfo) -> tuple[str | None, str]:
-    """The exception's type name and its message (with notes such as a falsifying example)."""
+def _describe(call: pytest.CallInfo, folder: Path | None) -> tuple[str | None, str]:
+    """The exception's type name and its message in the course's words: where in the task
+    files of ``folder`` it was raised, and the input a property check failed on."""
     if call.excinfo is None:
         return None, ""
     error = call.excinfo.value
     lines = [str(error).strip()] if str(error).strip() else []
     if not isinstance(error, (NotImplementedError, call_limit.CallTimedOut)):
-        lines += [  # hypothesis's failing example; its other notes name lines of the checks
-            str(note)
-            for note in getattr(error, "__notes__", ())
-            if str(note).startswith(("Falsifying example", "Failing test case"))
-        ]
-    return type(error).__name__, "\n".join(lines)
+        lines.append(failure.raised_in(error, folder))
+        lines += [failure.failing_inputs(str(note)) for note in getattr(error, "__notes__", ())]
+    return type(error).__name__, "\n".join(line for line in lines if line)
+
+
+def _task_folder(item: pytest.Item) -> Path | None:
+    """The folder of the task files under test, where they run in this process."""
+    implementation = getattr(item, "funcargs", {}).get("implementation")
+    return getattr(implementation, "folder", None)
 
 
 def _skip_reason(report: pytest.TestReport) -> str:

@@ -19,6 +19,8 @@ from . import PROJECT_ROOT, TASKS, loader
 from .report import CheckReport
 
 CHECKS = Path("tests") / "tasks"
+PLUGINS = ("msdlab.course.pytest_plugin", "_hypothesis_pytestplugin")
+"""The pytest plugins the checks run with: the course's and Hypothesis'."""
 CALL_TIMEOUT = 10.0
 """Seconds one call into a task file may take by default (`call_limit`); the slowest call the
 reference solutions make takes well under a second."""
@@ -63,7 +65,14 @@ def run_checks(
             process = subprocess.run(
                 command,
                 cwd=checks,
-                env={"MSDLAB_KERNEL": "numpy", **os.environ, "PYTHONDONTWRITEBYTECODE": "1"},
+                env={
+                    "MSDLAB_KERNEL": "numpy",
+                    **os.environ,
+                    "PYTHONDONTWRITEBYTECODE": "1",
+                    # only the plugins the checks use (`PLUGINS`): the others installed
+                    # beside them (xdist, anyio, nbval, ...) cost a second to load
+                    "PYTEST_DISABLE_PLUGIN_AUTOLOAD": "1",
+                },
                 capture_output=True,
                 text=True,
                 timeout=timeout,
@@ -109,12 +118,14 @@ def checks_folder(given: Path | None, cwd: Path) -> Path:
     return folder
 
 
-def implementation_folder(spec: str | None, cwd: Path) -> Path:
-    """The folder of task files to check; a student's ./assignments comes first."""
-    if spec is None:
-        local = loader.course_root(cwd) / "assignments"
-        folder = local if local.is_dir() else PROJECT_ROOT / "assignments"
-    elif spec in loader.NAMED:
+def implementation_spec(given: str | None) -> str:
+    """The task files asked for: ``given``, else ``$MSDLAB_IMPL``, else the student's."""
+    return given or os.environ.get(loader.ENV_IMPL) or loader.DEFAULT
+
+
+def implementation_folder(spec: str, cwd: Path) -> Path:
+    """The folder of task files ``spec`` names; the course folder ``cwd`` is in comes first."""
+    if spec in loader.NAMED:
         local = loader.course_root(cwd) / spec
         folder = local if local.is_dir() else PROJECT_ROOT / spec
     else:
@@ -128,22 +139,26 @@ def implementation_folder(spec: str | None, cwd: Path) -> Path:
 def pytest_command(
     checks: Path, folder: Path, task: int | None, hidden: bool, report: Path, verbose: bool
 ) -> list[str]:
-    """The pytest command line that runs the chosen checks on ``folder``."""
+    """The pytest command line that runs the chosen checks on ``folder``: only the files of
+    ``task`` where it is given (collecting the others' takes a second)."""
     selected = f"task{task}" if task else " or ".join(f"task{n}" for n in TASKS)
     marker = selected if hidden else f"({selected}) and not hidden"
+    files = sorted(checks.glob(f"test_task{task}.py")) + sorted(
+        checks.glob(f"test_task{task}_*.py")
+    )
+    plugins = [option for name in PLUGINS for option in ("-p", name)]
     return [
         sys.executable,
         "-m",
         "pytest",
-        str(checks),
+        *(map(str, files) if task and files else [str(checks)]),
+        *plugins,
         f"--impl={folder}",
         f"--msdlab-report={report}",
         "-m",
         marker,
         "-p",
         "no:cacheprovider",
-        "-p",
-        "no:nbval",  # not needed by the checks; loading it takes most of a second
         "--tb=short" if verbose else "--tb=no",
         "-q",
     ]

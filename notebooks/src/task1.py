@@ -25,7 +25,7 @@ import msdlab as msd
 from msdlab import viz
 from msdlab.course.notebook import Course
 
-course = Course()  # the task files: solutions/ or assignments/, or $MSDLAB_IMPL
+course = Course()  # your assignments/ (MSDLAB_IMPL=solutions: the reference answers)
 task1 = course.task(1)
 print(f"task files: {course.label}")
 

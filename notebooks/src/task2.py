@@ -28,7 +28,7 @@ import msdlab as msd
 from msdlab import viz
 from msdlab.course.notebook import Course
 
-course = Course()  # the task files: solutions/ or assignments/, or $MSDLAB_IMPL
+course = Course()  # your assignments/ (MSDLAB_IMPL=solutions: the reference answers)
 task2 = course.task(2)
 print(f"task files: {course.label}")
 h, k = task2.SPACING, task2.STIFFNESS

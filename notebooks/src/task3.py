@@ -27,7 +27,7 @@ from msdlab import kernels, viz
 from msdlab.course.notebook import Course
 from msdlab.scenes import jelly
 
-course = Course()  # the task files: solutions/ or assignments/, or $MSDLAB_IMPL
+course = Course()  # your assignments/ (MSDLAB_IMPL=solutions: the reference answers)
 task3 = course.task(3)
 print(f"task files: {course.label}")
 

@@ -23,7 +23,7 @@ import msdlab as msd
 from msdlab import kernels, viz
 from msdlab.course.notebook import Course
 
-course = Course()  # the task files: solutions/ or assignments/, or $MSDLAB_IMPL
+course = Course()  # your assignments/ (MSDLAB_IMPL=solutions: the reference answers)
 task4 = course.task(4)
 print(f"task files: {course.label}")
 

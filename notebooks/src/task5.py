@@ -28,7 +28,7 @@ from msdlab import viz
 from msdlab.course.notebook import Course
 from msdlab.scenes import jelly
 
-course = Course()  # the task files: solutions/ or assignments/, or $MSDLAB_IMPL
+course = Course()  # your assignments/ (MSDLAB_IMPL=solutions: the reference answers)
 task5 = course.task(5)
 template = course.task(1)  # its given code: the template's falling grid
 print(f"task files: {course.label}")

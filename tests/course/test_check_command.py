@@ -107,6 +107,40 @@ def test_default_is_the_students_assignments_folder(capsys, tmp_path, monkeypatc
     assert "public 9 of 9 points; hidden 6 of 6 points" in out
 
 
+def test_the_reference_answers_only_when_asked_and_then_said(capsys, tmp_path, monkeypatch):
+    for name in ("assignments", "solutions"):
+        (tmp_path / name).mkdir()
+        shutil.copy(PROJECT_ROOT / name / "task1.py", tmp_path / name / "task1.py")
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("MSDLAB_IMPL", raising=False)
+    assert main(["check", "1"]) == 1  # the templates, though solutions/ is here
+    out = capsys.readouterr().out
+    assert str(tmp_path / "assignments") in out and "reference answers" not in out
+    monkeypatch.setenv("MSDLAB_IMPL", "solutions")
+    assert main(["check", "1"]) == 0
+    out = capsys.readouterr().out
+    assert str(tmp_path / "solutions") in out
+    assert "the reference answers, not your task files" in out
+
+
+def test_an_error_in_the_students_code_names_its_file_and_line(capsys, tmp_path):
+    """Without -v: the file, line, function and code of the task file that raised; the
+    property check's failing input said plainly, none of Hypothesis' own wording."""
+    (tmp_path / "assignments").mkdir()
+    answer = (SOLUTIONS / "task2.py").read_text()
+    broken = "        a[first] += f[..., :2]  # one coordinate short\n"
+    answer = answer.replace("        a[first] += f\n", broken)
+    (tmp_path / "assignments" / "task2.py").write_text(answer)
+    line = answer.splitlines().index(broken.rstrip("\n")) + 1
+    assert main(["check", "2", "--impl", str(tmp_path / "assignments")]) == 1
+    out = capsys.readouterr().out
+    assert f"in your code: assignments/task2.py, line {line}, in spring_acceleration" in out
+    assert "a[first] += f[..., :2]  # one coordinate short" in out
+    assert "it fails whatever the input (tried first: seed = " in out
+    for hypothesis_words in ("Failing test case", "Falsifying example", "generated value", "@seed"):
+        assert hypothesis_words not in out
+
+
 @pytest.mark.parametrize(
     ("args", "complaint"),
     [

@@ -23,16 +23,16 @@ def course_folder(tmp_path: Path) -> Path:
     return tmp_path
 
 
-def test_choice_of_task_files_is_the_checks_choice(course_folder, monkeypatch):
+def test_the_students_files_by_default_the_reference_answers_when_asked(course_folder, monkeypatch):
     monkeypatch.delenv("MSDLAB_IMPL", raising=False)
     start = course_folder / "notebooks"
-    assert Course(start=start).label == "solutions"
-    monkeypatch.setenv("MSDLAB_IMPL", "assignments")
+    assert Course(start=start).label == "assignments"  # even beside solutions/
     assert Course(start=start).folder == (course_folder / "assignments").resolve()
-    assert Course("solutions", start=start).label == "solutions"  # the argument comes first
-    shutil.rmtree(course_folder / "solutions")
-    monkeypatch.delenv("MSDLAB_IMPL")
-    assert Course(start=start).label == "assignments"  # a student's folder
+    monkeypatch.setenv("MSDLAB_IMPL", "solutions")
+    asked = Course(start=start)
+    assert asked.folder == (course_folder / "solutions").resolve()
+    assert asked.label == "solutions (the reference answers, not your task files)"
+    assert Course("assignments", start=start).label == "assignments"  # the argument comes first
 
 
 def test_an_unwritten_function_says_what_to_do_and_the_cell_ends_quietly(course_folder, capsys):

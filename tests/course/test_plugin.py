@@ -81,9 +81,18 @@ def outcomes(data: dict) -> dict[str, tuple[str, str | None]]:
     return {c["name"]: (c["outcome"], c["exception"]) for c in data["checks"]}
 
 
-def test_solutions_by_default_with_points_hidden_and_summary(course):
+def test_the_students_files_by_default_even_beside_the_solutions(course):
     process, data = run(course)
+    assert data["implementation"] == "assignments" and data["totals"]["earned"] == 0
+    assert "msdlab: checking the task files of assignments" in process.stdout
+    assert "reference answers" not in process.stdout
+
+
+def test_solutions_when_asked_say_so_with_points_hidden_and_summary(course):
+    process, data = run(course, "--impl=solutions")
     assert process.returncode == 0, process.stdout
+    header = "msdlab: checking the task files of solutions (the reference answers, not your"
+    assert header in process.stdout
     assert data["schema"] == "msdlab-check-report/1"
     assert data["implementation"] == "solutions"
     assert data["totals"] == {"points": 3, "earned": 3, "checks": 2, "passed": 2}
@@ -117,13 +126,6 @@ def test_impl_path_and_physics_message(course):
     assert (answer["outcome"], answer["exception"]) == ("failed", "CheckFailed")
     assert answer["message"] == "the answer is 41. Usual cause: counting from 0."
     assert outcomes(data)["hidden_answer"] == ("passed", None)
-
-
-def test_assignments_by_default_without_solutions(course):
-    (course / "solutions" / "task1.py").unlink()
-    (course / "solutions").rmdir()
-    _, data = run(course)
-    assert data["implementation"] == "assignments"
 
 
 def test_broken_submissions_are_reported_clearly(course):

@@ -1,0 +1,82 @@
+"""A failed check in the course's words: where the student's code raised, what input failed.
+
+pytest and Hypothesis describe a failure for the people who wrote the checks (tracebacks
+through the checks, "Failing test case: test_x(task2=<...>, seed=0,  # or any other
+generated value)"). A student needs two things from it:
+
+- `raised_in`: the line of their own task file where an error was raised, as Python's
+  tracebacks name it (file, line, function and the line's code);
+- `failing_inputs`: the inputs a property check (Hypothesis ``@given``) failed on, said
+  plainly, or that it fails whatever the input.
+"""
+
+from __future__ import annotations
+
+import linecache
+import re
+import traceback
+from pathlib import Path
+
+EXAMPLE_NOTE = re.compile(r"^(Falsifying example|Failing test case): \w+\((?P<args>.*)\)\s*$", re.S)
+"""Hypothesis' note on the example a property check failed on."""
+
+ANY_VALUE = "# or any other generated value"
+"""Hypothesis' comment on an argument the failure does not depend on."""
+
+
+def raised_in(error: BaseException, folder: Path | None) -> str:
+    """'in your code: assignments/task2.py, line 51, in spring_acceleration' and the line's
+    code, for the innermost frame of ``error``'s traceback in a file of ``folder``; '' when
+    the error was not raised in (or through) the student's files."""
+    if folder is None:
+        return ""
+    folder = Path(folder).resolve()
+    frames = [
+        frame
+        for frame in traceback.extract_tb(error.__traceback__)
+        if Path(frame.filename).resolve().parent == folder
+    ]
+    if not frames:
+        return ""
+    frame = frames[-1]
+    shown = f"{folder.name}/{Path(frame.filename).name}"
+    code = (frame.line or linecache.getline(frame.filename, frame.lineno or 0)).strip()
+    where = f"in your code: {shown}, line {frame.lineno}, in {frame.name}"
+    return f"{where}\n    {code}" if code else where
+
+
+def failing_inputs(note: str) -> str:
+    """Hypothesis' note on a failing example, plainly: 'the input that failed: seed = 12'
+    (the task module the check was given is left out), or 'it fails whatever the input
+    (tried first: seed = 0)'; '' for any other note."""
+    found = EXAMPLE_NOTE.match(note.strip())
+    if not found:
+        return ""
+    arguments = _arguments(found["args"])
+    shown = [f"{name} = {value}" for name, (value, _) in arguments.items()]
+    if not shown:
+        return ""
+    if all(any_value for _, any_value in arguments.values()):
+        return f"it fails whatever the input (tried first: {', '.join(shown)})"
+    inputs = "inputs that failed" if len(shown) > 1 else "input that failed"
+    return f"the {inputs}: {', '.join(shown)}"
+
+
+def _arguments(text: str) -> dict[str, tuple[str, bool]]:
+    """name -> (value, whether Hypothesis says any other value fails too), from the lines
+    ``name=value,  # comment`` of a note; the task modules are left out."""
+    found: dict[str, list[str]] = {}
+    for line in text.strip().splitlines():
+        start = re.match(r"\s*(\w+)=(.*)$", line)
+        if start:
+            found[start[1]] = [start[2]]
+        elif found:
+            found[list(found)[-1]].append(line.strip())
+    arguments = {}
+    for name, lines in found.items():
+        value = " ".join(lines)
+        any_value = ANY_VALUE in value
+        value = value.split("  #", 1)[0].strip().rstrip(",")
+        if not value.startswith("<task module"):
+            arguments[name] = (value, any_value)
+    return arguments
