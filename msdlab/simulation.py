@@ -99,9 +99,8 @@ class Simulation:
                 self.constraints.append(item)
             else:
                 raise TypeError(
-                    f"forces holds a {type(item).__name__}, which is neither a msdlab.Force "
-                    "(Gravity, SphereContact, ...) nor a msdlab.Constraint (Ground, Drag, "
-                    "Walls, ...)"
+                    f"forces holds a {type(item).__name__}: neither a msdlab.Force (Gravity, "
+                    "SphereContact, ...) nor a msdlab.Constraint (Ground, Drag, Walls, ...)"
                 )
             item.check(body)
         self.dynamics = Dynamics(body, field_forces, kernel=kernel)

@@ -151,7 +151,7 @@ def test_a_single_force_needs_no_list_and_a_wrong_one_is_named():
     assert len(alone.forces) == 1
     with pytest.raises(TypeError, match=r"forces must be a list .* got a float"):
         msd.Simulation(body_2d(), msd.Verlet(), dt=0.1, forces=9.81)
-    with pytest.raises(TypeError, match=r"forces holds a ndarray, which is neither"):
+    with pytest.raises(TypeError, match=r"forces holds a ndarray: neither a msdlab.Force"):
         msd.Simulation(body_2d(), msd.Verlet(), dt=0.1, forces=[np.array([0, -9.81])])
 
 
