@@ -67,19 +67,27 @@ def wait_until(condition, seconds: float, what: str):
 
 
 @contextmanager
-def jupyterlab_server(tmp_path: Path):
-    """A JupyterLab server of this Python on a free local port, serving ``tmp_path``."""
+def jupyterlab_server(
+    tmp_path: Path, python: Path | str = sys.executable, root: Path | None = None
+):
+    """A JupyterLab server of ``python`` (default: this one) on a free local port, serving
+    ``root`` (default: ``tmp_path``, which holds its settings and log)."""
     port, token = free_port(), "msdlab-test"
     env = {
         **os.environ,
         "JUPYTER_CONFIG_DIR": str(tmp_path / "config"),
         "JUPYTER_RUNTIME_DIR": str(tmp_path / "runtime"),
         "IPYTHONDIR": str(tmp_path / "ipython"),
-        # a venv seeing the system's packages: their front-end extensions are there
+        # a venv seeing the system's packages, or this one's (a journey's fresh environment
+        # borrows them): their front-end extensions are there
         "JUPYTER_PATH": os.pathsep.join(
             filter(
                 None,
-                [os.environ.get("JUPYTER_PATH"), str(Path(sys.base_prefix, "share", "jupyter"))],
+                [
+                    os.environ.get("JUPYTER_PATH"),
+                    str(Path(sys.prefix, "share", "jupyter")),
+                    str(Path(sys.base_prefix, "share", "jupyter")),
+                ],
             )
         ),
     }
@@ -91,14 +99,14 @@ def jupyterlab_server(tmp_path: Path):
     log = (tmp_path / "jupyterlab.log").open("w")
     server = subprocess.Popen(
         [
-            sys.executable,
+            str(python),
             "-m",
             "jupyterlab",
             "--no-browser",
             "--ip=127.0.0.1",
             f"--port={port}",
             f"--IdentityProvider.token={token}",
-            f"--ServerApp.root_dir={tmp_path}",
+            f"--ServerApp.root_dir={root or tmp_path}",
             "--LabApp.expose_app_in_browser=True",  # window.jupyterapp runs the cells
             "--allow-root",  # CI runs as root
         ],
