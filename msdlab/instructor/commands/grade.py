@@ -22,6 +22,7 @@ import argparse
 import dataclasses
 import os
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -29,7 +30,7 @@ from tqdm.auto import tqdm
 
 from ...analysis.cluster import parse_cluster
 from ...course import PROJECT_ROOT, TASKS
-from .. import feedback, gradebook, grading, intake, sandbox
+from .. import feedback, final_points, gradebook, grading, intake, sandbox, term_options
 from ..cluster_grading import grade_all_on_cluster
 
 
@@ -88,6 +89,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         metavar="ADDRESS|local:N",
         help="grade on a Dask scheduler's workers, or N at a time here (local:N is --jobs N)",
     )
+    term_options.register(parser)
     parser.set_defaults(run=run)
 
 
@@ -105,12 +107,22 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError("give SUBMISSION folders or zip files, or --roster FILE (not both)")
     book = gradebook.Gradebook.load(args.out)
     checks = args.checks.resolve()
+    terms = term_options.terms(args)
+
+    def save() -> dict[str, list[str]]:
+        """Settle every row's final points (late work, manual changes), then write."""
+        explained = final_points.settle(book.rows, terms)
+        book.write(args.out)
+        return explained
+
     with (
         intake.from_roster(args.roster)
         if args.roster
-        else intake.from_paths(args.submissions) as found
+        else intake.from_paths(args.submissions) as found,
+        tempfile.TemporaryDirectory(prefix="msdlab-intake-") as scratch,
     ):
         entries = {entry.id: entry for entry in found.entries}
+        term_options.read_hand_ins(entries, args.handed_in, terms, args.timezone, Path(scratch))
         prints = {  # nothing is read from a submission refused at intake (a link, ...)
             i: gradebook.fingerprint(checks, e.folder)
             for i, e in entries.items()
@@ -140,7 +152,7 @@ def run(args: argparse.Namespace) -> int:
         def progress(grade: grading.Grade, done: int, count: int) -> None:
             entry = entries[grade.submission]
             book.record(shown(grade, entry), entry, prints[grade.submission], args.detail)
-            book.write(args.out)  # after each: an interrupted run keeps what was graded
+            save()  # after each: an interrupted run keeps what was graded
             if grade.graded:
                 result = f"{grade.total}/{grade.report.points} points"
             else:
@@ -163,10 +175,14 @@ def run(args: argparse.Namespace) -> int:
             grades = grade_all_on_cluster(graded, checks, address, progress=progress, **options)
         else:
             grades = grading.grade_all(graded, checks, jobs=jobs, progress=progress, **options)
-        book.write(args.out)
+        explained = save()
         grades = unusable + grades
         if args.feedback is not None:
             write_feedback(args.feedback, grades, entries)
+            final_points.refresh_feedback(
+                args.feedback, book.rows, explained, book.maximum.get("total", "")
+            )
+    term_options.report(terms, set(book.rows), args.out)
     print(grading.summary(grades, time.monotonic() - started))
     if args.isolation != "namespace":
         print(f"isolation: {args.isolation} (weaker than namespace; submissions were not "
