@@ -20,7 +20,7 @@ def register(parser: argparse.ArgumentParser) -> None:
         "--late-policy",
         default="",
         metavar="POLICY",
-        help=f"what late work costs, e.g. {late.EXAMPLE} (default: nothing)",
+        help=f"what late work costs, e.g. {late.EXAMPLE.replace('%', '%%')} (default: nothing)",
     )
     parser.add_argument(
         "--timezone",

@@ -9,6 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from msdlab.cli import main
 from msdlab.instructor.late import LatePolicy, format_points, parse_due, read_extensions, time_zone
 
 POLICY = LatePolicy.parse("grace=15m,penalty=10%/day,cap=50%,cutoff=7d")
@@ -141,3 +142,26 @@ def test_extensions_add_a_duration_or_give_a_date(tmp_path):
 )
 def test_points_are_short_decimals(value, text):
     assert format_points(value) == text
+
+
+def test_the_grade_command_explains_its_late_options(capsys):
+    with pytest.raises(SystemExit) as leaving:
+        main(["grade", "--help"])
+    assert leaving.value.code == 0
+    assert "grace=15m,penalty=10%/day,cap=50%,cutoff=7d" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("options", "says"),
+    [
+        (["--due", "2027-03-01"], "--due '2027-03-01' has no time of day"),
+        (["--late-policy", "penalty=10%/day"], "--late-policy and --extensions need --due DATE"),
+        (["--due", "2027-03-01T23:59", "--timezone", "CET+1"], "is not a time zone"),
+    ],
+)
+def test_bad_late_options_stop_the_run_before_grading(tmp_path, capsys, options, says):
+    (tmp_path / "alice").mkdir()
+    given = [str(tmp_path / "alice"), "--out", str(tmp_path / "grades.csv"), *options]
+    assert main(["grade", *given]) == 2
+    printed = capsys.readouterr()
+    assert says in printed.err and "grading" not in printed.err

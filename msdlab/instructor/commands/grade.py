@@ -7,13 +7,16 @@ by --roster FILE (CSV rows 'id,folder-or-zip'). Every submission is graded in
 its own workspace by a fresh process running the instructor's checks (hidden
 ones included); the submission's code runs in a sandbox and can only answer
 with data, under a time and memory limit. Every submission gets a CSV row (id,
-source, task1 ... task5, total, notes; per check with --detail); the first row
-holds the maximum points. Rows of earlier runs in the CSV are kept, a
-submission graded again gets its row replaced, and --resume skips those
-already graded with the same checks. --feedback DIR writes DIR/students/ID.md
-(to hand out), DIR/instructor/ID.md (everything) and DIR/summary.md. Exit
-status 0 if every submission was graded, 1 otherwise. With --cluster ADDRESS the
-submissions are graded by a Dask scheduler's workers (msdlab[cluster]).
+source, task1 ... task5, points, the late work columns, total, notes; per check
+with --detail); the first row holds the maximum points. --due, --late-policy
+and --extensions charge late work; the changes in GRADES.adjustments.csv beside
+the CSV (id,task,change,reason) are applied after every run. Rows of earlier
+runs in the CSV are kept, a submission graded again gets its row replaced,
+and --resume skips those already graded with the same checks. --feedback DIR
+writes DIR/students/ID.md (to hand out), DIR/instructor/ID.md (everything)
+and DIR/summary.md. Exit status 0 if every submission was graded, 1 otherwise.
+With --cluster ADDRESS the submissions are graded by a Dask scheduler's workers
+(msdlab[cluster]).
 """
 
 from __future__ import annotations
