@@ -4,9 +4,12 @@ and what the feedback says. (A grading run that keeps them: test_term_runs.py.)"
 from __future__ import annotations
 
 import re
-from datetime import datetime, timezone
+from datetime import datetime, timedelta, timezone
+from fractions import Fraction
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from msdlab.instructor import adjustments, final_points
 from msdlab.instructor.final_points import Terms
@@ -14,6 +17,7 @@ from msdlab.instructor.handin import HandIn
 from msdlab.instructor.late import LatePolicy
 
 DUE = datetime(2027, 3, 1, 23, 59, tzinfo=timezone.utc)
+NUMBERS = ("points", "late_penalty", "adjustment", "total")
 
 
 def row(*tasks: int) -> dict[str, str]:
@@ -95,3 +99,27 @@ def test_a_change_written_wrong_names_its_line(tmp_path, line, says):
 def test_the_file_lies_beside_the_grades(tmp_path):
     assert adjustments.beside(tmp_path / "grades.csv") == tmp_path / "grades.adjustments.csv"
     assert adjustments.read(tmp_path / "none.csv") == {}
+
+
+change = st.builds(
+    adjustments.Change,
+    id=st.just("alice"),
+    task=st.sampled_from([None, 1, 2]),
+    value=st.fractions(min_value=-5, max_value=20, max_denominator=2),
+    sets=st.booleans(),
+    reason=st.just("because"),
+)
+
+
+@given(st.lists(change, max_size=4), st.integers(min_value=-48, max_value=200))
+def test_the_total_is_always_points_minus_penalty_plus_adjustment(made, hours_late):
+    handed = HandIn(DUE + timedelta(hours=hours_late), "zip entry times")
+    policy = LatePolicy.parse("penalty=10%/day,cap=50%,cutoff=7d")
+    rows = {"alice": row(10, 4, 0, 0, 0)}
+    final_points.settle(rows, Terms(DUE, policy, {}, {"alice": handed}, {"alice": made}))
+    settled = {k: Fraction(v or 0) for k, v in rows["alice"].items() if k in NUMBERS}
+    made_total = settled["points"] - settled["late_penalty"] + settled["adjustment"]
+    assert settled["total"] == made_total  # exactly, as the CSV shows them
+    assert settled["late_penalty"] >= 0
+    if not made:
+        assert rows["alice"]["adjustment"] == "" and settled["total"] <= 14
