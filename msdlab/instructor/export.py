@@ -90,7 +90,16 @@ def _warn_unmatched(book: Gradebook, people: list[dict[str, str]], grades: Path)
               file=sys.stderr)  # fmt: skip
 
 
+def _warn_unnamed(people: list[dict[str, str]], keys: tuple[str, ...], form: str) -> None:
+    """Warn of each student the LMS cannot match: none of the roster's ``keys`` given."""
+    for person in people:
+        if not any(person.get(key) for key in keys):
+            print(f"warning: {person['id']!r} has none of {', '.join(keys)} in the roster: "
+                  f"{form} cannot tell whose grade it is", file=sys.stderr)  # fmt: skip
+
+
 def _canvas(book: Gradebook, people: list[dict[str, str]], assignment: str) -> list[list[str]]:
+    _warn_unnamed(people, ("canvas_id", "sis_id", "sis_login_id"), "Canvas")
     lines = [[*CANVAS_COLUMNS, assignment], [POINTS_POSSIBLE, "", "", "", "", _maximum(book)]]
     for person in people:
         row = book.rows.get(person["id"], {})
@@ -101,6 +110,7 @@ def _canvas(book: Gradebook, people: list[dict[str, str]], assignment: str) -> l
 
 
 def _moodle(book: Gradebook, people: list[dict[str, str]], assignment: str) -> list[list[str]]:
+    _warn_unnamed(people, ("email", "sis_id"), "Moodle")
     lines = [["Full name", "ID number", "Email address", assignment, "Feedback"]]
     for person in people:
         row = book.rows.get(person["id"], {})

@@ -56,10 +56,12 @@ def test_plain_csv_keeps_the_roster_columns_max_points_and_relative_sources(grad
 
 def test_a_student_missing_either_side_is_named(grades, capsys):
     roster = grades.parent / "roster.csv"
-    roster.write_text(roster.read_text() + "carol,class/carol,Carol Doe,c@uni.example,S3,Kim\n")
+    roster.write_text(roster.read_text() + "carol,class/carol,Carol Doe,c@uni.example,,Kim\n")
     rows = export(grades, "canvas")
     assert rows[0]["Student"] == "    Points Possible" and rows[3]["msdlab"] == ""
-    assert "'carol' is in the roster but not in" in capsys.readouterr().err
+    warned = capsys.readouterr().err
+    assert "'carol' is in the roster but not in" in warned
+    assert "'carol' has none of canvas_id, sis_id, sis_login_id in the roster" in warned
 
 
 def test_a_roster_without_a_header_and_canvas_without_a_roster_are_refused(grades, capsys):
