@@ -26,6 +26,11 @@ from .late import LatePolicy, format_points
 COLUMNS = ["points", "due", "handed_in", "handed_in_from", "late", "late_penalty", "adjustment"]
 """The grades file's columns between ``task5`` and ``total``."""
 MARK = "<!-- msdlab: late work and manual changes -->"
+END = "<!-- msdlab: end of late work and manual changes -->"
+_SECTION = re.compile(re.escape(MARK) + ".*?" + re.escape(END) + "\n*", re.S)
+_HEADLINE = re.compile(r"^(\*\*[\d.]+ of [\d.]+ points\*\*|[\d.]+/[\d.]+ points).*\n", re.M)
+"""The feedback's first line of points: the student's ``**P of Q points**``, the
+instructor's ``P/Q points``; the section goes right below it."""
 
 
 @dataclass
@@ -105,7 +110,7 @@ def feedback_section(row: dict[str, str], lines: list[str], possible: str) -> st
         f"The checks gave {row['points']} of {possible} points.", "", *lines, "",
         f"**Total: {row['total']} of {possible} points** (checks {row['points']}"
         f"{_term(' − late penalty ', row.get('late_penalty'))}"
-        f"{_term(' + adjustment ', row.get('adjustment'))}).", "",
+        f"{_term(' + adjustment ', row.get('adjustment'))}).", "", END, "",
     ])  # fmt: skip
 
 
@@ -126,6 +131,17 @@ def refresh_feedback(folder: Path, rows: dict[str, dict[str, str]], lines: dict[
         for kind in ("students", "instructor"):
             path = Path(folder) / kind / f"{file_stem(identifier)}.md"
             if path.is_file():
-                text = re.split(re.escape(MARK), path.read_text(encoding="utf-8"))[0]
-                path.write_text(text.rstrip("\n") + "\n\n" + section if section else text,
+                path.write_text(with_section(path.read_text(encoding="utf-8"), section),
                                 encoding="utf-8")  # fmt: skip
+
+
+def with_section(text: str, section: str) -> str:
+    """The feedback ``text`` with ``section`` (none if '') below its first line of points
+    (at its end if it has none), in place of the section it had."""
+    text = _SECTION.sub("", text).rstrip("\n") + "\n"
+    if not section:
+        return text
+    headline = _HEADLINE.search(text)
+    if headline is None:
+        return text.rstrip("\n") + "\n\n" + section
+    return f"{text[: headline.end()]}\n{section}{text[headline.end() :].lstrip(chr(10))}"

@@ -103,7 +103,9 @@ class LatePolicy:
         return cls(**settings)
 
     def charge(self, points: Fraction, late: timedelta) -> Lateness:
-        """What handing in ``late`` after the due date takes from ``points`` earned."""
+        """What handing in ``late`` after the due date takes from ``points`` earned (none
+        from points below zero, which manual changes can make)."""
+        points = max(points, Fraction(0))
         if late <= timedelta(0):
             return Lateness(late, Fraction(0), True, "handed in on time")
         said = f"handed in {format_duration(late)} late"

@@ -79,7 +79,22 @@ def test_refreshing_feedback_replaces_the_section(tmp_path):
         assert text.count(final_points.MARK) == 1 and "second reason" in text
         assert "first reason" not in text and text.startswith("# Feedback: alice\n\nchecks...")
     final_points.refresh_feedback(tmp_path, rows, final_points.settle(rows, Terms()), "95")
-    assert final_points.MARK not in (tmp_path / "students" / "alice.md").read_text()
+    assert (tmp_path / "students" / "alice.md").read_text() == "# Feedback: alice\n\nchecks...\n"
+
+
+def test_the_section_comes_right_below_the_points_the_checks_gave():
+    student = "# Feedback: a\n\n**10 of 95 points**: public checks 4 of 60.\n\n## Task 1\n"
+    teacher = "# a\n\nHanded in: `x`\n\n10/95 points (task1 10), graded in 2.0 s\n\nNote: x\n"
+    for text, headline, rest in (
+        (student, "public checks 4 of 60.\n", "## Task 1\n"),
+        (teacher, "in 2.0 s\n", "Note: x\n"),
+    ):
+        section = "<!-- msdlab: late work and manual changes -->\nTotal 12\n" + final_points.END
+        once = final_points.with_section(text, section + "\n")
+        assert once.count("Total 12") == 1
+        assert once.index(headline) < once.index("Total 12") and once.endswith(rest)
+        assert final_points.with_section(once, section + "\n") == once
+        assert final_points.with_section(once, "") == text
 
 
 @pytest.mark.parametrize(

@@ -96,6 +96,7 @@ def test_late_extended_and_overridden_work_lasts_and_reaches_canvas(tmp_path, ca
     assert int(rows["dave"]["points"]) < int(full) and rows["dave"]["total"] == full
     student = (notes / "students" / "bob.md").read_text()
     assert "2 started days × 10% of" in student and "handed in 1 d 31 min late" in student
+    assert student.index(f"**Total: {rows['bob']['total']} of") < student.index("## Task 1")
     assert "(your extension)" in (notes / "students" / "carol.md").read_text()
     for kind in ("students", "instructor"):
         assert "his grid was transposed" in (notes / kind / "dave.md").read_text()
