@@ -100,6 +100,10 @@ class Gradebook:
         """The fingerprint of a submission graded earlier (None if never graded to the end)."""
         return (self.rows.get(identifier) or {}).get("fingerprint") or None
 
+    def graded_rows(self) -> list[dict[str, str]]:
+        """The rows of submissions graded to the end (those with a fingerprint)."""
+        return [row for row in self.rows.values() if row.get("fingerprint")]
+
     def record(self, grade: Grade, entry: Entry, print_: str | None, detail: bool) -> None:
         """Put the row of ``grade`` in (replacing the row with the same id)."""
         row = {"id": grade.submission, "source": escaped(str(entry.source))}

@@ -14,9 +14,12 @@ the CSV (id,task,change,reason) are applied after every run. Rows of earlier
 runs in the CSV are kept, a submission graded again gets its row replaced,
 and --resume skips those already graded with the same checks. --feedback DIR
 writes DIR/students/ID.md (to hand out), DIR/instructor/ID.md (everything)
-and DIR/summary.md. Exit status 0 if every submission was graded, 1 otherwise.
-With --cluster ADDRESS the submissions are graded by a Dask scheduler's workers
-(msdlab[cluster]).
+and DIR/summary.md (over every row of the CSV). Exit status 0 if every
+submission was graded, 1 if some could not be (their notes say why), 2 if the
+grader itself failed (its sandbox could not start, or an error of its own, named
+in the notes: no student feedback file is written for those submissions; fix it
+and run again with --resume). With --cluster ADDRESS the submissions are graded
+by a Dask scheduler's workers (msdlab[cluster]).
 """
 
 from __future__ import annotations
@@ -181,7 +184,7 @@ def run(args: argparse.Namespace) -> int:
         explained = save()
         grades = unusable + grades
         if args.feedback is not None:
-            write_feedback(args.feedback, grades, entries)
+            write_feedback(args.feedback, grades, entries, book)
             final_points.refresh_feedback(
                 args.feedback, book.rows, explained, book.maximum.get("total", "")
             )
@@ -194,7 +197,22 @@ def run(args: argparse.Namespace) -> int:
     print(
         f"grades written to {args.out}" + (f" ({kept} rows of earlier runs kept)" if kept else "")
     )
+    failed = [grade for grade in grades if grade.grader_failed]
+    if failed:
+        print(grader_failure(failed), file=sys.stderr)
+        return 2
     return 0 if all(grade.graded for grade in grades) else 1
+
+
+def grader_failure(failed: list[grading.Grade]) -> str:
+    """What to tell the instructor when the grader itself failed on ``failed``."""
+    note = next(n for n in failed[0].notes if n.startswith(grading.GRADER_ERROR))
+    plural = "s" if len(failed) > 1 else ""
+    return (
+        f"msdlab grade: the grader failed on {len(failed)} submission{plural}, no fault of "
+        f"their authors, who got no feedback file: {feedback.scrub(note)}. Fix the grader and "
+        "run the same command with --resume to grade only those."
+    )
 
 
 def shown(grade: grading.Grade, entry: intake.Entry) -> grading.Grade:
@@ -203,21 +221,28 @@ def shown(grade: grading.Grade, entry: intake.Entry) -> grading.Grade:
 
 
 def write_feedback(
-    folder: Path, grades: list[grading.Grade], entries: dict[str, intake.Entry]
+    folder: Path,
+    grades: list[grading.Grade],
+    entries: dict[str, intake.Entry],
+    book: gradebook.Gradebook,
 ) -> None:
-    """DIR/students/ID.md, DIR/instructor/ID.md and DIR/summary.md."""
+    """DIR/students/ID.md (none where the grader failed), DIR/instructor/ID.md, and
+    DIR/summary.md over every row of ``book``."""
     for kind in ("students", "instructor"):
         (folder / kind).mkdir(parents=True, exist_ok=True)
     for grade in (shown(g, entries[g.submission]) for g in grades):
         stem = intake.file_stem(grade.submission)
-        (folder / "students" / f"{stem}.md").write_text(
-            feedback.for_student(grade), encoding="utf-8"
-        )
+        student = folder / "students" / f"{stem}.md"
+        if grade.grader_failed:  # nothing to hand out; an earlier run's file is out of date
+            student.unlink(missing_ok=True)
+        else:
+            student.write_text(feedback.for_student(grade), encoding="utf-8")
         source = intake.escaped(str(entries[grade.submission].source))
         (folder / "instructor" / f"{stem}.md").write_text(
             feedback.for_instructor(grade, source), encoding="utf-8"
         )
-    (folder / "summary.md").write_text(feedback.class_summary(grades), encoding="utf-8")
+    summary = feedback.class_summary(book, grades)
+    (folder / "summary.md").write_text(summary, encoding="utf-8")
 
 
 def _tasks(text: str) -> list[int]:
