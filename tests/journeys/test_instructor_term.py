@@ -1,6 +1,7 @@
 """An instructor's term: a class with a late, an extended and an overridden submission,
 graded with a due date, kept through --resume and a one-student regrade, exported to
-Canvas and read back as Canvas reads a gradebook import."""
+Canvas and read back as Canvas reads a gradebook import; every command as typed in the
+instructor's folder (the `shell` of the journey tests)."""
 
 from __future__ import annotations
 
@@ -10,8 +11,8 @@ import shutil
 from datetime import datetime, timezone
 from pathlib import Path
 
-from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
+from msdlab.instructor import sandbox
 
 SOLUTIONS = PROJECT_ROOT / "solutions"
 CHECKS = PROJECT_ROOT / "tests" / "tasks"
@@ -19,6 +20,8 @@ WRONG_COUNT = """
 def particle_count(n: int = N) -> int:
     return n * n  # wrong on purpose
 """
+# each submission in its bubblewrap sandbox, where there is one
+ISOLATION = "" if sandbox.isolation_problem() is None else " --isolation process"
 HANDED_IN = {  # UTC; due 2027-03-01 23:59 in Berlin is 22:59 UTC
     "alice": datetime(2027, 3, 1, 20, 0, tzinfo=timezone.utc),
     "bob": datetime(2027, 3, 2, 23, 30, tzinfo=timezone.utc),  # 24 h 31 min late: 2 days
@@ -72,20 +75,21 @@ def read_as_canvas(path: Path) -> tuple[dict[str, float], dict[str, dict[str, fl
     return possible, scores
 
 
-def test_late_extended_and_overridden_work_lasts_and_reaches_canvas(tmp_path, capsys):
+def test_late_extended_and_overridden_work_lasts_and_reaches_canvas(tmp_path, shell):
     folders = handed_in_class(tmp_path)
+    task1_checks(tmp_path)
     out, notes = tmp_path / "grades.csv", tmp_path / "feedback"
     (tmp_path / "extensions.csv").write_text("id,extension,reason\ncarol,3d,illness\n")
     (tmp_path / "grades.adjustments.csv").write_text(
         "id,task,change,reason\ndave,1,=15,counted by hand: his grid was transposed\n"
     )
-    terms = ["--due", "2027-03-01T23:59", "--timezone", "Europe/Berlin",
-             "--late-policy", "grace=15m,penalty=10%/day,cap=50%",
-             "--extensions", str(tmp_path / "extensions.csv")]  # fmt: skip
-    common = ["--out", str(out), "--checks", str(task1_checks(tmp_path)), "--jobs", "2",
-              "--call-timeout", "20", "--feedback", str(notes), *terms]  # fmt: skip
-    assert main(["grade", *map(str, folders), *common]) == 0
-    assert "manual changes: 1 from" in capsys.readouterr().err
+    common = (
+        " --out grades.csv --feedback feedback/ --checks checks --jobs 2 --call-timeout 20"
+        " --due 2027-03-01T23:59 --timezone Europe/Berlin"
+        " --late-policy grace=15m,penalty=10%/day,cap=50% --extensions extensions.csv" + ISOLATION
+    )
+    done = shell("msdlab grade class/*/assignments" + common, tmp_path)
+    assert done.returncode == 0 and "manual changes: 1 from" in done.stdout, done.stdout
     rows = read_rows(out)
     full = rows["(max points)"]["task1"]
     assert rows["alice"]["total"] == full and rows["alice"]["late_penalty"] == ""
@@ -104,8 +108,8 @@ def test_late_extended_and_overridden_work_lasts_and_reaches_canvas(tmp_path, ca
     # a decision made after grading reaches the grades and feedback without regrading
     with (tmp_path / "grades.adjustments.csv").open("a") as handle:
         handle.write("alice,,+2,best report of the class\n")
-    assert main(["grade", *map(str, folders), *common, "--resume"]) == 0
-    assert "4 unchanged since graded, skipped" in capsys.readouterr().err
+    done = shell("msdlab grade class/*/assignments --resume" + common, tmp_path)
+    assert done.returncode == 0 and "4 unchanged since graded, skipped" in done.stdout
     rows = read_rows(out)
     assert float(rows["alice"]["total"]) == int(full) + 2 and rows["dave"]["total"] == full
     assert "best report of the class" in (notes / "students" / "alice.md").read_text()
@@ -113,8 +117,7 @@ def test_late_extended_and_overridden_work_lasts_and_reaches_canvas(tmp_path, ca
     # regrading one student keeps his override and everyone else's row
     dave = folders[3]
     os.utime(dave / "task1.py", (HANDED_IN["dave"].timestamp(),) * 2)
-    assert main(["grade", str(dave), *common]) == 0
-    capsys.readouterr()
+    assert shell("msdlab grade class/dave/assignments" + common, tmp_path).returncode == 0
     again = read_rows(out)
     assert again["dave"]["total"] == full and again["dave"]["adjustment"] != ""
     assert {k: again[k]["total"] for k in again} == {k: rows[k]["total"] for k in rows}
@@ -127,10 +130,13 @@ def test_late_extended_and_overridden_work_lasts_and_reaches_canvas(tmp_path, ca
             for i, s in enumerate(HANDED_IN)
         )
     )
-    canvas = tmp_path / "canvas.csv"
-    given = [str(out), "--roster", str(roster), "--format", "canvas", "--out", str(canvas)]
-    assert main(["export", *given, "--assignment", "MSD lab 1"]) == 0
-    possible, scores = read_as_canvas(canvas)
+    done = shell(
+        "msdlab export grades.csv --roster roster.csv --format canvas --out canvas.csv"
+        " --assignment 'MSD lab 1'",
+        tmp_path,
+    )
+    assert done.returncode == 0, done.stdout
+    possible, scores = read_as_canvas(tmp_path / "canvas.csv")
     assert possible == {"MSD lab 1": float(again["(max points)"]["total"])}
     assert scores == {
         f"S{i}": {"MSD lab 1": float(again[s]["total"])} for i, s in enumerate(HANDED_IN)
