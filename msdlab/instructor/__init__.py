@@ -10,5 +10,8 @@ Not shipped to students (see `release_rules`):
 - `release_rules` and `release`: which files ship to students, and the bundle.
 - `validate` and `trivial`: how strong the checks are: solutions, templates, answers
   without physics and mutants of the solutions (``msdlab validate``).
-- `commands`: the ``msdlab templates``, ``grade`` and ``release`` sub-commands.
+- `late`, `handin`, `adjustments` and `final_points`: due dates and late penalties, when
+  each submission was handed in, manual changes that last, and each row's final points;
+  `export`: the grades for Canvas, Moodle or a spreadsheet.
+- `commands`: the ``msdlab templates``, ``grade``, ``export`` and ``release`` sub-commands.
 """

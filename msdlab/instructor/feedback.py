@@ -5,7 +5,8 @@
   message or generated input; a task not attempted (or whose file did not load)
   as one line; no path of the grader's temporary folders.
 - `for_instructor`: every check with its full message, and the grading notes.
-- `class_summary`: the score distribution per task and the checks failed most often.
+- `class_summary`: over the whole grades file, the score distribution per task and the
+  checks failed most often.
 """
 
 from __future__ import annotations
@@ -14,10 +15,14 @@ import collections
 import re
 import statistics
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from ..course import TASKS
 from ..course.report import CheckResult
 from .grading import Grade
+
+if TYPE_CHECKING:  # the gradebook uses `scrub`
+    from .gradebook import Gradebook
 
 _TEMPORARY = re.compile(
     r"[^\s'\"()]*msdlab-(?:grade|intake|sandbox|check)-[^/\s'\"()]*((?:/[^/\s'\"():,;]+)*)"
@@ -90,33 +95,63 @@ def for_instructor(grade: Grade, source: str = "") -> str:
     return "\n".join(lines) + "\n"
 
 
-def class_summary(grades: Sequence[Grade]) -> str:
-    """Markdown: per task the spread of points, then the checks failed most often."""
-    graded = [g for g in grades if g.report is not None]
-    lines = ["# Grading summary", "", f"{len(graded)} of {len(grades)} submissions graded.", ""]
+def class_summary(book: Gradebook, grades: Sequence[Grade]) -> str:
+    """Markdown over every row of the grades file ``book`` (earlier runs' too): per task the
+    spread of points, then the checks failed most often (from the file's per-check columns,
+    else from ``grades``, this run's)."""
+    graded = book.graded_rows()
+    total = len(book.rows)
+    lines = ["# Grading summary", "", f"{len(graded)} of {total} submissions graded.", ""]
     if not graded:
         return "\n".join(lines)
     lines += ["| task | points | mean | median | min | max | how many got how many points |",
               "| --- | --- | --- | --- | --- | --- | --- |"]  # fmt: skip
-    possible = {t: sum(c.points for c in graded[0].report.checks if c.task == t) for t in TASKS}
-    for task in (*TASKS, None):
-        scores = [g.points(task) if task else g.total for g in graded]
-        worth = possible[task] if task else sum(possible.values())
+    for column in (*(f"task{task}" for task in TASKS), "total"):
+        scores = [float(row[column]) for row in graded]
         spread = collections.Counter(scores)
-        counts = ", ".join(f"{points}: {spread[points]}" for points in sorted(spread))
+        counts = ", ".join(f"{points:g}: {spread[points]}" for points in sorted(spread))
         lines.append(
-            f"| {f'task{task}' if task else 'total'} | {worth} | {statistics.mean(scores):.1f} | "
-            f"{statistics.median(scores):g} | {min(scores)} | {max(scores)} | {counts} |"
+            f"| {column} | {book.maximum[column]} | {statistics.mean(scores):.1f} | "
+            f"{statistics.median(scores):g} | {min(scores):g} | {max(scores):g} | {counts} |"
         )
-    failed = collections.Counter(
-        (c.task, c.name, c.hidden) for g in graded for c in g.report.checks if not c.passed
-    )
-    if failed:
-        lines += ["", "Checks failed most often:", ""]
-        for (task, name, hidden), count in failed.most_common(10):
-            kind = " (hidden)" if hidden else ""
-            lines.append(f"- task{task} {name}{kind}: failed by {count} of {len(graded)}")
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines + _most_failed(book, graded, grades)) + "\n"
+
+
+def _most_failed(
+    book: Gradebook, graded: list[dict[str, str]], grades: Sequence[Grade]
+) -> list[str]:
+    """The lines naming the ten checks failed most often, by how many submissions."""
+    heading = "Checks failed most often:"
+    if book.detail_columns:  # every row of the file that has the check's column
+        failed, having = collections.Counter(), collections.Counter()
+        for row in graded:
+            for column in (c for c in book.detail_columns if row.get(c)):
+                having[column] += 1
+                failed[column] += float(row[column]) < float(book.maximum[column])
+    else:
+        reports = [g.report for g in grades if g.report is not None]
+        failed = collections.Counter(
+            f"task{c.task} {c.name}" + (" (hidden)" if c.hidden else "")
+            for report in reports
+            for c in report.checks
+            if not c.passed
+        )
+        having = collections.Counter({name: len(reports) for name in failed})
+        if len(reports) < len(graded):
+            plural = "" if len(reports) == 1 else "s"
+            heading = (
+                f"Checks failed most often by the {len(reports)} submission{plural} graded "
+                "in this run (grade with --detail to count them over every row):"
+            )
+    common = [(name, count) for name, count in failed.most_common(10) if count]
+    if not common:
+        return []
+    return [
+        "",
+        heading,
+        "",
+        *(f"- {name}: failed by {count} of {having[name]}" for name, count in common),
+    ]
 
 
 def _task_heading(task: int, checks: list[CheckResult]) -> str:

@@ -1,7 +1,8 @@
 """The class's grades as a CSV file: one row per submission id, kept up to date across runs.
 
 Columns: ``id``, ``source`` (the folder or zip handed in, named exactly: see
-`intake.escaped`), ``task1`` ... ``task5``, ``total``, optionally one column per check
+`intake.escaped`), ``task1`` ... ``task5`` (the checks' points), ``points`` (their sum),
+the late work and manual changes (`final_points`), ``total``, optionally one column per check
 (``--detail``: ``task2 rest_state_feels_no_force``), ``notes`` and ``fingerprint`` (a hash
 of the checks and the submission's task files).
 The first row, id ``(max points)``, holds what each column is worth.
@@ -18,19 +19,22 @@ import csv
 import hashlib
 import io
 import os
+import re
 import tempfile
 from pathlib import Path
 
 from ..course import TASKS
 from ..course.report import CheckReport
 from .feedback import scrub
+from .final_points import COLUMNS as FINAL_COLUMNS
 from .grading import Grade
 from .intake import MAX_POINTS_ID, Entry, escaped
 
-FIRST = ["id", "source", *(f"task{t}" for t in TASKS), "total"]
+FIRST = ["id", "source", *(f"task{t}" for t in TASKS), *FINAL_COLUMNS, "total"]
 LAST = ["notes", "fingerprint"]
 FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
 """A cell starting with one of these is a formula to a spreadsheet; it gets a leading quote."""
+NUMBER = re.compile(r"-?\d+(\.\d+)?")
 
 
 def fingerprint(checks: Path, folder: Path) -> str:
@@ -50,8 +54,10 @@ def check_column(task: int, name: str) -> str:
 
 
 def neutralised(value: object) -> str:
-    """``value`` as a CSV cell no spreadsheet takes for a formula."""
+    """``value`` as a CSV cell no spreadsheet takes for a formula (a number stays a number)."""
     text = str(value)
+    if NUMBER.fullmatch(text):
+        return text
     return "'" + text if text.startswith(FORMULA_STARTS) else text
 
 
@@ -94,11 +100,15 @@ class Gradebook:
         """The fingerprint of a submission graded earlier (None if never graded to the end)."""
         return (self.rows.get(identifier) or {}).get("fingerprint") or None
 
+    def graded_rows(self) -> list[dict[str, str]]:
+        """The rows of submissions graded to the end (those with a fingerprint)."""
+        return [row for row in self.rows.values() if row.get("fingerprint")]
+
     def record(self, grade: Grade, entry: Entry, print_: str | None, detail: bool) -> None:
         """Put the row of ``grade`` in (replacing the row with the same id)."""
         row = {"id": grade.submission, "source": escaped(str(entry.source))}
         row.update({f"task{t}": str(grade.points(t)) for t in TASKS})
-        row["total"] = str(grade.total)
+        row["points"] = row["total"] = str(grade.total)
         if grade.report is not None:
             self._maximum(grade.report, detail)
             if detail:
@@ -114,7 +124,7 @@ class Gradebook:
             self.maximum[f"task{task}"] = str(
                 sum(c.points for c in report.checks if c.task == task)
             )
-        self.maximum["total"] = str(report.points)
+        self.maximum["points"] = self.maximum["total"] = str(report.points)
         if detail:
             for check in report.checks:
                 column = check_column(check.task, check.name)

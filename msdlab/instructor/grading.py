@@ -34,6 +34,8 @@ from .judges import ForkedJudges
 
 MAX_FILE_BYTES = 1_000_000
 FIRST_UID = 61000  # as root, sandboxes run as reserved user ids from here on
+GRADER_ERROR = "grader error: "
+"""The start of the note of a submission the grader failed to grade (no fault of its author)."""
 
 
 @dataclass
@@ -62,6 +64,11 @@ class Grade:
         if self.report is None:
             return 0
         return sum(c.earned for c in self.report.checks if c.task == task)
+
+    @property
+    def grader_failed(self) -> bool:
+        """True if the grader itself failed (its setup or its code), not the submission."""
+        return any(note.startswith(GRADER_ERROR) for note in self.notes)
 
     @property
     def total(self) -> int:
@@ -144,22 +151,20 @@ def grade(
             environment["MSDLAB_SANDBOX_UID"] = str(uid)
         if references is not None:
             environment[reference_cache.ENV] = str(references)
-        try:
-            if server is None:
-                raise EOFError("no judge server")
-            failure = _outcome(*server.run(arguments, workspace, environment, timeout), timeout)
-        except (EOFError, OSError):  # no server, or it could not fork: a fresh judge grades
-            failure = _run_judge(arguments, workspace, environment, timeout)
+        status, printed = _judge(arguments, workspace, environment, timeout, server)
         if uid is not None:
             _kill_user(uid)
-        report = _read_report(report_path) if failure is None else None
-        if report is None:
-            notes.append(failure or "the checks ended without a report")
-        else:
+        report = _read_report(report_path) if status in (0, 1) else None
+        if report is not None:
             notes += _problems(report)
+        elif status is None:
+            notes.append(f"grading timed out after {timeout:g} s")
+        else:
+            notes.append(GRADER_ERROR + _judge_failure(status, printed))
         return Grade(submission.name, report, notes, time.monotonic() - started)
     except Exception as error:  # never lose a row: the reason goes to its notes
-        return Grade(submission.name, None, [f"not graded: {error}"], time.monotonic() - started)
+        note = f"{GRADER_ERROR}{type(error).__name__}: {error}"
+        return Grade(submission.name, None, [note], time.monotonic() - started)
     finally:
         shutil.rmtree(workspace, ignore_errors=True)
 
@@ -224,7 +229,7 @@ def as_grade(submission: Submission, outcome: Grade | BaseException) -> Grade:
     """The grade, or a row that says why the grading of ``submission`` failed."""
     if isinstance(outcome, Grade):
         return outcome
-    reason = f"not graded: the grader lost it ({type(outcome).__name__}: {outcome})"
+    reason = f"{GRADER_ERROR}the grader lost it ({type(outcome).__name__}: {outcome})"
     return Grade(submission.name, None, [reason])
 
 
@@ -307,40 +312,60 @@ def _copy_submission(source: Path, target: Path) -> list[str]:
     return notes
 
 
+def _judge(
+    arguments: list[str],
+    workspace: Path,
+    environment: dict,
+    timeout: float,
+    server: ForkedJudges | None,
+) -> tuple[int | None, str]:
+    """Run the judge, forked from ``server`` or else afresh: its exit status (None: timed
+    out) and what it printed."""
+    if server is not None:
+        try:
+            return server.run(arguments, workspace, environment, timeout)
+        except (EOFError, OSError):  # the server could not fork: a fresh judge grades
+            pass
+    return _run_judge(arguments, workspace, environment, timeout)
+
+
 def _run_judge(
     arguments: list[str], workspace: Path, environment: dict, timeout: float
-) -> str | None:
-    """Run a fresh judge; None if it finished, else why not. The whole process group is killed."""
+) -> tuple[int | None, str]:
+    """Run a fresh judge: its exit status (None: timed out) and what it printed. The whole
+    process group is killed."""
     process = subprocess.Popen(
         [sys.executable, "-m", "pytest", *arguments],
         cwd=workspace,
         env=environment,
         stdin=subprocess.DEVNULL,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
         start_new_session=True,
     )
     try:
-        _, errors = process.communicate(timeout=timeout)
+        printed, _ = process.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
         with contextlib.suppress(ProcessLookupError):
             os.killpg(process.pid, signal.SIGKILL)
         process.communicate()
-        return _outcome(None, "", timeout)
+        return None, ""
     finally:
         with contextlib.suppress(ProcessLookupError):
             os.killpg(process.pid, signal.SIGKILL)  # and anything left behind
-    return _outcome(process.returncode, errors.decode(errors="replace"), timeout)
+    return process.returncode, printed.decode(errors="replace")
 
 
-def _outcome(status: int | None, errors: str, timeout: float) -> str | None:
-    """None if the judge finished with exit ``status``, else why not (None: timed out)."""
-    if status is None:
-        return f"grading timed out after {timeout:g} s"
-    if status not in (0, 1):  # 1: some checks failed, which is a normal grade
-        tail = errors.strip().splitlines()[-3:]
-        return f"the checks could not run (pytest exit {status}): {' | '.join(tail)}"
-    return None
+def _judge_failure(status: int, printed: str) -> str:
+    """Why a judge gave no report, from its exit ``status``, the last error pytest showed and
+    the last line it ``printed`` (a judge runs only the grader's code: the submission's runs
+    in its sandbox)."""
+    lines = [line.strip() for line in printed.splitlines() if line.strip()]
+    raised = [line.removeprefix("E").strip() for line in lines if line.startswith("E ")]
+    tail = " | ".join(dict.fromkeys(raised[-1:] + lines[-1:])) or "it printed nothing (see above)"
+    if status in (0, 1):  # 1: some checks failed, which is a normal grade
+        return f"the checks ended without a report: {tail}"
+    return f"the checks could not run (pytest exit {status}): {tail}"
 
 
 def _kill_user(uid: int) -> None:

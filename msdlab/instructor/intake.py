@@ -5,7 +5,8 @@ holding ``assignments/`` (a student who handed in the whole bundle), or a zip
 file of either. Its id is its path relative to the common parent of all the
 submissions given, without a trailing ``assignments`` (``class/alice/assignments``
 -> ``alice``), or the id a roster gives it (``--roster FILE``: CSV rows
-``id,folder-or-zip``, paths relative to the roster's folder).
+``id,folder-or-zip``, paths relative to the roster's folder, after an optional header
+line such as ``student,submission``).
 
 Ids are readable text (a folder name that is not valid UTF-8 keeps its
 readable part, the rest becomes U+FFFD) and never repeat; `file_stem` makes
@@ -195,7 +196,9 @@ def link_problem(path: Path, given_in: Path) -> str | None:
 
 
 def from_roster(roster: Path) -> Intake:
-    """The submissions a roster CSV lists as ``id,folder-or-zip`` (a header row is optional)."""
+    """The submissions a roster CSV lists as ``id,folder-or-zip`` (paths relative to the
+    roster's folder; a first line naming the columns, such as ``student,submission``, is a
+    header)."""
     roster = Path(roster)
     if not roster.is_file():
         raise FileNotFoundError(f"no roster file at {roster}")
@@ -203,17 +206,36 @@ def from_roster(roster: Path) -> Intake:
     with roster.open(newline="", encoding="utf-8-sig") as handle:
         for number, row in enumerate(csv.reader(handle), start=1):
             cells = [cell.strip() for cell in row]
-            if not any(cells) or cells[0].startswith("#"):
+            if not any(cells) or cells[0].startswith("#") or (number == 1 and _header(cells)):
                 continue
-            if number == 1 and cells[0].lower() in ("id", "student", "name"):
-                continue
+            where = f"roster {roster}, line {number}"
             if len(cells) < 2 or not cells[0] or not cells[1]:
-                raise ValueError(f"{roster}, line {number}: expected 'id,folder-or-zip'")
+                raise ValueError(
+                    f"{where}: '{','.join(row)}' is not 'id,folder-or-zip' (the submission's "
+                    "id, then its folder or zip file)"
+                )
             path = Path(cells[1]).expanduser()
-            intake.add(cells[0], path if path.is_absolute() else roster.parent / path)
+            path = path if path.is_absolute() else roster.parent / path
+            if not path.exists():
+                header = " or name the columns (student,submission)" if number == 1 else ""
+                raise FileNotFoundError(
+                    f"{where}: no folder or zip file at {path}; give paths relative to the "
+                    f"roster's folder{header}"
+                )
+            intake.add(cells[0], path)
     if not intake.entries:
         raise ValueError(f"{roster} lists no submissions (rows of 'id,folder-or-zip')")
     return intake
+
+
+ID_HEADINGS = {"id", "student", "studentid", "name", "login", "username", "user", "email"}
+PATH_HEADINGS = {"folder", "folderorzip", "path", "submission", "zip", "source", "file"}
+
+
+def _header(cells: list[str]) -> bool:
+    """True if ``cells`` name a roster's columns (``id,folder``, ``Student,Submission``...)."""
+    words = [re.sub(r"[\s_-]+", "", cell.lower()) for cell in cells]
+    return words[0] in ID_HEADINGS or (len(words) > 1 and words[1] in PATH_HEADINGS)
 
 
 def _path_id(path: Path, base: Path) -> str:

@@ -9,6 +9,11 @@ arguments. Each child starts from the server's untouched state, so nothing passe
 submission's judge to the next; the submission itself still runs only in its sandbox, which
 the judge starts. As with any ``forkserver`` child, a script that grades must keep its work
 under ``if __name__ == "__main__":`` (each judge imports the script that started it).
+
+The server is started with Python's safe-path setting (``PYTHONSAFEPATH``, Python 3.11 and
+later): its imports come from the installed packages, never from the folder grading runs
+in, where a clone of the course (a folder named ``msdlab``) would shadow the installed
+msdlab. Older Pythons have no such setting: there every judge is started afresh instead.
 """
 
 from __future__ import annotations
@@ -18,9 +23,13 @@ import multiprocessing
 import os
 import signal
 import sys
+import threading
+from multiprocessing import forkserver
 from pathlib import Path
 
 PRELOAD = ["__main__", "hypothesis.strategies", "pytest", "scipy.linalg", "scipy.sparse", "msdlab"]
+SAFE_PATH = sys.version_info >= (3, 11)  # PYTHONSAFEPATH: no working folder on sys.path
+_STARTING = threading.Lock()
 
 
 class ForkedJudges:
@@ -34,10 +43,12 @@ class ForkedJudges:
         self, arguments: list[str], cwd: Path, environment: dict[str, str], timeout: float
     ) -> tuple[int | None, str]:
         """Run pytest with ``arguments`` in a forked judge; its exit status (None if it was
-        killed after ``timeout`` seconds) and what it wrote to stderr."""
-        errors = cwd / "judge-stderr.txt"
+        killed after ``timeout`` seconds) and what it printed (stdout and stderr). OSError where no
+        server can start whose imports are safe from the working folder."""
+        _start_server()
+        output = cwd / "judge-output.txt"
         judge = self.context.Process(
-            target=_judge, args=(arguments, str(cwd), environment, str(errors)), daemon=True
+            target=_judge, args=(arguments, str(cwd), environment, str(output)), daemon=True
         )
         judge.start()
         judge.join(timeout)
@@ -48,12 +59,28 @@ class ForkedJudges:
         judge.join()
         judge.close()
         try:
-            return status, errors.read_text(errors="replace")
+            return status, output.read_text(errors="replace")
         except OSError:
             return status, ""
 
 
-def _judge(arguments: list[str], cwd: str, environment: dict[str, str], errors: str) -> None:
+def _start_server() -> None:
+    """Start the forkserver unless it runs, with no working folder on its ``sys.path``."""
+    if not SAFE_PATH:
+        raise OSError("a forkserver would import from the working folder before Python 3.11")
+    with _STARTING:
+        before = os.environ.get("PYTHONSAFEPATH")
+        os.environ["PYTHONSAFEPATH"] = "1"  # inherited by the server, read at its start
+        try:
+            forkserver.ensure_running()
+        finally:
+            if before is None:
+                del os.environ["PYTHONSAFEPATH"]
+            else:
+                os.environ["PYTHONSAFEPATH"] = before
+
+
+def _judge(arguments: list[str], cwd: str, environment: dict[str, str], output: str) -> None:
     """In the forked child: become the judge of one submission and exit with pytest's status."""
     code = 3
     try:
@@ -66,8 +93,8 @@ def _judge(arguments: list[str], cwd: str, environment: dict[str, str], errors: 
         tempfile.tempdir = None  # found again from the judge's TMPDIR
         sys.dont_write_bytecode = True
         quiet = os.open(os.devnull, os.O_RDWR)
-        stderr = os.open(errors, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-        for fd, target in ((quiet, 0), (quiet, 1), (stderr, 2)):
+        printed = os.open(output, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+        for fd, target in ((quiet, 0), (printed, 1), (printed, 2)):
             os.dup2(fd, target)
         import pytest
 

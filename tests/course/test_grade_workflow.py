@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import json
 import os
+import re
 import shutil
 import stat
 import subprocess
@@ -93,6 +94,33 @@ def test_roster_gives_ids_and_refuses_repeats(tmp_path):
     roster.write_text("alice,sub1\nalice,sub1\n")
     with pytest.raises(ValueError, match="two submissions have the id 'alice'"):
         intake.from_roster(roster)
+
+
+@pytest.mark.parametrize("header", ["student,submission", "Student ID,Folder", "email,zip"])
+def test_a_roster_may_start_with_a_header_line(tmp_path, header):
+    folder_of_tasks(tmp_path / "sub1", 1)
+    roster = tmp_path / "roster.csv"
+    roster.write_text(f"{header}\nalice,sub1\n")
+    with intake.from_roster(roster) as found:
+        assert [e.id for e in found.entries] == ["alice"]
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("alice,sub1\nbob\n", "line 2: 'bob' is not 'id,folder-or-zip'"),
+        ("alice,sub1\nbob,gone\n", "line 2: no folder or zip file at .*gone; give paths rel"),
+        ("who,where\nalice,sub1\n", "line 1: no folder or zip file at .*where; .*name the col"),
+    ],
+)
+def test_a_malformed_roster_names_its_line_and_the_fix(tmp_path, capsys, text, message):
+    folder_of_tasks(tmp_path / "sub1", 1)
+    roster = tmp_path / "roster.csv"
+    roster.write_text(text)
+    assert main(["grade", "--roster", str(roster), "--out", str(tmp_path / "grades.csv")]) == 2
+    assert re.search(
+        f"msdlab grade: error: roster .*roster.csv, {message}", capsys.readouterr().err
+    )
 
 
 # ---------------------------------------- links are not submissions; exact sources
@@ -192,15 +220,28 @@ def test_student_feedback_hides_hidden_checks_and_temporary_paths():
     assert "secret_corner" in everything and "secret_input" in everything
 
 
-def test_class_summary_spread_and_most_failed():
+def summary_of(grades: list[Grade], detail: bool, tmp_path: Path) -> str:
+    book = gradebook.Gradebook()
+    for grade in grades:
+        book.record(grade, intake.Entry(grade.submission, tmp_path, tmp_path), "print", detail)
+    return feedback.class_summary(book, grades[1:])  # the first graded in an earlier run
+
+
+@pytest.mark.parametrize("detail", [True, False])
+def test_class_summary_spread_and_most_failed(tmp_path, detail):
     grades = [
-        Grade("a", report(PUBLIC_FAIL, PUBLIC_PASS)),
-        Grade("b", report(PUBLIC_FAIL, PUBLIC_PASS)),
-        Grade("c", None, ["not graded: timed out"]),
+        Grade("a", report(PUBLIC_FAIL, PUBLIC_PASS, HIDDEN_FAIL)),
+        Grade("b", report(PUBLIC_FAIL, PUBLIC_PASS, HIDDEN_FAIL)),
+        Grade("c", None, ["grading timed out after 9 s"]),
     ]
-    text = feedback.class_summary(grades)
-    assert "2 of 3 submissions graded" in text and "| task2 | 5 | 3.0 | 3 | 3 | 3 | 3: 2 |" in text
-    assert "task2 rest_state: failed by 2 of 2" in text
+    text = summary_of(grades, detail, tmp_path)
+    assert "2 of 3 submissions graded" in text and "| task2 | 7 | 3.0 | 3 | 3 | 3 | 3: 2 |" in text
+    if detail:  # the per-check columns of every row
+        assert "- task2 rest_state: failed by 2 of 2" in text
+        assert "- task2 secret_corner: failed by 2 of 2" in text
+    else:  # this run's reports only, and the summary says so
+        assert "by the 1 submission graded in this run (grade with --detail" in text
+        assert "- task2 secret_corner (hidden): failed by 1 of 1" in text
 
 
 def test_gradebook_cells_are_never_formulas_and_survive_a_round_trip(tmp_path):
@@ -287,16 +328,44 @@ def test_grade_command_keys_rows_by_student_resumes_and_regrades_one(tmp_path, c
     assert "particle_count_for_any_size" in (notes / "instructor" / "alice.md").read_text()
     assert f"| task1 | {full} |" in (notes / "summary.md").read_text()
 
-    assert main(["grade", *given[:2], *common, "--resume"]) == 0
+    everyone = "2 of 3 submissions graded."  # dave handed in nothing
+    assert everyone in (notes / "summary.md").read_text()
+    assert main(["grade", *given[:2], *common, "--resume", "--feedback", str(notes)]) == 0
     assert "grading 0 submissions (2 unchanged since graded, skipped)" in capsys.readouterr().err
+    assert everyone in (notes / "summary.md").read_text()
 
     (alice / "task1.py").write_text((alice / "task1.py").read_text() + WRONG_COUNT)
-    assert main(["grade", str(alice), *common, "--resume"]) == 0
+    assert main(["grade", str(alice), *common, "--resume", "--feedback", str(notes)]) == 0
     printed = capsys.readouterr()
     assert "grading 1 submission," in printed.err and "graded 1 of 1 submission " in printed.out
     rows = {row["id"]: row for row in csv.DictReader(out.open())}
     assert int(rows["alice"]["task1"]) < full and rows["carol"]["task1"] == str(full)
     assert len(rows) == 4
+    summary = (notes / "summary.md").read_text()  # the whole class, alice's new grade in it
+    assert (
+        everyone in summary
+        and f"| task1 | {full} | {(int(rows['alice']['task1']) + full) / 2:.1f} |" in summary
+    )
+
+
+def test_a_grader_error_is_named_and_hands_out_no_feedback(tmp_path, capsys):
+    checks = folder_of_tasks(tmp_path / "checks")
+    shutil.copy(CHECKS / "test_task1.py", checks)
+    (checks / "test_broken.py").write_text("import no_such_module_of_the_grader\n")
+    alice = folder_of_tasks(tmp_path / "class" / "alice", 1)
+    notes = tmp_path / "feedback"
+    (notes / "students").mkdir(parents=True)
+    (notes / "students" / "alice.md").write_text("an earlier run's feedback")
+    arguments = ["grade", str(alice), "--out", str(tmp_path / "grades.csv"), "--checks",
+                 str(checks), "--feedback", str(notes)]  # fmt: skip
+    assert main(arguments) == 2
+    error = capsys.readouterr().err
+    assert "the grader failed on 1 submission, no fault of their authors" in error
+    assert "No module named 'no_such_module_of_the_grader'" in error and "--resume" in error
+    row = {row["id"]: row for row in csv.DictReader((tmp_path / "grades.csv").open())}["alice"]
+    assert "grader error: the checks could not run (pytest exit 2)" in row["notes"]
+    assert "no_such_module_of_the_grader" in (notes / "instructor" / "alice.md").read_text()
+    assert not (notes / "students" / "alice.md").exists()
 
 
 WRONG_COUNT = """

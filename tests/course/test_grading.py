@@ -6,6 +6,8 @@ from __future__ import annotations
 import csv
 import os
 import shutil
+import subprocess
+import sys
 import textwrap
 from pathlib import Path
 
@@ -13,7 +15,7 @@ import pytest
 
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
-from msdlab.instructor import grading
+from msdlab.instructor import grading, sandbox
 from msdlab.instructor.judges import ForkedJudges
 
 SOLUTIONS = PROJECT_ROOT / "solutions"
@@ -220,6 +222,13 @@ def test_grade_command_writes_rows_feedback_and_exit_status(tmp_path, capsys):
         "task3",
         "task4",
         "task5",
+        "points",
+        "due",
+        "handed_in",
+        "handed_in_from",
+        "late",
+        "late_penalty",
+        "adjustment",
         "total",
         "notes",
         "fingerprint",
@@ -250,3 +259,25 @@ def test_concurrent_grading_runs_never_share_a_sandbox_user():
         assert len(set(first) | set(second)) == 5
     with grading.reserved_uids(1) as again:
         assert again[0] == min(first + second)  # released when the runs end
+
+
+@pytest.mark.parametrize("isolation", ["namespace", "process"])
+def test_grading_from_a_folder_holding_one_named_msdlab_grades_normally(tmp_path, isolation):
+    """The judges import the installed msdlab, not the folder ``msdlab`` (an empty one here;
+    a clone of the course in the instructor's journey test) where grading runs."""
+    if isolation == "namespace" and sandbox.isolation_problem() is not None:
+        pytest.skip(sandbox.isolation_problem())
+    (tmp_path / "msdlab").mkdir()
+    checks = tmp_path / "checks"
+    checks.mkdir()
+    for name in ("conftest.py", "test_task1.py"):
+        shutil.copy(CHECKS / name, checks)
+    alice = tmp_path / "class" / "alice"
+    alice.mkdir(parents=True)
+    shutil.copy(SOLUTIONS / "task1.py", alice)
+    command = [str(Path(sys.executable).with_name("msdlab")), "grade", "class/alice", "--out",
+               "grades.csv", "--checks", str(checks), "--isolation", isolation]  # fmt: skip
+    result = subprocess.run(command, cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    rows = {row["id"]: row for row in csv.DictReader((tmp_path / "grades.csv").open())}
+    assert rows["alice"]["task1"] == rows["(max points)"]["task1"] != "0", rows["alice"]["notes"]

@@ -92,6 +92,6 @@ def test_a_grading_that_fails_in_the_grader_keeps_its_row_in_its_place(
     grades = grading.grade_all(submissions, tmp_path, progress=lambda g, *_: seen.append(g))
     assert [g.submission for g in grades] == names and sorted(g.submission for g in seen) == names
     assert grades[1].notes == [
-        "not graded: the grader lost it (MemoryError: the grader ran out of memory)"
+        "grader error: the grader lost it (MemoryError: the grader ran out of memory)"
     ]
     assert grades[0].notes == grades[2].notes == ["graded elsewhere"]

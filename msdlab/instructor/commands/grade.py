@@ -7,13 +7,19 @@ by --roster FILE (CSV rows 'id,folder-or-zip'). Every submission is graded in
 its own workspace by a fresh process running the instructor's checks (hidden
 ones included); the submission's code runs in a sandbox and can only answer
 with data, under a time and memory limit. Every submission gets a CSV row (id,
-source, task1 ... task5, total, notes; per check with --detail); the first row
-holds the maximum points. Rows of earlier runs in the CSV are kept, a
-submission graded again gets its row replaced, and --resume skips those
-already graded with the same checks. --feedback DIR writes DIR/students/ID.md
-(to hand out), DIR/instructor/ID.md (everything) and DIR/summary.md. Exit
-status 0 if every submission was graded, 1 otherwise. With --cluster ADDRESS the
-submissions are graded by a Dask scheduler's workers (msdlab[cluster]).
+source, task1 ... task5, points, the late work columns, total, notes; per check
+with --detail); the first row holds the maximum points. --due, --late-policy
+and --extensions charge late work; the changes in GRADES.adjustments.csv beside
+the CSV (id,task,change,reason) are applied after every run. Rows of earlier
+runs in the CSV are kept, a submission graded again gets its row replaced,
+and --resume skips those already graded with the same checks. --feedback DIR
+writes DIR/students/ID.md (to hand out), DIR/instructor/ID.md (everything)
+and DIR/summary.md (over every row of the CSV). Exit status 0 if every
+submission was graded, 1 if some could not be (their notes say why), 2 if the
+grader itself failed (its sandbox could not start, or an error of its own, named
+in the notes: no student feedback file is written for those submissions; fix it
+and run again with --resume). With --cluster ADDRESS the submissions are graded
+by a Dask scheduler's workers (msdlab[cluster]).
 """
 
 from __future__ import annotations
@@ -22,6 +28,7 @@ import argparse
 import dataclasses
 import os
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -29,7 +36,7 @@ from tqdm.auto import tqdm
 
 from ...analysis.cluster import parse_cluster
 from ...course import PROJECT_ROOT, TASKS
-from .. import feedback, gradebook, grading, intake, sandbox
+from .. import feedback, final_points, gradebook, grading, intake, sandbox, term_options
 from ..cluster_grading import grade_all_on_cluster
 
 
@@ -88,6 +95,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         metavar="ADDRESS|local:N",
         help="grade on a Dask scheduler's workers, or N at a time here (local:N is --jobs N)",
     )
+    term_options.register(parser)
     parser.set_defaults(run=run)
 
 
@@ -105,12 +113,22 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError("give SUBMISSION folders or zip files, or --roster FILE (not both)")
     book = gradebook.Gradebook.load(args.out)
     checks = args.checks.resolve()
+    terms = term_options.terms(args)
+
+    def save() -> dict[str, list[str]]:
+        """Settle every row's final points (late work, manual changes), then write."""
+        explained = final_points.settle(book.rows, terms)
+        book.write(args.out)
+        return explained
+
     with (
         intake.from_roster(args.roster)
         if args.roster
-        else intake.from_paths(args.submissions) as found
+        else intake.from_paths(args.submissions) as found,
+        tempfile.TemporaryDirectory(prefix="msdlab-intake-") as scratch,
     ):
         entries = {entry.id: entry for entry in found.entries}
+        term_options.read_hand_ins(entries, args.handed_in, terms, args.timezone, Path(scratch))
         prints = {  # nothing is read from a submission refused at intake (a link, ...)
             i: gradebook.fingerprint(checks, e.folder)
             for i, e in entries.items()
@@ -140,7 +158,7 @@ def run(args: argparse.Namespace) -> int:
         def progress(grade: grading.Grade, done: int, count: int) -> None:
             entry = entries[grade.submission]
             book.record(shown(grade, entry), entry, prints[grade.submission], args.detail)
-            book.write(args.out)  # after each: an interrupted run keeps what was graded
+            save()  # after each: an interrupted run keeps what was graded
             if grade.graded:
                 result = f"{grade.total}/{grade.report.points} points"
             else:
@@ -163,10 +181,14 @@ def run(args: argparse.Namespace) -> int:
             grades = grade_all_on_cluster(graded, checks, address, progress=progress, **options)
         else:
             grades = grading.grade_all(graded, checks, jobs=jobs, progress=progress, **options)
-        book.write(args.out)
+        explained = save()
         grades = unusable + grades
         if args.feedback is not None:
-            write_feedback(args.feedback, grades, entries)
+            write_feedback(args.feedback, grades, entries, book)
+            final_points.refresh_feedback(
+                args.feedback, book.rows, explained, book.maximum.get("total", "")
+            )
+    term_options.report(terms, set(book.rows), args.out)
     print(grading.summary(grades, time.monotonic() - started))
     if args.isolation != "namespace":
         print(f"isolation: {args.isolation} (weaker than namespace; submissions were not "
@@ -175,7 +197,22 @@ def run(args: argparse.Namespace) -> int:
     print(
         f"grades written to {args.out}" + (f" ({kept} rows of earlier runs kept)" if kept else "")
     )
+    failed = [grade for grade in grades if grade.grader_failed]
+    if failed:
+        print(grader_failure(failed), file=sys.stderr)
+        return 2
     return 0 if all(grade.graded for grade in grades) else 1
+
+
+def grader_failure(failed: list[grading.Grade]) -> str:
+    """What to tell the instructor when the grader itself failed on ``failed``."""
+    note = next(n for n in failed[0].notes if n.startswith(grading.GRADER_ERROR))
+    plural = "s" if len(failed) > 1 else ""
+    return (
+        f"msdlab grade: the grader failed on {len(failed)} submission{plural}, no fault of "
+        f"their authors, who got no feedback file: {feedback.scrub(note)}. Fix the grader and "
+        "run the same command with --resume to grade only those."
+    )
 
 
 def shown(grade: grading.Grade, entry: intake.Entry) -> grading.Grade:
@@ -184,21 +221,28 @@ def shown(grade: grading.Grade, entry: intake.Entry) -> grading.Grade:
 
 
 def write_feedback(
-    folder: Path, grades: list[grading.Grade], entries: dict[str, intake.Entry]
+    folder: Path,
+    grades: list[grading.Grade],
+    entries: dict[str, intake.Entry],
+    book: gradebook.Gradebook,
 ) -> None:
-    """DIR/students/ID.md, DIR/instructor/ID.md and DIR/summary.md."""
+    """DIR/students/ID.md (none where the grader failed), DIR/instructor/ID.md, and
+    DIR/summary.md over every row of ``book``."""
     for kind in ("students", "instructor"):
         (folder / kind).mkdir(parents=True, exist_ok=True)
     for grade in (shown(g, entries[g.submission]) for g in grades):
         stem = intake.file_stem(grade.submission)
-        (folder / "students" / f"{stem}.md").write_text(
-            feedback.for_student(grade), encoding="utf-8"
-        )
+        student = folder / "students" / f"{stem}.md"
+        if grade.grader_failed:  # nothing to hand out; an earlier run's file is out of date
+            student.unlink(missing_ok=True)
+        else:
+            student.write_text(feedback.for_student(grade), encoding="utf-8")
         source = intake.escaped(str(entries[grade.submission].source))
         (folder / "instructor" / f"{stem}.md").write_text(
             feedback.for_instructor(grade, source), encoding="utf-8"
         )
-    (folder / "summary.md").write_text(feedback.class_summary(grades), encoding="utf-8")
+    summary = feedback.class_summary(book, grades)
+    (folder / "summary.md").write_text(summary, encoding="utf-8")
 
 
 def _tasks(text: str) -> list[int]:

@@ -1,0 +1,147 @@
+"""Each row's final points: the checks' points, manual changes, and the late penalty.
+
+    total = points (the checks') − late_penalty + adjustment
+
+Task changes (`adjustments`) come first; the late penalty is taken from the points after
+them; then the changes to the total. ``adjustment`` is whatever the manual changes added
+in all. Every grading run settles every row of the grades file again, so a row kept from
+an earlier run gets the changes made since. Without ``--due`` a run charges no penalty
+to the submissions it grades and leaves earlier rows' penalties as they were.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from datetime import datetime
+from fractions import Fraction
+from pathlib import Path
+
+from ..course import TASKS
+from .adjustments import Change
+from .handin import HandIn
+from .intake import file_stem
+from .late import LatePolicy, format_points
+
+COLUMNS = ["points", "due", "handed_in", "handed_in_from", "late", "late_penalty", "adjustment"]
+"""The grades file's columns between ``task5`` and ``total``."""
+MARK = "<!-- msdlab: late work and manual changes -->"
+END = "<!-- msdlab: end of late work and manual changes -->"
+_SECTION = re.compile(re.escape(MARK) + ".*?" + re.escape(END) + "\n*", re.S)
+_HEADLINE = re.compile(r"^(\*\*[\d.]+ of [\d.]+ points\*\*|[\d.]+/[\d.]+ points).*\n", re.M)
+"""The feedback's first line of points: the student's ``**P of Q points**``, the
+instructor's ``P/Q points``; the section goes right below it."""
+
+
+@dataclass
+class Terms:
+    """The class's due date (None: no late penalties charged this run), its late policy,
+    each student's own due date, hand-in times read this run, and the manual changes."""
+
+    due: datetime | None = None
+    policy: LatePolicy = field(default_factory=LatePolicy)
+    own_due: dict[str, datetime] = field(default_factory=dict)
+    handed_in: dict[str, HandIn] = field(default_factory=dict)
+    changes: dict[str, list[Change]] = field(default_factory=dict)
+
+    def due_of(self, identifier: str) -> datetime | None:
+        return self.own_due.get(identifier, self.due)
+
+
+def settle(rows: dict[str, dict[str, str]], terms: Terms) -> dict[str, list[str]]:
+    """Write every row's final columns; return for each id the lines its feedback shows
+    (none for a row with neither a due date nor a change)."""
+    return {identifier: _settle_row(identifier, row, terms) for identifier, row in rows.items()}
+
+
+def _settle_row(identifier: str, row: dict[str, str], terms: Terms) -> list[str]:
+    checks = {t: Fraction(row.get(f"task{t}") or 0) for t in TASKS}
+    row["points"] = row.get("points") or format_points(sum(checks.values()))
+    changes = terms.changes.get(identifier, [])
+    lines = [f"- {change}" for change in changes]
+    for change in (c for c in changes if c.task is not None):
+        checks[change.task] = change.apply(checks[change.task])
+    points = sum(checks.values())
+    _stamp(row, terms.handed_in.get(identifier))
+    due = terms.due_of(identifier)
+    if due is not None:
+        _charge(row, points, due, terms, identifier in terms.own_due)
+    penalty = Fraction(row.get("late_penalty") or 0)
+    if row.get("late"):
+        lines.append(f"- {row['late']}")
+    total = points - penalty
+    for change in (c for c in changes if c.task is None):
+        total = change.apply(total)
+    row["adjustment"] = format_points(total - Fraction(row["points"]) + penalty) if changes else ""
+    row["total"] = format_points(total)
+    return lines
+
+
+def _stamp(row: dict[str, str], handed: HandIn | None) -> None:
+    """The row's hand-in time and where it was read (kept as it was if not read this run)."""
+    if handed is not None:
+        row["handed_in"] = handed.time.isoformat(timespec="seconds") if handed.time else ""
+        row["handed_in_from"] = handed.source
+
+
+def _charge(row: dict[str, str], points: Fraction, due: datetime, terms: Terms, own: bool) -> None:
+    """The late penalty on ``points`` of a row due at ``due`` (``own``: an extension)."""
+    row["due"] = due.isoformat(timespec="minutes")
+    if not row.get("handed_in"):
+        row["late"], row["late_penalty"] = "hand-in time unknown: no late penalty", ""
+        return
+    handed = datetime.fromisoformat(row["handed_in"])
+    lateness = terms.policy.charge(points, handed - due)
+    when = f"due {_shown(due)}{' (your extension)' if own else ''}, handed in {_shown(handed)}"
+    row["late"] = f"{when} ({row.get('handed_in_from') or 'time'}): {lateness.reason}"
+    row["late_penalty"] = format_points(lateness.penalty) if lateness.penalty else ""
+
+
+def _shown(moment: datetime) -> str:
+    return moment.strftime("%Y-%m-%d %H:%M UTC%z").replace("UTC+0000", "UTC")
+
+
+def feedback_section(row: dict[str, str], lines: list[str], possible: str) -> str:
+    """The feedback's section on late work and manual changes ('' if there is none)."""
+    if not lines:
+        return ""
+    return "\n".join([
+        MARK, "", "## Late work and manual changes", "",
+        f"The checks gave {row['points']} of {possible} points.", "", *lines, "",
+        f"**Total: {row['total']} of {possible} points** (checks {row['points']}"
+        f"{_term(' − late penalty ', row.get('late_penalty'))}"
+        f"{_term(' + adjustment ', row.get('adjustment'))}).", "", END, "",
+    ])  # fmt: skip
+
+
+def _term(label: str, value: str | None) -> str:
+    if not value or Fraction(value) == 0:
+        return ""
+    if label.startswith(" + ") and Fraction(value) < 0:
+        return f" − adjustment {format_points(-Fraction(value))}"
+    return f"{label}{value}"
+
+
+def refresh_feedback(folder: Path, rows: dict[str, dict[str, str]], lines: dict[str, list[str]],
+                     possible: str) -> None:  # fmt: skip
+    """Put the section on late work and manual changes into each feedback file there is
+    (the student's and the instructor's), replacing the one an earlier run wrote."""
+    for identifier, row in rows.items():
+        section = feedback_section(row, lines.get(identifier, []), possible)
+        for kind in ("students", "instructor"):
+            path = Path(folder) / kind / f"{file_stem(identifier)}.md"
+            if path.is_file():
+                path.write_text(with_section(path.read_text(encoding="utf-8"), section),
+                                encoding="utf-8")  # fmt: skip
+
+
+def with_section(text: str, section: str) -> str:
+    """The feedback ``text`` with ``section`` (none if '') below its first line of points
+    (at its end if it has none), in place of the section it had."""
+    text = _SECTION.sub("", text).rstrip("\n") + "\n"
+    if not section:
+        return text
+    headline = _HEADLINE.search(text)
+    if headline is None:
+        return text.rstrip("\n") + "\n\n" + section
+    return f"{text[: headline.end()]}\n{section}{text[headline.end() :].lstrip(chr(10))}"
