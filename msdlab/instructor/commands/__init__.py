@@ -1,5 +1,5 @@
 """The instructor's sub-commands of the ``msdlab`` command line."""
 
-from . import grade, gradescope, release, templates, validate
+from . import grade, gradescope, release, similarity, templates, validate
 
-COMMANDS = [templates, grade, gradescope, release, validate]
+COMMANDS = [templates, grade, similarity, gradescope, release, validate]

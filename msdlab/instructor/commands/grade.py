@@ -31,6 +31,7 @@ from ...analysis.cluster import parse_cluster
 from ...course import PROJECT_ROOT, TASKS
 from .. import feedback, gradebook, grading, intake, sandbox
 from ..cluster_grading import grade_all_on_cluster
+from . import similarity
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -47,6 +48,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--out", type=Path, required=True, help="CSV file to write")
     parser.add_argument("--feedback", type=Path, default=None, help="folder for feedback files")
     parser.add_argument("--detail", action="store_true", help="also a column per check")
+    parser.add_argument(
+        "--similarity",
+        action="store_true",
+        help="also the similarity report (msdlab similarity) in the folder similarity/ beside "
+        "the CSV; it changes no points",
+    )
     parser.add_argument(
         "--resume", action="store_true", help="skip submissions graded with the same checks"
     )
@@ -103,6 +110,8 @@ def run(args: argparse.Namespace) -> int:
         return 2
     if bool(args.roster) == bool(args.submissions):
         raise ValueError("give SUBMISSION folders or zip files, or --roster FILE (not both)")
+    if args.similarity:
+        similarity.require_copydetect()
     book = gradebook.Gradebook.load(args.out)
     checks = args.checks.resolve()
     with (
@@ -167,6 +176,9 @@ def run(args: argparse.Namespace) -> int:
         grades = unusable + grades
         if args.feedback is not None:
             write_feedback(args.feedback, grades, entries)
+        if args.similarity:
+            folders = {i: e.folder for i, e in entries.items() if e.problem is None}
+            similarity.write_report(folders, args.out.parent / "similarity")
     print(grading.summary(grades, time.monotonic() - started))
     if args.isolation != "namespace":
         print(f"isolation: {args.isolation} (weaker than namespace; submissions were not "
