@@ -69,8 +69,8 @@ def compare(submissions: Mapping[str, Path], templates: Path) -> list[Pair]:
 
 
 def _template_hashes(template: Path) -> list[int]:
-    if not template.is_file():
-        return []
+    if not template.is_file():  # without it the given code would count as shared
+        raise FileNotFoundError(f"no template {template.name} in {template.parent}")
     return list(CodeFingerprint(str(template), NOISE, 1, fp=io.StringIO(_read(template))).hashes)
 
 

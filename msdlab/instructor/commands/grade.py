@@ -28,7 +28,7 @@ from pathlib import Path
 from tqdm.auto import tqdm
 
 from ...analysis.cluster import parse_cluster
-from ...course import PROJECT_ROOT, TASKS
+from ...course import PROJECT_ROOT, TASKS, own_numbers
 from .. import feedback, gradebook, grading, intake, sandbox
 from ..cluster_grading import grade_all_on_cluster
 from . import similarity
@@ -164,6 +164,7 @@ def run(args: argparse.Namespace) -> int:
             memory_mb=args.memory,
             isolation=args.isolation,
             allow_delegation=_tasks(args.allow_delegation),
+            own_numbers=own_numbers.enabled(checks.parent.parent),  # the course's settings
         )
         graded = [grading.Submission(e.id, e.folder) for e in todo]
         if not graded:
