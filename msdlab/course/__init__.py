@@ -14,6 +14,7 @@ is `msdlab.instructor`, which the student bundle does not contain.)
 - `report`: the machine-readable result of a check run, and its text table.
 - `call_limit`: the time limit on each call into a task file (``msdlab check --call-timeout``).
 - `manifest`: what the checks of each task are worth, hidden ones included.
+- `own_numbers`: each student's own template parameters, derived from their roster id.
 - `pytest_plugin`: ``--impl``, the task fixtures, markers, points and the JSON report.
 """
 

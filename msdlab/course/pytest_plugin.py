@@ -31,7 +31,7 @@ from typing import Any
 
 import pytest
 
-from . import TASKS, call_limit, delegation, failure, loader, manifest
+from . import TASKS, call_limit, delegation, failure, loader, manifest, own_numbers
 from .report import CheckReport, CheckResult
 
 ENV_IMPL = loader.ENV_IMPL
@@ -76,6 +76,13 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         default=0.0,
         metavar="S",
         help="seconds one call into the implementation may take (default 0: no limit)",
+    )
+    group.addoption(
+        "--student",
+        default=None,
+        metavar="ID",
+        help="grade against this student's own numbers (msdlab.course.own_numbers; default: "
+        "the id in the implementation's student.json, else the template's numbers)",
     )
     group.addoption(
         "--msdlab-points",
@@ -129,6 +136,18 @@ def implementation(pytestconfig: pytest.Config) -> Iterator[loader.Implementatio
         close = getattr(provided, "close", None)
         if close is not None:
             close()
+
+
+@pytest.fixture(scope="session", name="own_numbers")
+def own_numbers_fixture(
+    pytestconfig: pytest.Config, implementation: loader.Implementation
+) -> own_numbers.Numbers:
+    """The numbers of the student under test (`own_numbers`)."""
+    student = pytestconfig.getoption("student")
+    folder = getattr(implementation, "folder", None)
+    if student is None and folder is not None:
+        student = own_numbers.student_of(folder)
+    return own_numbers.numbers(student)
 
 
 def _task_fixture(number: int):

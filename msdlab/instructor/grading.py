@@ -109,6 +109,7 @@ def grade(
     allow_delegation: Sequence[int] = (),
     references: Path | None = None,
     server: ForkedJudges | None = None,
+    own_numbers: bool = False,
 ) -> Grade:
     """Grade one submission with the checks in ``checks`` (see the module docstring).
 
@@ -116,14 +117,15 @@ def grade(
     ``isolation`` is the sandbox's level (`sandbox.ISOLATION_LEVELS`); a weaker one
     than ``namespace`` is named in the row's notes. ``references`` is a folder the
     judges share for references (`reference_cache`). With a ``server`` the judge is
-    forked from it (`judges`) instead of started afresh.
+    forked from it (`judges`) instead of started afresh. With ``own_numbers`` the checks
+    use the numbers of the student the submission's id names (`course.own_numbers`).
     """
     if uid is None and os.geteuid() == 0:
         with reserved_uids(1) as (reserved,):
             return grade(submission, checks, timeout=timeout, call_timeout=call_timeout,
                          memory_mb=memory_mb, uid=reserved, isolation=isolation,
                          allow_delegation=allow_delegation, references=references,
-                         server=server)  # fmt: skip
+                         server=server, own_numbers=own_numbers)  # fmt: skip
     started = time.monotonic()
     workspace = Path(tempfile.mkdtemp(prefix="msdlab-grade-"))
     try:
@@ -140,6 +142,7 @@ def grade(
             "--sandbox", "--sandbox-timeout", str(call_timeout), "--sandbox-memory", str(memory_mb),
             "--msdlab-report", str(report_path),
             "--allow-delegation", ",".join(str(task) for task in allow_delegation),
+            *([f"--student={submission.name}"] if own_numbers else []),
         ]  # fmt: skip
         environment = judge_environment()
         environment["MSDLAB_SANDBOX_ISOLATION"] = isolation
@@ -187,7 +190,7 @@ def grade_all(
     progress: Callable[[Grade, int, int], None] | None = None,
     isolation: str = "namespace",
     allow_delegation: Sequence[int] = (),
-    **limits: float,
+    **limits: float | bool,
 ) -> list[Grade]:
     """Grade ``submissions``, ``jobs`` at a time (threads: each judge is its own process);
     ``progress(grade, done, count)`` as each ends."""

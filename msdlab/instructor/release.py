@@ -16,7 +16,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from ..course import manifest
+from ..course import TASKS, manifest, own_numbers
 from ..course.runner import CHECKS
 from .release_rules import shipped_files, solution_leaks, solution_lines
 
@@ -95,9 +95,22 @@ class ReleaseError(RuntimeError):
     """The bundle would contain something students must not get."""
 
 
-def build(out: Path, root: Path, force: bool = False) -> list[Path]:
-    """Write the student release of the course at ``root`` into ``out``; return its files."""
+def build(out: Path, root: Path, force: bool = False, student: str | None = None) -> list[Path]:
+    """Write the student release of the course at ``root`` into ``out``; return its files.
+
+    Where the course gives each student their own numbers (`own_numbers.enabled`), the
+    release is one ``student``'s: their numbers in the templates, their id beside them.
+    """
     out, root = Path(out).resolve(), Path(root).resolve()
+    own = own_numbers.enabled(root)
+    if own != (student is not None):
+        raise ValueError(
+            f"{root / own_numbers.SETTINGS_FILE} gives each student their own numbers: build "
+            "one release per student with --student ID (the roster id)"
+            if own
+            else "--student is for a course that gives each student their own numbers: set "
+            f'"own_numbers": true in {root / own_numbers.SETTINGS_FILE}, or leave --student out'
+        )
     if out == root or root in out.parents:
         raise ValueError(f"write the release outside the course folder {root}")
     if out.exists() and any(out.iterdir()):
@@ -117,6 +130,8 @@ def build(out: Path, root: Path, force: bool = False) -> list[Path]:
         pyproject = (root / "pyproject.toml").read_text(encoding="utf-8")
         (out / "pyproject.toml").write_text(student_pyproject(pyproject), encoding="utf-8")
         written.append(out / "pyproject.toml")
+    if student is not None:
+        written.append(_personalise(out / "assignments", student))
     (out / "README.md").write_text(STUDENT_README, encoding="utf-8")
     (out / ".gitignore").write_text(STUDENT_GITIGNORE, encoding="utf-8")
     points = out / CHECKS / manifest.FILE_NAME
@@ -151,6 +166,16 @@ def student_pyproject(text: str) -> str:
         if keep:
             kept.append(line)
     return "".join(kept + pending)
+
+
+def _personalise(assignments: Path, student: str) -> Path:
+    """Put ``student``'s own numbers into the templates; write their id beside them."""
+    numbers = own_numbers.numbers(student)
+    for task in TASKS:
+        template = assignments / f"task{task}.py"
+        source = template.read_text(encoding="utf-8")
+        template.write_text(own_numbers.personalised(task, source, numbers), encoding="utf-8")
+    return own_numbers.write_student(assignments, student)
 
 
 def _write_points(checks: Path, path: Path) -> None:

@@ -27,6 +27,7 @@ import ast
 import contextlib
 import dataclasses
 import importlib.util
+import inspect
 import json
 import random
 import shutil
@@ -41,7 +42,7 @@ from typing import Any, NoReturn
 
 import numpy as np
 
-from ..course import call_limit, delegation
+from ..course import call_limit, delegation, own_numbers
 from ..course.loader import FolderImplementation
 from . import trivial
 
@@ -181,7 +182,7 @@ def run_checks(
                 np.errstate(all="ignore"),
             ):
                 warnings.simplefilter("ignore")
-                check.function(**{f"task{check.task}": module})
+                check.function(**_arguments(check, module))
         except (KeyboardInterrupt, SystemExit):
             raise
         except BaseException as error:  # whatever the code under test raises
@@ -191,6 +192,14 @@ def run_checks(
         else:
             outcomes[check.name] = Outcome(True)
     return outcomes
+
+
+def _arguments(check: Check, module: Any) -> dict[str, Any]:
+    """The fixtures ``check`` takes: its task's module, and the template's own numbers."""
+    arguments = {f"task{check.task}": module}
+    if "own_numbers" in inspect.signature(check.function).parameters:
+        arguments["own_numbers"] = own_numbers.DEFAULT
+    return arguments
 
 
 def run_source(

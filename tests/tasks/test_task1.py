@@ -142,20 +142,21 @@ def test_height_after_as_template(task1):
 
 
 @pytest.mark.points(2)
-def test_steps_to_floor_as_template(task1):
+def test_steps_to_floor_as_template(task1, own_numbers):
     """steps_to_floor() is the step in which the running template's floor first catches the
-    bottom layer."""
-    start = oracles.template_positions((3, 2, 3), 0.1, (-1.0, BOTTOM, -1.0))
-    frames = oracles.template_run(start, 600)
+    bottom layer (of the student's own template where each student has their own numbers)."""
+    bottom, g = own_numbers.bottom, own_numbers.gravity
+    start = oracles.template_positions((3, 2, 3), 0.1, (-1.0, bottom, -1.0))
+    frames = oracles.template_run(start, 1000, acceleration=(0.0, g, 0.0))  # own: up to 707
     on_floor = np.flatnonzero(frames[:, :, 0, :, 1].min(axis=(1, 2)) <= 0.0)
     first = int(on_floor[0])
     for got, call in (
         (task1.steps_to_floor(), "steps_to_floor()"),
-        (task1.steps_to_floor(BOTTOM, DT, G), f"steps_to_floor({BOTTOM}, {DT}, {G})"),
+        (task1.steps_to_floor(bottom, DT, g), f"steps_to_floor({bottom}, {DT}, {g})"),
     ):
         expect(
             got == first,
-            saw=f"{call} = {got!r}, but the running template's bottom layer (y0 = {BOTTOM}) "
+            saw=f"{call} = {got!r}, but the running template's bottom layer (y0 = {bottom}) "
             f"first reaches the floor in step {first} (its height after step {first - 1} is "
             f"{num(frames[first - 1, :, 0, :, 1].min())})",
             cause=f"one step {'early' if got < first else 'late'}: the answer is the first n "

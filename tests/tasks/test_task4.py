@@ -212,21 +212,23 @@ def test_rotated_cube_holds_its_shape(task4):
 
 
 @pytest.mark.points(1)
-def test_step_cost_reports_springs_and_time(task4):
+def test_step_cost_reports_springs_and_time(task4, own_numbers):
     """step_cost gives the number of springs of the n³ grid and a plausible time per step."""
+    n = own_numbers.cost_size
     for neighbours in ((1,), (1, 2, 3)):
-        springs, seconds = task4.step_cost(6, neighbours, 5)
-        expected = oracles.grid_body((6, 6, 6), 1.0, 1.0, neighbours).n_springs
+        springs, seconds = task4.step_cost(n, neighbours, 5)
+        expected = oracles.grid_body((n, n, n), 1.0, 1.0, neighbours).n_springs
         expect(
             springs == expected,
-            saw=f"step_cost(6, {neighbours}) counts {springs} springs, a 6³ grid has {expected}",
+            saw=f"step_cost({n}, {neighbours}) counts {springs} springs, a {n}³ grid has "
+            f"{expected}",
             cause="springs counted twice"
             if springs == 2 * expected
             else "the wrong neighbours, or a grid other than n³ (is n ignored?)",
         )
         expect(
             math.isfinite(seconds) and 0 < seconds < 1.0,
-            saw=f"step_cost(6, {neighbours}) reports {num(seconds)} s per step",
+            saw=f"step_cost({n}, {neighbours}) reports {num(seconds)} s per step",
             cause="the total time not divided by the number of steps, or a wrong clock",
         )
     springs, _ = task4.step_cost(3, (1,), 1)

@@ -1,5 +1,5 @@
 """The instructor's sub-commands of the ``msdlab`` command line."""
 
-from . import export, grade, gradescope, release, templates, validate
+from . import export, grade, gradescope, release, similarity, templates, validate
 
-COMMANDS = [templates, grade, export, gradescope, release, validate]
+COMMANDS = [templates, grade, similarity, export, gradescope, release, validate]

@@ -35,9 +35,10 @@ from pathlib import Path
 from tqdm.auto import tqdm
 
 from ...analysis.cluster import parse_cluster
-from ...course import PROJECT_ROOT, TASKS
+from ...course import PROJECT_ROOT, TASKS, own_numbers
 from .. import feedback, final_points, gradebook, grading, intake, sandbox, term_options
 from ..cluster_grading import grade_all_on_cluster
+from . import similarity
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -54,6 +55,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--out", type=Path, required=True, help="CSV file to write")
     parser.add_argument("--feedback", type=Path, default=None, help="folder for feedback files")
     parser.add_argument("--detail", action="store_true", help="also a column per check")
+    parser.add_argument(
+        "--similarity",
+        action="store_true",
+        help="also the similarity report (msdlab similarity) in the folder similarity/ beside "
+        "the CSV; it changes no points",
+    )
     parser.add_argument(
         "--resume", action="store_true", help="skip submissions graded with the same checks"
     )
@@ -111,6 +118,8 @@ def run(args: argparse.Namespace) -> int:
         return 2
     if bool(args.roster) == bool(args.submissions):
         raise ValueError("give SUBMISSION folders or zip files, or --roster FILE (not both)")
+    if args.similarity:
+        similarity.require_copydetect()
     book = gradebook.Gradebook.load(args.out)
     checks = args.checks.resolve()
     terms = term_options.terms(args)
@@ -173,6 +182,7 @@ def run(args: argparse.Namespace) -> int:
             memory_mb=args.memory,
             isolation=args.isolation,
             allow_delegation=_tasks(args.allow_delegation),
+            own_numbers=own_numbers.enabled(checks.parent.parent),  # the course's settings
         )
         graded = [grading.Submission(e.id, e.folder) for e in todo]
         if not graded:
@@ -188,6 +198,9 @@ def run(args: argparse.Namespace) -> int:
             final_points.refresh_feedback(
                 args.feedback, book.rows, explained, book.maximum.get("total", "")
             )
+        if args.similarity:
+            folders = {i: e.folder for i, e in entries.items() if e.problem is None}
+            similarity.write_report(folders, args.out.parent / "similarity")
     term_options.report(terms, set(book.rows), args.out)
     print(grading.summary(grades, time.monotonic() - started))
     if args.isolation != "namespace":

@@ -4,6 +4,8 @@ It holds the engine, the task templates (assignments/), the notebooks without
 their outputs and the public checks; no solutions/, no hidden checks, and no
 line of a solution anywhere (the build stops if one turns up). The bundle has
 its own README whose quick start installs it, runs the demo and the checks.
+Where the course gives each student their own numbers ("own_numbers": true in its
+course.json), each release is one student's: --student ID.
 """
 
 from __future__ import annotations
@@ -27,13 +29,22 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default=PROJECT_ROOT,
         help="course folder with solutions/ (default: this installation's, %(default)s)",
     )
+    parser.add_argument(
+        "--student",
+        metavar="ID",
+        default=None,
+        help="the student (roster id) this release is for, where the course gives each "
+        "student their own numbers (course.json)",
+    )
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     if not (args.course / "solutions").is_dir():
         raise FileNotFoundError(f"{args.course} has no solutions/: give the course folder")
-    files = release.build(args.out, args.course, force=args.force)
+    files = release.build(args.out, args.course, force=args.force, student=args.student)
     print(f"student release: {len(files)} files in {args.out.resolve()}")
     print("no solutions, no hidden checks, no solution text; notebooks without outputs")
+    if args.student is not None:
+        print(f"with the own numbers of student {args.student}")
     return 0

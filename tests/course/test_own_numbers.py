@@ -1,0 +1,137 @@
+"""Each student's own numbers: two students get different template parameters from their
+roster ids, each one's work passes against their own numbers and fails against the
+other's (in ``msdlab check``'s pytest run and in the grader), and with the switch off,
+the default, the checks and the release are those of the template."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from msdlab.course import PROJECT_ROOT, oracles, own_numbers
+from msdlab.course.report import CheckReport
+from msdlab.instructor import grading, release
+
+CHECKS = PROJECT_ROOT / "tests" / "tasks"
+TEMPLATE_1 = (PROJECT_ROOT / "assignments" / "task1.py").read_text(encoding="utf-8")
+SOLUTION_1 = (PROJECT_ROOT / "solutions" / "task1.py").read_text(encoding="utf-8")
+FLOOR_CHECK = "steps_to_floor_as_template"
+
+
+def own_solution(folder: Path, student: str) -> Path:
+    """The reference answer of task 1 in ``student``'s own template (their id beside it)."""
+    folder.mkdir(parents=True)
+    text = own_numbers.personalised(1, SOLUTION_1, own_numbers.numbers(student))
+    (folder / "task1.py").write_text(text, encoding="utf-8")
+    own_numbers.write_student(folder, student)
+    return folder
+
+
+def check_task1(folder: Path, report: Path, *options: str) -> CheckReport:
+    """Task 1's public checks on ``folder``, as ``msdlab check 1`` runs them."""
+    command = [sys.executable, "-m", "pytest", str(CHECKS / "test_task1.py"), f"--impl={folder}",
+               f"--msdlab-report={report}", "-q", "--tb=no", "-p", "no:cacheprovider",
+               "-p", "no:nbval", *options]  # fmt: skip
+    subprocess.run(command, cwd=PROJECT_ROOT, capture_output=True, check=False)
+    return CheckReport.read(report)
+
+
+def failed(report: CheckReport) -> set[str]:
+    return {check.name for check in report.checks if not check.passed}
+
+
+def test_two_students_get_different_numbers_from_their_ids():
+    alice, carol = own_numbers.numbers("alice"), own_numbers.numbers("carol")
+    assert alice == own_numbers.numbers("alice") == own_numbers.numbers(" alice ")
+    assert alice.bottom != carol.bottom and alice.gravity != carol.gravity
+    assert alice.cost_size != carol.cost_size
+    assert alice.bottom in own_numbers.HEIGHTS and carol.gravity in own_numbers.ACCELERATIONS
+
+
+def test_the_defaults_are_the_templates_numbers():
+    """Off (no student): the checks use exactly the numbers they always used."""
+    spec = importlib.util.spec_from_file_location(
+        "template_task1", PROJECT_ROOT / "assignments" / "task1.py"
+    )
+    template = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(template)
+    default = own_numbers.numbers(None)
+    assert default.bottom == template.ORIGIN[1] and default.gravity == template.GRAVITY[1]
+    assert default.gravity == oracles.TEMPLATE_GRAVITY[1] and default.cost_size == 6
+    assert own_numbers.personalised(1, TEMPLATE_1, default) == TEMPLATE_1
+
+
+def test_own_template_changes_only_its_numbers():
+    alice = own_numbers.numbers("alice")
+    own = own_numbers.personalised(1, TEMPLATE_1, alice)
+    changed = [(a, b) for a, b in zip(TEMPLATE_1.splitlines(), own.splitlines()) if a != b]
+    assert changed == [
+        ("ORIGIN = (-1.0, 1.5, -1.0)  # position of particle (0, 0, 0)",
+         f"ORIGIN = (-1.0, {alice.bottom}, -1.0)  # position of particle (0, 0, 0)"),
+        ("GRAVITY = (0.0, -0.001, 0.0)  # the template's acceleration a",
+         f"GRAVITY = (0.0, {alice.gravity}, 0.0)  # the template's acceleration a"),
+    ]  # fmt: skip
+
+
+def test_each_passes_against_their_own_numbers_and_fails_against_the_others(tmp_path):
+    alice = own_solution(tmp_path / "alice", "alice")
+    carol = own_solution(tmp_path / "carol", "carol")
+    own_alice = check_task1(alice, tmp_path / "a.json")  # the id from student.json
+    own_carol = check_task1(carol, tmp_path / "c.json")
+    assert own_alice.earned == own_alice.points > 0 and own_carol.earned == own_carol.points
+    handed = check_task1(alice, tmp_path / "ac.json", "--student=carol")  # alice's answers
+    assert failed(handed) == {FLOOR_CHECK}  # ... handed to carol
+
+
+def test_without_own_numbers_nothing_changes(tmp_path):
+    """No course.json: the switch is off, the checks use the template's numbers, and a
+    release for one student is refused with the way to switch it on."""
+    assert not own_numbers.enabled(PROJECT_ROOT)
+    folder = tmp_path / "plain"
+    folder.mkdir()
+    (folder / "task1.py").write_text(SOLUTION_1, encoding="utf-8")
+    assert failed(check_task1(folder, tmp_path / "plain.json")) == set()
+    with pytest.raises(ValueError, match=r'set "own_numbers": true in .*course\.json'):
+        release.build(tmp_path / "out", PROJECT_ROOT, student="alice")
+
+
+def test_the_settings_switch_is_checked(tmp_path):
+    (tmp_path / "course.json").write_text('{"own_numbers": "yes"}')
+    with pytest.raises(ValueError, match='"own_numbers" must be true or false'):
+        own_numbers.enabled(tmp_path)
+    (tmp_path / "course.json").write_text(json.dumps({"own_numbers": True}))
+    assert own_numbers.enabled(tmp_path)
+    with pytest.raises(ValueError, match="one release per student with --student ID"):
+        release.build(tmp_path / "out", tmp_path)
+
+
+def test_a_release_for_one_student_holds_their_numbers(tmp_path):
+    assignments = shutil.copytree(PROJECT_ROOT / "assignments", tmp_path / "assignments")
+    release._personalise(assignments, "carol")
+    carol = own_numbers.numbers("carol")
+    assert f"ORIGIN = (-1.0, {carol.bottom}, -1.0)" in (assignments / "task1.py").read_text()
+    assert own_numbers.student_of(assignments) == "carol"
+    for task in (2, 3, 4, 5):
+        assert (assignments / f"task{task}.py").read_bytes() == (
+            PROJECT_ROOT / "assignments" / f"task{task}.py"
+        ).read_bytes()
+
+
+def test_the_grader_grades_each_against_the_roster_ids_numbers(tmp_path):
+    checks = tmp_path / "checks"
+    checks.mkdir()
+    for name in ("conftest.py", "test_task1.py"):
+        shutil.copy(CHECKS / name, checks)
+    alice = own_solution(tmp_path / "alice", "alice")
+    (alice / own_numbers.STUDENT_FILE).write_text('{"id": "carol"}')  # not trusted
+    options = dict(own_numbers=True, call_timeout=20.0, isolation="process")
+    own = grading.grade(grading.Submission("alice", alice), checks, **options)
+    handed = grading.grade(grading.Submission("carol", alice), checks, **options)
+    assert own.graded and own.report.earned == own.report.points, own.notes
+    assert failed(handed.report) == {FLOOR_CHECK}
