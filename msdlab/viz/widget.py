@@ -194,8 +194,8 @@ class LiveView(anywidget.AnyWidget):
         self.recording.add(sim.time, sim.body.positions, velocities, ledger)
         with self.hold_sync():
             self.positions = sim.body.positions.astype(np.float32).tobytes()
-            if any(self.tools.values()):
-                self.readings = self.measure()
+            if any(self.tools.values()) or self.readings:  # once more, empty, when all go off
+                self.readings = self.measure() if any(self.tools.values()) else {}
             if energy:
                 self.energy = ledger
                 self.status = f"t = {sim.time:.4g}   steps {sim.step_count}"
@@ -366,10 +366,15 @@ class LiveView(anywidget.AnyWidget):
     def measure(self) -> dict:
         """What each instrument turned on in `tools` reads now, for the page."""
         sim, traced, on = self.sim, self.trace.particle, self.tools
+        unit = self.recording.units["time"]
         readings: dict = {"time": sim.time}
         if on.get("stopwatch"):
             watch = self.stopwatch
-            readings["stopwatch"] = {"reading": watch.reading, "running": watch.running}
+            readings["stopwatch"] = {
+                "reading": watch.reading,
+                "running": watch.running,
+                "unit": unit,
+            }
         if on.get("ruler"):
             distance = instruments.distance(sim, self.ruler_ends)
             readings["ruler"] = {"ends": list(self.ruler_ends), "distance": distance}
@@ -380,6 +385,7 @@ class LiveView(anywidget.AnyWidget):
                 "axis": self.trace.axis,
                 "points": self.trace.shown(),
                 "period": period,
+                "unit": unit,
             }
         if on.get("lines"):
             readings["lines"] = instruments.hanging_lines(sim, traced)
