@@ -13,6 +13,7 @@ import subprocess
 import sys
 import time
 import urllib.request
+from collections.abc import Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -67,8 +68,9 @@ def wait_until(condition, seconds: float, what: str):
 
 
 @contextmanager
-def jupyterlab_server(tmp_path: Path):
-    """A JupyterLab server of this Python on a free local port, serving ``tmp_path``."""
+def jupyterlab_server(tmp_path: Path, options: Sequence[str] = ()):
+    """A JupyterLab server of this Python on a free local port, serving ``tmp_path``,
+    with the command-line ``options`` added (``--ServerApp.name=value``)."""
     port, token = free_port(), "msdlab-test"
     env = {
         **os.environ,
@@ -101,6 +103,7 @@ def jupyterlab_server(tmp_path: Path):
             f"--ServerApp.root_dir={tmp_path}",
             "--LabApp.expose_app_in_browser=True",  # window.jupyterapp runs the cells
             "--allow-root",  # CI runs as root
+            *options,
         ],
         env=env,
         stdout=log,

@@ -19,6 +19,23 @@ from ..errors import check_non_negative
 _UP = {2: np.array([0.0, 1.0]), 3: np.array([0.0, 1.0, 0.0])}  # the default ground normal, +y
 
 
+def lead(state: StepState, particles: np.ndarray, target: np.ndarray) -> float:
+    """Move fixed ``particles`` to ``target`` (m) with the velocity of that move,
+    v = (target - x_old) / dt, and return the energy removed (J; negative: put in).
+
+    The integrator kept them where they were and stopped them; that stop is the
+    driver's doing as much as the move, so the energy before counts them still with
+    the velocity they had: the driver's work is E(target, v) - E(x_old, v_old), and
+    over a run these add up to the change in energy it caused (a hand moved on a
+    circle does no net work on a held particle's kinetic energy).
+    """
+    state.v[particles] = state.v_old[particles]
+    before = state.energy_of(particles)
+    state.x[particles] = target
+    state.v[particles] = (target - state.x_old[particles]) / state.dt
+    return before - state.energy_of(particles)
+
+
 class Ground(Constraint):
     """The template's floor: particles that end a step below the plane are put back on it.
 
@@ -216,14 +233,10 @@ class Prescribed(Constraint):
         body.fixed[self.particles] = True
 
     def apply(self, state: StepState) -> float:
-        p = self.particles
-        before = state.energy_of(p)
         target = np.broadcast_to(
-            np.asarray(self.path(state.time), dtype=float), (len(p), state.body.dim)
+            np.asarray(self.path(state.time), dtype=float), (len(self.particles), state.body.dim)
         )
-        state.x[p] = target
-        state.v[p] = (target - state.x_old[p]) / state.dt
-        return before - state.energy_of(p)
+        return lead(state, self.particles, target)
 
 
 class Grab(Constraint):
@@ -267,8 +280,4 @@ class Grab(Constraint):
     def apply(self, state: StepState) -> float:
         if self.particle is None or self.target is None:
             return 0.0
-        p = np.array([self.particle])
-        before = state.energy_of(p)
-        state.x[p] = self.target
-        state.v[p] = (self.target - state.x_old[p]) / state.dt
-        return before - state.energy_of(p)
+        return lead(state, np.array([self.particle]), self.target)

@@ -1,7 +1,10 @@
 // msdlab's live view and replay player: a mass-spring body drawn on a canvas.
 //
-// The page draws at its own frame rate (requestAnimationFrame) from the latest
-// positions it has; it never waits for Python. 2-D bodies are drawn as they are;
+// The page draws at its own frame rate (requestAnimationFrame) and never waits for
+// Python. The kernel sends one message per state (positions, and every few states
+// the energies and the status line) at the page's frame rate, which the page reports;
+// the page queues the states and shows one a frame, so states that arrive together
+// (the network bunches small messages) are each shown, not only the last. 2-D bodies are drawn as they are;
 // 3-D ones through an orbit camera (orthographic: left-drag on empty space or
 // right-drag turns, the wheel zooms). Springs are coloured by strain on the
 // colour table the scene brings (matplotlib's coolwarm in 64 levels).
@@ -11,6 +14,9 @@ const PICK_RADIUS = 25; // px: how near the mouse a particle must be to be taken
 const HISTORY = 600; // points of the energy plot
 const DENSE = 3000; // springs from which lines are written as pixels (`Pixels`)
 const SURFACE_ONLY = 30000; // springs from which a 3-D body is drawn by its surface
+const QUEUED = 3; // states kept waiting at most: older ones are dropped (3 frames late at most)
+const PICTURE_TIMES = 1200; // times of the last new pictures kept in a view's stats
+const REPORT_EVERY = 2000; // ms between two reports of the page's frame rate to the kernel
 
 /** A typed array of `Type` over a DataView, ArrayBuffer or typed array. */
 function typed(data, Type) {
@@ -433,12 +439,29 @@ class EnergyPanel {
 
 /** What a view counted (for benchmarks and tests): frames (requestAnimationFrame calls),
  * pictures drawn (frames in which something changed), new positions received (updates),
- * and the delays (ms) from a mouse move to the frame drawing the held particle at the hand
- * (`drawDelays`) and to the first positions from the engine with it there (`engineDelays`).
+ * new pictures (frames showing positions that differ from the frame before) and the
+ * times (ms) of the last `PICTURE_TIMES` of them, and the delays (ms) from a mouse move
+ * to the frame drawing the held particle at the hand (`drawDelays`) and to the first
+ * positions from the engine with it there (`engineDelays`).
  * Each view is listed in `window.msdlabViews`. */
 function newStats() {
-  return { frames: 0, drawn: 0, updates: 0, drawDelays: [], engineDelays: [],
-    moved: null, pending: null };
+  return { frames: 0, drawn: 0, updates: 0, pictures: 0, pictureTimes: [], drawDelays: [],
+    engineDelays: [], moved: null, pending: null };
+}
+
+/** Whether two position arrays hold different numbers. */
+function differ(a, b) {
+  if (a === b) return false;
+  if (!b || a.length !== b.length) return true;
+  for (let i = 0; i < a.length; i++) if (a[i] !== b[i]) return true;
+  return false;
+}
+
+/** Count a new picture (positions unlike the last shown) at time `now` (ms). */
+function countPicture(stats, now) {
+  stats.pictures++;
+  stats.pictureTimes.push(now);
+  if (stats.pictureTimes.length > PICTURE_TIMES) stats.pictureTimes.shift();
 }
 
 /** Whether particle `p` of `x` (dimension `d`) is at `target`, to float32's precision. */
@@ -479,6 +502,7 @@ export function mountView(el, scene, arrays, source) {
     if (positions) {
       if (positions !== last) {
         stats.updates++;
+        if (differ(positions, last)) countPicture(stats, performance.now());
         checkDelay(stats, positions, scene.dim);
       }
       letGo(view, positions, scene.dim);
@@ -637,43 +661,68 @@ function render({ model, el }) {
     fixed: typed(model.get("fixed"), Uint8Array),
   };
   let positions = typed(model.get("positions"), Float32Array);
+  const states = []; // states received, not shown yet, oldest first
   const send = (message) => model.send(message);
+  const show = (state) => { // a state's positions, and its energies and status line if any
+    positions = state.positions;
+    if (state.energy && view.energy) view.energy.update(state.energy);
+    if (state.pace !== undefined) view.status.dataset.pace = String(state.pace);
+    if (state.status !== undefined) view.status.dataset.line = state.status;
+    if (state.status !== undefined && !model.get("error")) view.status.textContent = state.status;
+    if (state.readings !== undefined) tools.update(state.readings);
+  };
   const source = {
-    latest: () => positions,
+    latest: () => { // one state a frame
+      if (states.length) show(states.shift());
+      return positions;
+    },
     grab: (particle, target) => send({ type: "grab", particle, target }),
     move: (target) => send({ type: "move", target }),
     release: () => send({ type: "release" }),
     stepping: () => model.get("running") && !model.get("error"),
-    readings: () => readingsOf(model),
+    readings: () => tools.shown(),
   };
   const view = mountView(el, scene, arrays, source);
   const onPositions = () => (positions = typed(model.get("positions"), Float32Array));
-  const onEnergy = () => view.energy && view.energy.update(model.get("energy"));
-  const onStatus = () => {
+  const onMessage = (message, buffers) => {
+    if (message.type === "export") download(message, buffers);
+    if (message.type !== "state") return;
+    states.push({ ...message, positions: typed(buffers[0], Float32Array) });
+    if (states.length > QUEUED) states.shift();
+  };
+  const onError = () => {
     const error = model.get("error");
-    view.status.textContent = error ? `stopped: ${error}` : model.get("status");
+    view.status.textContent = error ? `stopped: ${error}` : view.status.dataset.line ?? "";
     view.status.style.color = error ? "#b00" : "#333";
   };
   model.on("change:positions", onPositions);
-  model.on("change:energy", onEnergy);
-  model.on("change:status", onStatus);
-  model.on("change:error", onStatus);
+  model.on("msg:custom", onMessage);
+  model.on("change:error", onError);
   const bar = controls(view.root, model, send);
   const tools = instrumentPanel(view.root, model, send);
   keyboard(view.root, bar);
-  const onMessage = (content, buffers) => download(content, buffers);
-  model.on("msg:custom", onMessage);
-  onEnergy();
-  onStatus();
+  onError();
+  const report = reportFrames(view.stats, send);
   return () => {
     view.alive = false;
+    clearInterval(report);
     tools.stop();
-    model.off("msg:custom", onMessage);
     model.off("change:positions", onPositions);
-    model.off("change:energy", onEnergy);
-    model.off("change:status", onStatus);
-    model.off("change:error", onStatus);
+    model.off("msg:custom", onMessage);
+    model.off("change:error", onError);
   };
+}
+
+/** Tell the kernel, every `REPORT_EVERY` ms, how many frames a second the page draws:
+ * it sends that many states. The interval's id. */
+function reportFrames(stats, send) {
+  let frames = stats.frames, since = performance.now();
+  return setInterval(() => {
+    const now = performance.now();
+    const rate = (1000 * (stats.frames - frames)) / (now - since);
+    if (rate > 0) send({ type: "frames", rate });
+    [frames, since] = [stats.frames, now];
+  }, REPORT_EVERY);
 }
 
 /** Pause, step, reset, speed and the scene's settings; the controls by name, for the
@@ -712,12 +761,6 @@ const TOOL_NAMES = { stopwatch: "stopwatch (simulated time)",
   lines: "natural-length and equilibrium lines of a hung mass",
   arrows: "velocity and force arrows on the particle last taken in hand" };
 const ARROW = 60; // px: the longest arrow (PhET's vectors: scaled to show, not to units)
-
-/** The instruments' readings to draw, or null when none is turned on. */
-function readingsOf(model) {
-  const on = model.get("tools") ?? {};
-  return Object.values(on).some(Boolean) ? model.get("readings") : null;
-}
 
 /** The ruler, the lines and the arrows over the body just drawn. */
 function drawInstruments(painter, camera, readings) {
@@ -793,7 +836,9 @@ function arrow(g, [x0, y0], [x1, y1], colour) {
   g.fill();
 }
 
-/** The instruments' toggles and readouts, gravity presets and the export buttons. */
+/** The instruments' toggles and readouts, gravity presets and the export buttons.
+ * `update(readings)` shows the readings of a state; `shown()` is what to draw over the
+ * body: the last readings, or null when no instrument is on. */
 function instrumentPanel(parent, model, send) {
   const panel = element("div", { className: "msdlab-tools" }, parent);
   panel.setAttribute("role", "group");
@@ -812,18 +857,23 @@ function instrumentPanel(parent, model, send) {
   presetButtons(presets, model, send);
   element("span", { textContent: "  export the run: " }, presets);
   exportButtons(presets, send);
-  const update = () => {
-    const readings = readingsOf(model) ?? {};
+  let last = {};
+  const shown = () => (Object.values(model.get("tools") ?? {}).some(Boolean) ? last : null);
+  const show = () => {
+    const readings = shown() ?? {};
     watch.show(readings.stopwatch);
     trace.show(readings.trace, readings.time);
     ruler.hidden = !readings.ruler;
     if (readings.ruler) ruler.textContent = `ruler ${readings.ruler.distance.toPrecision(4)}`
       + ` between particles ${readings.ruler.ends.join(" and ")}`;
   };
-  model.on("change:readings", update);
-  model.on("change:tools", update);
-  update();
-  return { stop: () => { model.off("change:readings", update); model.off("change:tools", update); } };
+  model.on("change:tools", show);
+  show();
+  return {
+    update: (readings) => { last = readings; show(); },
+    shown,
+    stop: () => model.off("change:tools", show),
+  };
 }
 
 /** A button that turns the instrument `name` on and off (the `tools` trait). */

@@ -1,11 +1,13 @@
 """The live view in a notebook: an anywidget whose page draws while Python steps.
 
-The browser (``live.js``) draws at its own frame rate from the latest positions
-it has and never waits for Python. Python steps the simulation in a background
-thread at the scene's pace (``steps_per_second`` × ``speed``: 60 a second for
-the gallery, real time, 1/dt a second, for physical scenes) and, up to
-`FRAME_RATE` times a second, sends the positions as a float32 buffer and the
-energies as JSON. A thread rather than an asyncio task: the kernel's event loop
+The browser (``live.js``) draws at its own frame rate and never waits for Python.
+Python steps the simulation in a background thread at the scene's pace
+(``steps_per_second`` × ``speed``: 60 a second for the gallery, real time, 1/dt a
+second, for physical scenes) and sends a state at the page's frame rate (which the
+page reports; `FRAME_RATE` at most): one message per state, the positions as a
+float32 buffer and, every `ENERGY_EVERY` states, the energies and the status line
+inside the same message. The page queues the states and shows one a frame, so two
+that arrive together are both shown. A thread rather than an asyncio task: the kernel's event loop
 stops while a cell runs, and a thread also runs outside Jupyter (tests,
 scripts); the kernel sends comm messages from any thread. What the page asks
 (grab, move, release, step, reset, a slider) arrives on the kernel's main
@@ -30,14 +32,18 @@ from ..forces import Gravity
 from ..interaction import Grab, Ground, Walls
 from ..scenes.registry import Scene
 from ..simulation import Simulation
+from ..units import SI
 from . import frontend, instruments, settings
 from .export import Recording
 from .upright import UPS, resolve_up
 from .view import LIVE_STRAIN_LIMIT, spheres_of
 
-FRAME_RATE = 60.0  # most frames sent a second
-ENERGY_EVERY = 4  # frames sent per energy update (15 a second)
-BUDGET = 0.5 / FRAME_RATE  # s of stepping between two frames sent, at most
+FRAME_RATE = 60.0  # most states sent a second
+SLOWEST = 10.0  # fewest states sent a second, whatever the page reports
+ENERGY_EVERY = 4  # states sent per energy update (15 a second)
+BUDGET = 0.75  # of the time between two states sent, spent stepping at most
+KEEPS_PACE = 0.97  # a pace below this share of the one asked is shown in the status line
+PACE_OVER = 10.0  # steps asked, at least, over which the pace kept is measured
 _running: list[LiveView] = []  # views started by `show`, stopped when a new one starts
 
 
@@ -66,7 +72,8 @@ def energies(
     level: float = 0.0,
     v: np.ndarray | None = None,
 ) -> dict:
-    """The ledger's energies of ``sim`` now (as `Simulation.run` records them, J):
+    """The ledger's energies of ``sim`` now (as `Simulation.run` records them, in the
+    simulation's units, J in SI):
     kinetic, elastic, gravitational (counted from height ``level`` along gravity; ``zero``
     is the ledger's gravitational energy at that height), other potential, and what each
     mechanism took out since the view started; the time (s). ``v``: `velocities_now`,
@@ -98,6 +105,8 @@ class LiveView(anywidget.AnyWidget):
     ``scene`` (a registered `Scene`) adds its build settings as sliders that rebuild it.
     ``steps_per_second`` defaults to real time (1/dt); ``view`` is (azimuth, elevation) in
     degrees and ``up`` the vertical axis (by default against gravity, `upright`).
+    Energies are labelled in ``energy_unit``, by default the simulation's (`sim.units`:
+    J in SI, px²/frame² for the gallery's unit masses in pixels and frames).
     """
 
     _esm = frontend.ESM
@@ -105,15 +114,12 @@ class LiveView(anywidget.AnyWidget):
     springs = traitlets.Bytes().tag(sync=True)
     rest = traitlets.Bytes().tag(sync=True)
     fixed = traitlets.Bytes().tag(sync=True)
-    positions = traitlets.Bytes().tag(sync=True)
-    energy = traitlets.Dict().tag(sync=True)
+    positions = traitlets.Bytes().tag(sync=True)  # at the start; then in the states sent
     settings = traitlets.List().tag(sync=True)
-    status = traitlets.Unicode().tag(sync=True)
     error = traitlets.Unicode().tag(sync=True)
     running = traitlets.Bool(True).tag(sync=True)
     speed = traitlets.Float(1.0).tag(sync=True)
     tools = traitlets.Dict().tag(sync=True)  # which instruments are shown: name -> on
-    readings = traitlets.Dict().tag(sync=True)  # what the instruments shown read
     presets = traitlets.Dict().tag(sync=True)  # gravity presets, |g| in the scene's units
 
     def __init__(
@@ -124,7 +130,7 @@ class LiveView(anywidget.AnyWidget):
         steps_per_second: float | None = None,
         view: Sequence[float] | None = None,
         up: str | None = None,
-        energy_unit: str = "J",
+        energy_unit: str | None = None,
     ) -> None:
         super().__init__()
         self.scene_entry, self.pace = scene, steps_per_second
@@ -136,7 +142,12 @@ class LiveView(anywidget.AnyWidget):
         self._values: dict[str, float] = {}
         self._frames = 0
         self._moved = False  # the hand moved since the last frame
+        self.send_rate = FRAME_RATE  # states sent a second: the page's frame rate
+        self.energy: dict = {}  # the energies last sent (`energies`)
+        self.status = ""  # the status line last sent
+        self.achieved = 1.0  # steps done over steps asked since the last energy update
         self.stopwatch = instruments.Stopwatch(lambda: self.sim.time)
+        self.readings: dict = {}  # what the instruments turned on read, as last sent
         self.tools = {name: False for name in instruments.TOOLS}
         self.attach(sim)
         self.on_msg(self._on_message)
@@ -153,8 +164,8 @@ class LiveView(anywidget.AnyWidget):
         up = resolve_up(self._look[1], sim, sim.body.dim)
         self._level = ground_level(sim, UPS.index(up))
         self._up = UPS.index(up)
-        self.set_up_instruments()
         self._owed, self._clock = 0.0, time.perf_counter()
+        self._asked = self._done = 0.0
         view, _, energy_unit = self._look
         live = settings.live_settings(sim)
         rebuild = (
@@ -177,36 +188,57 @@ class LiveView(anywidget.AnyWidget):
                 setattr(self, name, data)
             self.settings = [s.as_dict() for s in (*live, *rebuild)]
             self.error = ""
-            self.publish()
+            self.positions = self._positions()
+        self.set_up_instruments()
+        self.publish()
 
     @property
     def steps_per_second(self) -> float:
         """The pace at speed 1: ``steps_per_second`` as given, or real time."""
         return self.pace if self.pace is not None else 1.0 / self.sim.dt
 
-    def publish(self, energy: bool = True) -> None:
-        """Send the positions (float32 buffer) and, if ``energy``, the energies and the
-        status line (the energies cost a force evaluation, the line a layout of the page:
-        the thread sends them every `ENERGY_EVERY` frames)."""
-        sim = self.sim
-        velocities = velocities_now(sim)
-        ledger = energies(sim, self._taken, self._level, velocities)
-        self.recording.add(sim.time, sim.body.positions, velocities, ledger)
-        with self.hold_sync():
-            self.positions = sim.body.positions.astype(np.float32).tobytes()
-            if any(self.tools.values()) or self.readings:  # once more, empty, when all go off
-                self.readings = self.measure() if any(self.tools.values()) else {}
-            if energy:
-                self.energy = ledger
-                self.status = f"t = {sim.time:.4g}   steps {sim.step_count}"
+    def _positions(self) -> bytes:
+        return self.sim.body.positions.astype(np.float32).tobytes()
 
-    def advance(self, seconds: float, budget: float = BUDGET, early: bool = False) -> int:
+    def publish(self, energy: bool = True) -> None:
+        """Send the state: one message, the positions (a float32 buffer) and, if
+        ``energy``, the energies and the status line (the energies cost a force
+        evaluation, the line a layout of the page: the thread sends them every
+        `ENERGY_EVERY` states)."""
+        content: dict = {"type": "state"}
+        if energy:
+            velocities = velocities_now(self.sim)
+            self.energy = energies(self.sim, self._taken, self._level, velocities)
+            content["energy"] = self.energy
+            self.status = content["status"] = self.status_line()
+            content["pace"] = self.achieved
+            self.recording.add(self.sim.time, self.sim.body.positions, velocities, self.energy)
+        if any(self.tools.values()) or self.readings:  # once more, empty, when all go off
+            self.readings = content["readings"] = self.measure() if any(self.tools.values()) else {}
+        self.send(content, buffers=[self._positions()])
+
+    def status_line(self) -> str:
+        """The time, the steps and, when the engine falls behind, the pace it keeps."""
+        sim, unit = self.sim, self.scene["time_unit"]
+        line = f"t = {sim.time:.4g} {unit}   steps {sim.step_count}"
+        if self._asked >= PACE_OVER:
+            self.achieved = min(1.0, self._done / self._asked)
+            self._asked = self._done = 0.0
+        if self.running and self.achieved < KEEPS_PACE:
+            asked = "real time" if self.pace is None else f"{self.steps_per_second:g} steps/s"
+            line += f"   pace {self.achieved:.2f} × {asked} (the engine cannot keep up)"
+        return line
+
+    def advance(self, seconds: float, budget: float | None = None, early: bool = False) -> int:
         """Step for ``seconds`` of wall-clock time at the pace (at most ``budget`` s of
         stepping: a slow engine runs slower than real time rather than falling behind);
         stop with the diagnosis on a blow-up. ``early``: a step now even if none is due yet
         (the hand moved: `Grab` pins the particle at the next step), one step ahead of the
         pace at most, taken from the steps owed later. The number of steps done."""
-        self._owed += seconds * self.steps_per_second * self.speed
+        if budget is None:
+            budget = BUDGET / self.send_rate
+        asked = seconds * self.steps_per_second * self.speed
+        self._owed += asked
         lent = 1.0 if early and 0.0 <= self._owed < 1.0 else 0.0
         self._owed += lent
         done, start = 0, time.perf_counter()
@@ -219,6 +251,8 @@ class LiveView(anywidget.AnyWidget):
         except SimulationDiverged as error:
             self.running, self.error = False, str(error)
         self._owed = min(self._owed, 1.0) - lent  # what was not done in time is dropped
+        self._asked += asked
+        self._done += done
         return done
 
     def do_pending(self) -> None:
@@ -251,6 +285,7 @@ class LiveView(anywidget.AnyWidget):
             "step": self.step_once,
             "reset": self.reset,
             "set": lambda: self.set(content["name"], content["value"]),
+            "frames": lambda: self.match_frames(content["rate"]),
             "stopwatch": lambda: self.press_stopwatch(content["action"]),
             "export": lambda: self.send_export(content["format"]),
         }
@@ -271,6 +306,10 @@ class LiveView(anywidget.AnyWidget):
         else:
             self.grab.move(target)
         self._moved = True
+
+    def match_frames(self, rate: float) -> None:
+        """Send as many states a second as the page draws frames (``rate``, 1/s)."""
+        self.send_rate = min(FRAME_RATE, max(SLOWEST, float(rate)))
 
     def step_once(self) -> None:
         """One step, paused or not."""
@@ -306,11 +345,11 @@ class LiveView(anywidget.AnyWidget):
         """A new run: the trace, the recording and the stopwatch start over; the trace
         follows the lowest free particle, the ruler runs from the first pinned one to it
         (``keep_picks``: the particles picked before)."""
-        sim, scene = self.sim, self.scene_entry
+        sim = self.sim
         self.stopwatch.stop()
         self.stopwatch.reset()
-        time_unit = scene.unit if scene is not None else "s"
-        self.recording = Recording(len(sim.body), sim.body.dim, time_unit, self._look[2])
+        units = (self.scene["time_unit"], self.scene["energy_unit"])
+        self.recording = Recording(len(sim.body), sim.body.dim, *units)
         if keep_picks:
             self.follow(self.trace.particle)
             return
@@ -331,14 +370,13 @@ class LiveView(anywidget.AnyWidget):
 
     def gravity_presets(self) -> dict[str, float]:
         """|g| of Earth, Moon, Jupiter and zero in the scene's units: Earth's is 9.81 in
-        SI scenes (energies in J), else the scene's own gravity at the start; none
-        without gravity."""
+        SI, else the scene's own gravity at the start; none without gravity."""
         gravity = instruments.gravity_of(self.sim)
         if gravity is None:
             return {}
         if self._start["gravity"] is None:  # no direction yet: along the view's down
             self._start["gravity"] = -np.eye(self.sim.body.dim)[self._up]
-        si = self._look[2] == "J"
+        si = self.sim.units == SI
         earth = instruments.GRAVITY["Earth"] if si else float(np.linalg.norm(gravity.g))
         return instruments.GravityPresets(earth or instruments.GRAVITY["Earth"]).values()
 
@@ -394,8 +432,9 @@ class LiveView(anywidget.AnyWidget):
         return readings
 
     def export(self, path: str | Path) -> Path:
-        """Write the run shown (time, energies, positions, velocities of every frame sent
-        to the page) to ``path``: a .csv table or a .npz of NumPy arrays."""
+        """Write the run shown to ``path``, a .csv table or a .npz of NumPy arrays: time,
+        energies, positions and velocities of each state sent with its energies (every
+        `ENERGY_EVERY`-th while it runs, 15 a second at 60; each one paused)."""
         return self.recording.write(path)
 
     def send_export(self, kind: str) -> None:
@@ -422,11 +461,16 @@ class LiveView(anywidget.AnyWidget):
         self._thread = None
 
     def _loop(self) -> None:
+        """Send a state every 1/`send_rate` s on a fixed beat (a late one does not shift
+        the next), and at once when the page asks something."""
+        beat = time.perf_counter()
         while not self._stop.is_set():
-            began = time.perf_counter()
             self._wake.clear()
             self.frame()
-            self._wake.wait(max(0.0, 1.0 / FRAME_RATE - (time.perf_counter() - began)))
+            now = time.perf_counter()
+            while beat <= now:  # the beats a slow frame overran are skipped, not caught up
+                beat += 1.0 / self.send_rate
+            self._wake.wait(beat - now)
 
 
 def in_notebook() -> bool:

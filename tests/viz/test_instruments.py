@@ -134,7 +134,7 @@ def test_gravity_presets_are_in_the_scenes_units():
     assert view.presets == pytest.approx({"Earth": 9.81, "Moon": 1.62, "Jupiter": 24.79, "zero": 0})
     view.set_gravity("Jupiter")
     assert view.sim.forces[0].g == pytest.approx([0.0, -24.79])
-    mesh = LiveView(SCENES["mesh"].build(), energy_unit="px²/frame²")  # pixels and frames
+    mesh = LiveView(SCENES["mesh"].build())  # in pixels and frames
     g = np.linalg.norm(mesh.sim.forces[0].g)
     assert mesh.presets["Earth"] == pytest.approx(g)
     assert mesh.presets["Moon"] == pytest.approx(g * 1.62 / 9.81)

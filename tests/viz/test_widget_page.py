@@ -17,8 +17,8 @@ from msdlab.viz.widget import LiveView
 pytestmark = [*needs("playwright", "anywidget"), pytest.mark.timeout(180)]
 
 BYTES = ("springs", "rest", "fixed", "positions")  # traits sent as binary
-TRAITS = (*BYTES, "scene", "energy", "settings", "status", "error", "running", "speed")
-TRAITS += ("tools", "readings", "presets")
+CHANGING = ("error", "running", "speed", "tools")  # traits a frame may change
+TRAITS = (*BYTES, "scene", "settings", "presets", *CHANGING)
 
 PAGE = """<!DOCTYPE html><html><body style="margin: 0"><div id="view"></div>
 <script type="text/plain" id="module">MODULE</script>
@@ -79,12 +79,13 @@ def state_of(view: LiveView, names=TRAITS) -> dict:
 
 
 class Kernel:
-    """Carries the page's requests to ``view`` and its new state back, a frame at a time."""
+    """Carries the page's requests to ``view`` and its states and changed traits back, a
+    frame at a time."""
 
     def __init__(self, page, view: LiveView) -> None:
         self.page, self.view = page, view
         self.asked: list = []  # everything the page asked, in order
-        view.send = self.to_page  # the view's custom messages (a download)
+        view.send = self.to_page  # the view's messages: states, a download
 
     def to_page(self, content: dict, buffers: list) -> None:
         data = base64.b64encode(buffers[0]).decode()
@@ -110,7 +111,7 @@ class Kernel:
             if view.running:
                 view.advance(1 / 60, budget=60)
             view.publish()
-            self.page.evaluate("(s) => window.model.put(s)", state_of(view))
+            self.page.evaluate("(s) => window.model.put(s)", state_of(view, CHANGING))
 
 
 @pytest.fixture
