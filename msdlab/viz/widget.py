@@ -360,6 +360,13 @@ class LiveView(anywidget.AnyWidget):
         self.ruler_ends = (start, traced)
         self.presets = self.gravity_presets()
 
+    def toggle(self, tool: str, on: bool | None = None) -> None:
+        """Show the instrument ``tool`` (stopwatch, ruler, trace, lines, arrows) or hide
+        it: ``on``, or the other way round from now."""
+        if tool not in self.tools:
+            raise ValueError(f"no instrument {tool!r}: choose one of {', '.join(self.tools)}")
+        self.tools = {**self.tools, tool: not self.tools[tool] if on is None else bool(on)}
+
     def press_stopwatch(self, button: str) -> None:
         """The stopwatch's button ``button``: start, stop or reset."""
         watch = self.stopwatch

@@ -59,11 +59,18 @@ def test_the_page_gets_the_readings_of_the_instruments_turned_on():
     view = LiveView(spring_mass())
     view.publish()
     assert view.readings == {}  # nothing turned on: nothing measured
-    view.tools = {**view.tools, "stopwatch": True, "ruler": True}
+    view.toggle("stopwatch")
+    view.toggle("ruler", True)
     view.stopwatch.start()
     run_for(view, 0.1)
     assert set(view.readings) == {"time", "stopwatch", "ruler"}
     assert view.readings["stopwatch"]["reading"] == pytest.approx(0.1, abs=1e-9)
+    view.toggle("stopwatch")
+    view.toggle("ruler", False)
+    view.publish()
+    assert view.readings == {}  # all off: the page is told once
+    with pytest.raises(ValueError, match="no instrument 'protractor': choose one of stopwatch"):
+        view.toggle("protractor")
 
 
 def test_the_traces_period_is_the_spring_masss():
@@ -72,7 +79,7 @@ def test_the_traces_period_is_the_spring_masss():
     run_for(view, 3.0)
     expected = 2 * np.pi * np.sqrt(MASS / STIFFNESS)  # 0.993 s: three periods traced
     assert view.trace.period() == pytest.approx(expected, rel=1e-4)
-    view.tools = {**view.tools, "trace": True}
+    view.toggle("trace")
     view.publish()
     trace = view.readings["trace"]
     assert trace["period"] == view.trace.period()
@@ -96,7 +103,7 @@ def test_the_ruler_and_the_trace_follow_the_particles_taken_in_hand():
     ask(view, type="release")
     ask(view, type="grab", particle=9, target=sim.body.positions[9].tolist())
     assert view.ruler_ends == (5, 9) and view.trace.particle == 9
-    view.tools = {**view.tools, "ruler": True}
+    view.toggle("ruler")
     view.publish()
     expected = np.linalg.norm(sim.body.positions[5] - sim.body.positions[9])
     assert view.readings["ruler"]["distance"] == pytest.approx(expected, rel=1e-12)
@@ -104,7 +111,7 @@ def test_the_ruler_and_the_trace_follow_the_particles_taken_in_hand():
 
 def test_the_lines_are_where_the_hung_mass_is_at_rest_and_unstretched():
     view = LiveView(spring_mass())
-    view.tools = {**view.tools, "lines": True}
+    view.toggle("lines")
     view.publish()
     lines = view.readings["lines"]
     assert lines["natural"] == pytest.approx([0.0, -REST])
@@ -115,14 +122,14 @@ def test_the_lines_are_where_the_hung_mass_is_at_rest_and_unstretched():
         -REST - MASS * 1.62 / STIFFNESS
     )
     rope = LiveView(SCENES["mesh"].build())
-    rope.tools = {**rope.tools, "lines": True}
+    rope.toggle("lines")
     rope.publish()
     assert rope.readings["lines"] is None  # no mass hung by a single spring
 
 
 def test_the_arrows_are_the_velocity_and_the_net_force():
     view = LiveView(spring_mass(pulled=0.1))
-    view.tools = {**view.tools, "arrows": True}
+    view.toggle("arrows")
     view.publish()
     arrows = view.readings["arrows"]
     assert arrows["velocity"] == pytest.approx([0.0, 0.0])
