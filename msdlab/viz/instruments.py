@@ -97,10 +97,10 @@ def gravity_of(sim: Simulation) -> Gravity | None:
 
 
 def hung_from(body: Body, particle: int) -> tuple[int, int] | None:
-    """(spring, anchor) when ``particle`` is free and hangs by its only spring from a pinned
-    particle (the anchor); else None."""
+    """(spring, anchor) when ``particle`` hangs by its only spring from a pinned particle
+    (the anchor), held in hand or not; else None."""
     springs = np.flatnonzero((body.spring_a == particle) | (body.spring_b == particle))
-    if body.fixed[particle] or len(springs) != 1:
+    if len(springs) != 1:
         return None
     spring = int(springs[0])
     anchor = int(body.spring_a[spring] + body.spring_b[spring] - particle)
