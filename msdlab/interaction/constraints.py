@@ -23,17 +23,26 @@ def lead(state: StepState, particles: np.ndarray, target: np.ndarray) -> float:
     """Move fixed ``particles`` to ``target`` (m) with the velocity of that move,
     v = (target - x_old) / dt, and return the energy removed (J; negative: put in).
 
-    The integrator kept them where they were and stopped them; that stop is the
-    driver's doing as much as the move, so the energy before counts them still with
-    the velocity they had: the driver's work is E(target, v) - E(x_old, v_old), and
-    over a run these add up to the change in energy it caused (a hand moved on a
-    circle does no net work on a held particle's kinetic energy).
+    The driver's work over the step is the change of the energy involving the
+    particles, E(target, v) - E(x_old, v_old): the integrator kept them where they were
+    and stopped them, and that stop is the driver's doing as much as the move. Their
+    neighbours are taken at the middle of the step, ½ (x_old + x): the work is then the
+    midpoint rule of ∫ F·dx along the move, exact to second order in dt (with the
+    neighbours at the step's end it falls short by a term of first order, 6 % of a hand's
+    work on the gallery's mesh).
     """
+    body = state.body
+    touching = body.springs_touching(particles)
+    ends = np.setdiff1d(np.union1d(body.spring_a[touching], body.spring_b[touching]), particles)
+    now = state.x[ends]
+    state.x[ends] = 0.5 * (state.x_old[ends] + now)
     state.v[particles] = state.v_old[particles]
     before = state.energy_of(particles)
     state.x[particles] = target
     state.v[particles] = (target - state.x_old[particles]) / state.dt
-    return before - state.energy_of(particles)
+    removed = before - state.energy_of(particles)
+    state.x[ends] = now
+    return removed
 
 
 class Ground(Constraint):

@@ -179,16 +179,15 @@ def energy_in(sim: msd.Simulation) -> float:
 
 
 def test_a_hand_moved_on_a_circle_is_booked_as_the_work_it_did():
-    # a mesh (pixels, frames) at a tenth of its frame, the hand circling twice in 240 frames
+    # the gallery's mesh (pixels, a step a frame), the hand circling twice in 240 frames
     sim = gallery.mesh(gravity=0.0)
-    sim.dt = 0.1
     grab = msd.Grab()
     sim.constraints.append(grab)
     start, centre = energy_in(sim), sim.body.positions[37].copy()
     grab.hold(sim.body, 37)
     gross = 0.0  # the hand's work, each step's counted whatever its sign
-    for k in range(1, 2401):
-        angle = 4 * np.pi * k / 2400
+    for k in range(1, 241):
+        angle = 4 * np.pi * k / 240
         grab.move(centre + 40.0 * np.array([np.cos(angle) - 1.0, np.sin(angle)]))
         driven = sim.dissipated["driven"]
         sim.step()
@@ -197,7 +196,7 @@ def test_a_hand_moved_on_a_circle_is_booked_as_the_work_it_did():
     sim.run(duration=100.0)  # the drag takes the rest out
     balance = energy_in(sim) + sum(sim.dissipated.values()) - start
     assert gross > 1000.0
-    assert abs(balance) < 0.01 * gross  # before: the held particle's stops went unbooked
+    assert abs(balance) < 0.01 * gross  # before: -19 %, the held particle's stops unbooked
 
 
 def test_a_prescribed_particle_stopped_by_its_path_is_booked():
@@ -208,4 +207,4 @@ def test_a_prescribed_particle_stopped_by_its_path_is_booked():
     start = energy_in(sim)
     sim.run(duration=2.0)
     balance = energy_in(sim) + sum(sim.dissipated.values()) - start
-    assert abs(balance) < 0.01 * abs(sim.dissipated["driven"])
+    assert abs(balance) < 1e-4 * abs(sim.dissipated["driven"])
