@@ -10,8 +10,10 @@ inside the same message. The page queues the states and shows one a frame, so tw
 that arrive together are both shown. A thread rather than an asyncio task: the kernel's event loop
 stops while a cell runs, and a thread also runs outside Jupyter (tests,
 scripts); the kernel sends comm messages from any thread. What the page asks
-(grab, move, release, step, reset, a slider) arrives on the kernel's main
-thread and is queued, to be done by the stepping thread between two steps.
+(grab, move, release, step, reset, a slider, the stopwatch's buttons, an export)
+arrives on the kernel's main thread and is queued, to be done by the stepping thread
+between two steps. The instruments turned on (`instruments`) are read here and their
+readings ride in the states; the run shown is kept for export (`export.Recording`).
 """
 
 from __future__ import annotations
@@ -162,8 +164,8 @@ class LiveView(anywidget.AnyWidget):
         self._initial = (sim.body.positions.copy(), sim.body.velocities.copy())
         self._taken = dict(sim.dissipated)
         up = resolve_up(self._look[1], sim, sim.body.dim)
-        self._level = ground_level(sim, UPS.index(up))
         self._up = UPS.index(up)
+        self._level = ground_level(sim, self._up)
         self._owed, self._clock = 0.0, time.perf_counter()
         self._asked = self._done = 0.0
         view, _, energy_unit = self._look
