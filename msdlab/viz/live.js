@@ -610,6 +610,7 @@ function pointer(view, painter, source) {
   };
   canvas.addEventListener("pointerup", letGoOf);
   canvas.addEventListener("pointercancel", letGoOf);
+  canvas.addEventListener("lostpointercapture", letGoOf); // the page took the pointer away
   canvas.addEventListener("wheel", (event) => {
     event.preventDefault();
     camera.zoom *= Math.exp(-event.deltaY * 0.001);
