@@ -36,9 +36,10 @@ class Recording:
         """The run as arrays: time (F,), positions and velocities (F, N, d), and one array
         (F,) per energy: kinetic, elastic, gravitational, other, each mechanism's
         dissipated_<name>, and total (their sum)."""
-        if not self.frames:
+        frames = tuple(self.frames)  # at once: the stepping thread may add one meanwhile
+        if not frames:
             raise ValueError("nothing to export yet: the view has sent no frame")
-        times, xs, vs, energy = zip(*self.frames)
+        times, xs, vs, energy = zip(*frames)
         names = sorted({name for e in energy for name in e["dissipated"]})
         table = {"time": np.array(times), "positions": np.stack(xs), "velocities": np.stack(vs)}
         for name in ("kinetic", "elastic", "gravitational", "other"):
@@ -57,8 +58,8 @@ class Recording:
         return buffer.getvalue()
 
     def csv(self) -> bytes:
-        """One row per frame: time, the energies, then x_0, y_0, ..., vx_0, vy_0, ...
-        (the units in the header's first two columns' names)."""
+        """One row per frame: time, the energies (their units in the header), then x_0,
+        y_0, ..., vx_0, vy_0, ... of every particle."""
         table = self.columns()
         x, v = table.pop("positions"), table.pop("velocities")
         frames, particles, dim = x.shape
