@@ -2,12 +2,14 @@
 stopwatch against the simulated time, the trace's period against 2π√(m/k), the ruler,
 the hanging lines, the arrows, gravity presets, and an export read back with numpy."""
 
+import time
+
 import numpy as np
 import pytest
 
 import msdlab as msd
 from msdlab.scenes import SCENES
-from msdlab.viz.widget import LiveView
+from msdlab.viz.widget import LiveView, live
 
 MASS, STIFFNESS, REST, G = 0.5, 20.0, 1.0, 9.81
 
@@ -197,3 +199,15 @@ def test_the_page_can_download_the_run(monkeypatch):
     ((content, [data]),) = sent
     assert content == {"type": "export", "name": "msdlab-run.csv"}
     assert data.decode().startswith("time (s),kinetic (J),")
+
+
+def test_the_run_exports_while_the_view_runs(tmp_path):
+    view = live(spring_mass())
+    try:
+        time.sleep(0.5)
+        for _ in range(10):  # while the stepping thread adds states
+            path = view.export(tmp_path / "run.npz")
+    finally:
+        view.stop()
+    times = np.load(path)["time"]
+    assert len(times) >= 3 and np.all(np.diff(times) > 0)
