@@ -28,6 +28,7 @@ extensions = [
     "sphinx_gallery.gen_gallery",
     "architecture",
     "docstrings",
+    "public_names",
 ]
 
 # scenes/ holds the gallery's sources; gallery/ its generated pages, whose .ipynb downloads

@@ -124,7 +124,7 @@ def make_kernel(name: str | None = None) -> SpringKernel:
     except ImportError as error:
         warnings.warn(
             f"the numba kernel is unavailable ({error}); using the numpy kernel, which "
-            'computes the same more slowly. Reinstall with pip install -e ".[test]" to fix it.',
+            "computes the same more slowly. Reinstall msdlab (pip install -e .) to fix it.",
             RuntimeWarning,
             stacklevel=3,
         )

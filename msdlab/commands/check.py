@@ -76,7 +76,7 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError("--timeout and --call-timeout must be positive numbers of seconds")
     missing = missing_test_tools()
     if missing:
-        print(f"msdlab check needs {' and '.join(missing)} (the test extras); install them with:")
+        print(f"msdlab check needs {' and '.join(missing)} (the grade extra); install them with:")
         print(f"  {install_command(Path.cwd())}")
         return 2
     checks = checks_folder(args.checks, Path.cwd())

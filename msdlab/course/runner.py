@@ -89,13 +89,13 @@ def missing_test_tools() -> list[str]:
 
 
 def install_command(cwd: Path) -> str:
-    """The command that installs the test extras into this Python: of the course folder
-    ``cwd`` is in when it is an installable project, else of the msdlab package."""
+    """The command that installs what the checks need (the ``grade`` extra) into this Python:
+    of the course folder ``cwd`` is in when it is an installable project, else of msdlab."""
     python = shlex.quote(sys.executable)
     for root in (loader.course_root(cwd), PROJECT_ROOT):
         if (root / "pyproject.toml").is_file():
-            return f"{python} -m pip install -e {shlex.quote(f'{root}[test]')}"
-    return f"{python} -m pip install 'msdlab[test]'"
+            return f"{python} -m pip install -e {shlex.quote(f'{root}[grade]')}"
+    return f"{python} -m pip install 'msdlab[grade]'"
 
 
 def checks_folder(given: Path | None, cwd: Path) -> Path:

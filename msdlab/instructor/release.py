@@ -31,13 +31,15 @@ cube, in five staged tasks.
 
 ```bash
 pip install -e . && msdlab demo
-pip install -e ".[test]" && msdlab check
+pip install -e ".[grade]" && msdlab check
 ```
 
 The first command installs msdlab and drops a jelly cube on the floor (it
 prints the energy ledger and saves an animation in `msdlab-output/`). The
-second runs the checks of all five tasks on your files in `assignments/`:
-until you write them, each check says what is still to do.
+second installs what the checks need (pytest and hypothesis: the `grade`
+extra, the same that grades your work) and runs the checks of all five tasks
+on your files in `assignments/`: until you write them, each check says what
+is still to do.
 
 ## Your work
 
@@ -53,9 +55,13 @@ Fill in the lines that raise `NotImplementedError`, keeping names and
 signatures, then check one task at a time: `msdlab check 2`. Each call into
 your files may take a few seconds (`--call-timeout S` to change); the last
 line shows your public points and what the hidden checks, which run when
-your work is graded, are worth. The notebooks in
-`notebooks/` (`pip install jupyterlab && jupyter lab notebooks`) walk through
-each task with plots and animations.
+your work is graded, are worth. The notebooks in `notebooks/` walk through
+each task with plots and animations; install JupyterLab with them (the
+`notebooks` extra) and open them:
+
+```bash
+pip install -e ".[notebooks]" && jupyter lab notebooks
+```
 """
 
 STUDENT_GITIGNORE = """\
@@ -77,6 +83,12 @@ __pycache__/
 build/
 dist/
 """
+
+
+STUDENT_EXTRAS = ("grade", "notebooks")
+"""The extras of pyproject.toml that students use: the checks' tools and JupyterLab."""
+
+EXTRAS_TABLE = "[project.optional-dependencies]"
 
 
 class ReleaseError(RuntimeError):
@@ -102,7 +114,8 @@ def build(out: Path, root: Path, force: bool = False) -> list[Path]:
             shutil.copyfile(source, target)
         written.append(target)
     if not (out / "pyproject.toml").exists():
-        shutil.copyfile(root / "pyproject.toml", out / "pyproject.toml")
+        pyproject = (root / "pyproject.toml").read_text(encoding="utf-8")
+        (out / "pyproject.toml").write_text(student_pyproject(pyproject), encoding="utf-8")
         written.append(out / "pyproject.toml")
     (out / "README.md").write_text(STUDENT_README, encoding="utf-8")
     (out / ".gitignore").write_text(STUDENT_GITIGNORE, encoding="utf-8")
@@ -115,6 +128,29 @@ def build(out: Path, root: Path, force: bool = False) -> list[Path]:
         found = "\n  ".join(str(leak).replace(f"{out}/", "") for leak in leaks)
         raise ReleaseError(f"solution text found in the release:\n  {found}")
     return sorted(written)
+
+
+def student_pyproject(text: str) -> str:
+    """pyproject.toml's text with only the extras students use (`STUDENT_EXTRAS`): no test,
+    documentation or cluster tools to install. Each extra keeps the comment above it."""
+    lines = text.splitlines(keepends=True)
+    start = lines.index(EXTRAS_TABLE + "\n") + 1
+    kept, pending, keep, depth = lines[:start], [], True, 0
+    for index in range(start, len(lines)):
+        line = lines[index]
+        if depth == 0 and line.startswith("["):  # the next table
+            return "".join(kept + pending + lines[index:])
+        if depth == 0 and (line.startswith("#") or not line.strip()):
+            pending.append(line)
+            continue
+        if depth == 0:
+            keep = line.split("=")[0].strip() in STUDENT_EXTRAS
+            kept += pending if keep else [p for p in pending if not p.strip()]
+            pending = []
+        depth += line.count("[") - line.count("]")
+        if keep:
+            kept.append(line)
+    return "".join(kept + pending)
 
 
 def _write_points(checks: Path, path: Path) -> None:

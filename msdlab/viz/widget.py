@@ -20,6 +20,7 @@ import queue
 import threading
 import time
 from collections.abc import Callable, Sequence
+from pathlib import Path
 
 import anywidget
 import numpy as np
@@ -31,7 +32,9 @@ from ..forces import Gravity
 from ..interaction import Grab, Ground, Walls
 from ..scenes.registry import Scene
 from ..simulation import Simulation
-from . import frontend, settings
+from ..units import SI
+from . import frontend, instruments, settings
+from .export import Recording
 from .upright import UPS, resolve_up
 from .view import LIVE_STRAIN_LIMIT, spheres_of
 
@@ -59,15 +62,28 @@ def ground_level(sim: Simulation, up: int) -> float:
     return float(sim.body.positions[:, up].min())
 
 
-def energies(sim: Simulation, taken_at_start: dict[str, float], level: float = 0.0) -> dict:
+def velocities_now(sim: Simulation) -> np.ndarray:
+    """The velocities at the positions' time, as the ledger takes them."""
+    x, v = sim.body.positions, sim.body.velocities
+    if sim.step_count == 0:
+        return v
+    return sim.integrator.velocity_at_positions(v, sim.dynamics.acceleration(x, v), sim.dt)
+
+
+def energies(
+    sim: Simulation,
+    taken_at_start: dict[str, float],
+    level: float = 0.0,
+    v: np.ndarray | None = None,
+) -> dict:
     """The ledger's energies of ``sim`` now (as `Simulation.run` records them, in the
     simulation's units, J in SI):
     kinetic, elastic, gravitational (counted from height ``level`` along gravity; ``zero``
     is the ledger's gravitational energy at that height), other potential, and what each
-    mechanism took out since the view started; the time (s)."""
-    x, v = sim.body.positions, sim.body.velocities
-    if sim.step_count > 0:  # the velocity at the positions' time, as the ledger takes it
-        v = sim.integrator.velocity_at_positions(v, sim.dynamics.acceleration(x, v), sim.dt)
+    mechanism took out since the view started; the time (s). ``v``: `velocities_now`,
+    if the caller has them."""
+    x = sim.body.positions
+    v = velocities_now(sim) if v is None else v
     gravities = [f for f in sim.forces if isinstance(f, Gravity)]
     gravitational = sum(f.potential_energy(sim.body, x) for f in gravities)
     potential = sum(f.potential_energy(sim.body, x) for f in sim.forces)
@@ -107,6 +123,8 @@ class LiveView(anywidget.AnyWidget):
     error = traitlets.Unicode().tag(sync=True)
     running = traitlets.Bool(True).tag(sync=True)
     speed = traitlets.Float(1.0).tag(sync=True)
+    tools = traitlets.Dict().tag(sync=True)  # which instruments are shown: name -> on
+    presets = traitlets.Dict().tag(sync=True)  # gravity presets, |g| in the scene's units
 
     def __init__(
         self,
@@ -132,6 +150,9 @@ class LiveView(anywidget.AnyWidget):
         self.energy: dict = {}  # the energies last sent (`energies`)
         self.status = ""  # the status line last sent
         self.achieved = 1.0  # steps done over steps asked since the last energy update
+        self.stopwatch = instruments.Stopwatch(lambda: self.sim.time)
+        self.readings: dict = {}  # what the instruments turned on read, as last sent
+        self.tools = {name: False for name in instruments.TOOLS}
         self.attach(sim)
         self.on_msg(self._on_message)
 
@@ -146,6 +167,7 @@ class LiveView(anywidget.AnyWidget):
         self._taken = dict(sim.dissipated)
         up = resolve_up(self._look[1], sim, sim.body.dim)
         self._level = ground_level(sim, UPS.index(up))
+        self._up = UPS.index(up)
         self._owed, self._clock = 0.0, time.perf_counter()
         self._asked = self._done = 0.0
         view, _, energy_unit = self._look
@@ -171,6 +193,7 @@ class LiveView(anywidget.AnyWidget):
             self.settings = [s.as_dict() for s in (*live, *rebuild)]
             self.error = ""
             self.positions = self._positions()
+        self.set_up_instruments()
         self.publish()
 
     @property
@@ -188,9 +211,14 @@ class LiveView(anywidget.AnyWidget):
         `ENERGY_EVERY` states)."""
         content: dict = {"type": "state"}
         if energy:
-            self.energy = content["energy"] = energies(self.sim, self._taken, self._level)
+            velocities = velocities_now(self.sim)
+            self.energy = energies(self.sim, self._taken, self._level, velocities)
+            content["energy"] = self.energy
             self.status = content["status"] = self.status_line()
             content["pace"] = self.achieved
+            self.recording.add(self.sim.time, self.sim.body.positions, velocities, self.energy)
+        if any(self.tools.values()) or self.readings:  # once more, empty, when all go off
+            self.readings = content["readings"] = self.measure() if any(self.tools.values()) else {}
         self.send(content, buffers=[self._positions()])
 
     def status_line(self) -> str:
@@ -221,6 +249,7 @@ class LiveView(anywidget.AnyWidget):
         try:
             while self._owed >= 1.0 and time.perf_counter() - start < budget:
                 self.sim.step()
+                self.trace.record(self.sim)
                 self._owed -= 1.0
                 done += 1
         except SimulationDiverged as error:
@@ -261,6 +290,8 @@ class LiveView(anywidget.AnyWidget):
             "reset": self.reset,
             "set": lambda: self.set(content["name"], content["value"]),
             "frames": lambda: self.match_frames(content["rate"]),
+            "stopwatch": lambda: self.press_stopwatch(content["action"]),
+            "export": lambda: self.send_export(content["format"]),
         }
         command = handlers.get(content.get("type"))
         if command is not None:
@@ -276,6 +307,7 @@ class LiveView(anywidget.AnyWidget):
             return
         if particle != self.grab.particle:
             self.grab.hold(self.sim.body, particle, target)
+            self.pick(particle)
         else:
             self.grab.move(target)
         self._moved = True
@@ -299,6 +331,7 @@ class LiveView(anywidget.AnyWidget):
         self.sim.time, self.sim.step_count = 0.0, 0
         self._taken = dict(self.sim.dissipated)
         self.error = ""
+        self.set_up_instruments(keep_picks=True)
 
     def set(self, name: str, value: float) -> None:
         """Apply a slider: in place between steps, or by rebuilding the scene."""
@@ -311,6 +344,115 @@ class LiveView(anywidget.AnyWidget):
             self.attach(self.scene_entry.build(**built))
         else:
             settings.apply(self.sim, name, value, self._start)
+
+    # ------------------------------------------------------------------ the instruments
+    def set_up_instruments(self, keep_picks: bool = False) -> None:
+        """A new run: the trace, the recording and the stopwatch start over; the trace
+        follows the lowest free particle, the ruler runs from the first pinned one to it
+        (``keep_picks``: the particles picked before)."""
+        sim = self.sim
+        self.stopwatch.stop()
+        self.stopwatch.reset()
+        units = (self.scene["time_unit"], self.scene["energy_unit"])
+        self.recording = Recording(len(sim.body), sim.body.dim, *units)
+        if keep_picks:
+            self.follow(self.trace.particle)
+            return
+        traced = instruments.lowest_free(sim, self._up)
+        pinned = np.flatnonzero(sim.body.fixed)
+        start = int(pinned[0]) if len(pinned) else int(traced == 0)
+        self.follow(traced)
+        self.ruler_ends = (start, traced)
+        self.presets = self.gravity_presets()
+
+    def toggle(self, tool: str, on: bool | None = None) -> None:
+        """Show the instrument ``tool`` (stopwatch, ruler, trace, lines, arrows) or hide
+        it: ``on``, or the other way round from now."""
+        if tool not in self.tools:
+            raise ValueError(f"no instrument {tool!r}: choose one of {', '.join(self.tools)}")
+        self.tools = {**self.tools, tool: not self.tools[tool] if on is None else bool(on)}
+
+    def press_stopwatch(self, button: str) -> None:
+        """The stopwatch's button ``button``: start, stop or reset."""
+        watch = self.stopwatch
+        actions = {"start": watch.start, "stop": watch.stop, "reset": watch.reset}
+        if button not in actions:
+            raise ValueError(f"the stopwatch has no button {button!r}: start, stop or reset")
+        actions[button]()
+
+    def gravity_presets(self) -> dict[str, float]:
+        """|g| of Earth, Moon, Jupiter and zero in the scene's units: Earth's is 9.81 in
+        SI, else the scene's own gravity at the start; none without gravity."""
+        gravity = instruments.gravity_of(self.sim)
+        if gravity is None:
+            return {}
+        if self._start["gravity"] is None:  # no direction yet: along the view's down
+            self._start["gravity"] = -np.eye(self.sim.body.dim)[self._up]
+        si = self.sim.units == SI
+        earth = instruments.GRAVITY["Earth"] if si else float(np.linalg.norm(gravity.g))
+        return instruments.GravityPresets(earth or instruments.GRAVITY["Earth"]).values()
+
+    def set_gravity(self, preset: str) -> None:
+        """Set gravity to a preset: "Earth", "Moon", "Jupiter" or "zero"."""
+        if not self.presets:
+            raise ValueError("this scene has no gravity to set: it was built without msd.Gravity")
+        if preset not in self.presets:
+            raise ValueError(
+                f"no gravity preset {preset!r}: choose one of {', '.join(self.presets)}"
+            )
+        self.set("gravity", self.presets[preset])
+
+    def follow(self, particle: int, axis: int | None = None) -> None:
+        """Trace ``particle`` along ``axis`` (default: the vertical) from now on."""
+        self.trace = instruments.Trace(particle, self._up if axis is None else axis)
+
+    def pick(self, particle: int) -> None:
+        """A particle taken in hand: the trace follows it, the ruler runs from the one
+        picked before to it."""
+        if particle != self.trace.particle:
+            self.ruler_ends = (self.trace.particle, particle)
+            self.follow(particle)
+
+    def measure(self) -> dict:
+        """What each instrument turned on in `tools` reads now, for the page."""
+        sim, traced, on = self.sim, self.trace.particle, self.tools
+        unit = self.recording.units["time"]
+        readings: dict = {"time": sim.time}
+        if on.get("stopwatch"):
+            watch = self.stopwatch
+            readings["stopwatch"] = {
+                "reading": watch.reading,
+                "running": watch.running,
+                "unit": unit,
+            }
+        if on.get("ruler"):
+            distance = instruments.distance(sim, self.ruler_ends)
+            readings["ruler"] = {"ends": list(self.ruler_ends), "distance": distance}
+        if on.get("trace"):
+            period = self.trace.period()
+            readings["trace"] = {
+                "particle": traced,
+                "axis": self.trace.axis,
+                "points": self.trace.shown(),
+                "period": period,
+                "unit": unit,
+            }
+        if on.get("lines"):
+            readings["lines"] = instruments.hanging_lines(sim, traced)
+        if on.get("arrows"):
+            readings["arrows"] = {"particle": traced, **instruments.arrows(sim, traced)}
+        return readings
+
+    def export(self, path: str | Path) -> Path:
+        """Write the run shown to ``path``, a .csv table or a .npz of NumPy arrays: time,
+        energies, positions and velocities of each state sent with its energies (every
+        `ENERGY_EVERY`-th while it runs, 15 a second at 60; each one paused)."""
+        return self.recording.write(path)
+
+    def send_export(self, kind: str) -> None:
+        """Send the page the run shown as a file to download (``kind``: csv or npz)."""
+        data = self.recording.npz() if kind == "npz" else self.recording.csv()
+        self.send({"type": "export", "name": f"msdlab-run.{kind}"}, [data])
 
     # ------------------------------------------------------------------ the thread
     def start(self) -> LiveView:

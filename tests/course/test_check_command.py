@@ -81,7 +81,7 @@ def test_missing_test_tools_name_the_install_command(capsys, monkeypatch):
     assert main(["check", "1"]) == 2
     out = capsys.readouterr().out
     assert "needs pytest" in out and f"{sys.executable} -m pip install -e " in out
-    assert "[test]" in out
+    assert "[grade]" in out
 
 
 def test_without_hidden_files_hidden_says_so_and_the_manifest_counts_them(capsys, tmp_path):

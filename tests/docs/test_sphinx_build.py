@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import html
+import inspect
 import re
 from pathlib import Path
 
+import msdlab
 from msdlab.scenes import SCENES
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
@@ -44,3 +47,15 @@ def test_the_api_reference_has_a_page_per_listed_module(site):
     assert "msdlab.simulation" in listed
     for module in listed:
         assert (site / "api" / "generated" / f"{module}.html").exists(), module
+
+
+def test_the_msdlab_page_links_every_public_name_with_its_summary(site):
+    """``msd.Body``, ``msd.Simulation``, ...: each name of ``msdlab.__all__`` links to where
+    its module documents it, beside the first words of its docstring."""
+    page = (site / "api" / "generated" / "msdlab.html").read_text(encoding="utf-8")
+    text = html.unescape(re.sub(r"<[^>]+>", "", page))
+    for name in msdlab.__all__:
+        target = f"{getattr(msdlab, name).__module__}.{name}"
+        assert f'href="{target.rsplit(".", 1)[0]}.html#{target}"' in page, name
+        words = " ".join(inspect.getdoc(getattr(msdlab, name)).split()[:3])
+        assert words in " ".join(text.split()), f"{name}: no summary ({words} ...)"
