@@ -14,9 +14,9 @@ const PICK_RADIUS = 25; // px: how near the mouse a particle must be to be taken
 const HISTORY = 600; // points of the energy plot
 const DENSE = 3000; // springs from which lines are written as pixels (`Pixels`)
 const SURFACE_ONLY = 30000; // springs from which a 3-D body is drawn by its surface
-const QUEUED = 3; // states kept waiting at most: older ones are dropped (3 frames late at most)
+const QUEUED = 6; // states kept waiting at most: older ones are dropped (6 frames late at most)
 const PICTURE_TIMES = 1200; // times of the last new pictures kept in a view's stats
-const REPORT_EVERY = 2000; // ms between two reports of the page's frame rate to the kernel
+const REPORT_EVERY = 1000; // ms between two reports of the page's frame rate to the kernel
 
 /** A typed array of `Type` over a DataView, ArrayBuffer or typed array. */
 function typed(data, Type) {
@@ -438,15 +438,16 @@ class EnergyPanel {
 }
 
 /** What a view counted (for benchmarks and tests): frames (requestAnimationFrame calls),
- * pictures drawn (frames in which something changed), new positions received (updates),
+ * pictures drawn (frames in which something changed), new positions shown (updates),
+ * states received from the kernel (`received`, the live view's),
  * new pictures (frames showing positions that differ from the frame before) and the
  * times (ms) of the last `PICTURE_TIMES` of them, and the delays (ms) from a mouse move
  * to the frame drawing the held particle at the hand (`drawDelays`) and to the first
  * positions from the engine with it there (`engineDelays`).
  * Each view is listed in `window.msdlabViews`. */
 function newStats() {
-  return { frames: 0, drawn: 0, updates: 0, pictures: 0, pictureTimes: [], drawDelays: [],
-    engineDelays: [], moved: null, pending: null };
+  return { frames: 0, drawn: 0, updates: 0, received: 0, pictures: 0, pictureTimes: [],
+    drawDelays: [], engineDelays: [], moved: null, pending: null };
 }
 
 /** Whether two position arrays hold different numbers. */
@@ -688,6 +689,7 @@ function render({ model, el }) {
   const onMessage = (message, buffers) => {
     if (message.type === "export") download(message, buffers);
     if (message.type !== "state") return;
+    view.stats.received++;
     states.push({ ...message, positions: typed(buffers[0], Float32Array) });
     if (states.length > QUEUED) states.shift();
   };

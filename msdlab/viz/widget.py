@@ -41,11 +41,15 @@ from .upright import UPS, resolve_up
 from .view import LIVE_STRAIN_LIMIT, spheres_of
 
 FRAME_RATE = 60.0  # most states sent a second
-SLOWEST = 10.0  # fewest states sent a second, whatever the page reports
+SLOWEST = 5.0  # fewest states sent a second, whatever the page reports
 ENERGY_EVERY = 4  # states sent per energy update (15 a second)
 BUDGET = 0.75  # of the time between two states sent, spent stepping at most
 KEEPS_PACE = 0.97  # a pace below this share of the one asked is shown in the status line
 PACE_OVER = 10.0  # steps asked, at least, over which the pace kept is measured
+# requests done at the next state sent, not at once: a mouse moves 60 times a second,
+# and a state sent for each move beside the paced ones would be more than the page can
+# show (the page draws the held particle at the hand itself)
+PACED = ("move", "frames")
 _running: list[LiveView] = []  # views started by `show`, stopped when a new one starts
 
 
@@ -296,7 +300,8 @@ class LiveView(anywidget.AnyWidget):
             self._commands.put(command)
             if self._thread is None:
                 self.do_pending()
-            self._wake.set()  # a frame now: the hand should not wait for the next one
+            if content["type"] not in PACED:
+                self._wake.set()  # a frame now: a grab, a step, a slider need not wait
 
     def _hold(self, particle: int | None, target: list[float]) -> None:
         """The hand at ``target`` holding ``particle`` (none: the move of a hand let go)."""

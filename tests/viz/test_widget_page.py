@@ -176,8 +176,8 @@ def test_a_finger_drags_a_particle_with_pointer_events(widget_page):
     for fraction in np.linspace(0.2, 1.0, 5):
         finger("touchMove", start + fraction * np.array([60.0, 30.0]))
         kernel.frames()
-    hand = [what[0] for kind, *what in kernel.asked if kind == "send"]
-    grab, *moves = [m for m in hand if m["type"] != "frames"]  # not the page's frame rate
+    sent = [what[0] for kind, *what in kernel.asked if kind == "send"]
+    grab, *moves = [m for m in sent if m["type"] != "frames"]  # not the page's frame rate
     assert grab["type"] == "grab" and grab["particle"] == 1
     assert [m["type"] for m in moves] == ["move"] * len(moves) and len(moves) == 5
     assert kernel.view.grab.particle == 1
