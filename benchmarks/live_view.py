@@ -1,27 +1,29 @@
-"""Frames per second of the live widget, counted in the page, and the delay of a drag.
+"""What the live widget shows, counted in the page: new pictures a second, their gaps,
+the pace the engine keeps, and the energy books of a drag.
 
 Runs JupyterLab and headless Chromium (as tests/viz/test_widget_browser.py does), shows
-each case with `viz.show` in a fresh notebook, at 60 steps a second (the gallery's frames;
-the template cube's steps of dt = 0.4, whose real time would be 2.5 steps a second), and
-counts, over ``--seconds``, the page's frames (requestAnimationFrame callbacks), the
-pictures it drew (in frames where positions, camera or hand changed) and the new positions
-it received from Python, and the CPU time Chromium's processes took (psutil, which
-ipykernel installs): what the page costs a loaded machine, whatever the frame rate.
-For the mesh it then presses on a particle and moves the mouse 15 px every 0.3 s, and
-gives two delays from a mouse move (the event's time stamp): to the end of the frame
-that draws the held particle at the hand (the page draws it there itself, where `Grab`
-will pin it), and to the first positions from the engine with the particle there (the
-page's request, the server, the kernel, a step, the positions back).
+each case with `viz.show` in a fresh notebook and counts, over ``--seconds``:
+
+- frames: the page's requestAnimationFrame callbacks a second;
+- new pictures: frames showing positions that differ from the frame before (what the
+  eye sees move), and the longest gap between two of them and the gaps over 50 ms;
+- updates: the states received from the kernel a second;
+- pace: the share of the asked steps the engine did (1.00: it keeps up);
+- Chromium's CPU time (psutil, which ipykernel installs).
+
+For the mesh it then presses on a particle and moves the mouse around a circle for two
+seconds, and reports the delays from a mouse move (the event's time stamp) to the frame
+drawing the held particle at the hand and to the first positions from the engine with it
+there, and the drag's energy drift: the change of the total the energy panel shows
+(in the body plus all taken out) over the hand's work (the "driven" bar's change).
 The ceiling: requestAnimationFrame callbacks a second of an empty page in the same
 browser, measured before each case; and the machine's load average (`os.getloadavg`).
-Beside it, the matplotlib view measured on the Agg canvas alone: the time of one frame
-(the steps of a frame and a full redraw), an upper bound of ipympl's frame rate, which
-then encodes a PNG per frame and sends it over the websocket.
 
-    python benchmarks/live_view.py [--seconds 10] [--cases mesh,cube10,cube20]
+    python benchmarks/live_view.py [--seconds 8] [--cases mesh,cube10,cube20,grid10] [--nodelay]
 
-Headless Chromium with --disable-gpu draws on the CPU and paces requestAnimationFrame at
-the display's 60 Hz at most, so 60 fps is the ceiling here (less on a loaded machine).
+``--nodelay`` starts JupyterLab with the kernel websocket that sets TCP no-delay
+(`msdlab.viz.nodelay`). Headless Chromium with --disable-gpu draws on the CPU and paces
+requestAnimationFrame at the display's 60 Hz at most, so 60 a second is the ceiling here.
 """
 
 from __future__ import annotations
@@ -39,16 +41,24 @@ import nbformat
 import numpy as np
 import psutil
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "viz"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from browser import jupyterlab_server, launch, run_notebook
 
+NODELAY = "msdlab.viz.nodelay.NoDelayConnection"  # the websocket with TCP no-delay
 KERNEL = {"name": "python3", "display_name": "Python 3 (ipykernel)", "language": "python"}
-CASES = {
+GRID = (
+    "msd.Simulation(msd.Body.grid((10, 10, 10), spacing=0.1, stiffness=5000.0, "
+    "neighbours=(1, 2, 3)), msd.Verlet(damping=0.01), dt=1e-3, "
+    "forces=[msd.Gravity((0, -9.81, 0)), msd.Ground(height=0.0)])"
+)
+CASES = {  # label, the simulation, steps a second (None: real time)
     "mesh": ("gallery mesh (2-D, 100 particles)", "SCENES['mesh'].build()", 60),
     "cube10": ("jelly cube 10³ (3-D)", "SCENES['jelly-cube'].build(size=10)", 60),
     "cube20": ("jelly cube 20³ (3-D)", "SCENES['jelly-cube'].build(size=20)", 60),
+    "grid10": ("Body.grid 10³, dt = 1e-3, real time", GRID, None),
 }
 CELL = """\
+import msdlab as msd
 from msdlab import viz
 from msdlab.scenes import SCENES
 
@@ -58,11 +68,15 @@ EMPTY_RATE = """(ms) => new Promise((done) => { let n = 0; const t0 = performanc
 const frame = (t) => { n++; if (t - t0 < ms) requestAnimationFrame(frame);
   else done((1000 * n) / (t - t0)); };
 requestAnimationFrame(frame); })"""
-# (an older live.js, before the page drew the hand itself, had only `delays`: the engine's)
 DELAYS = """() => { const s = window.msdlabViews.at(-1).stats;
-return [s.drawDelays ?? [], s.engineDelays ?? s.delays]; }"""
-COUNTS = "() => {const s = window.msdlabViews.at(-1).stats; return [s.frames, s.drawn, s.updates, \
-performance.now()];}"
+return [s.drawDelays, s.engineDelays]; }"""
+# a page without new-picture counts (an older live.js) counts the pictures drawn
+COUNTS = """() => { const v = window.msdlabViews.at(-1), s = v.stats;
+return { frames: s.frames, pictures: s.pictures ?? s.drawn, updates: s.updates,
+  times: s.pictureTimes ?? null, pace: Number(v.status.dataset.pace ?? NaN),
+  now: performance.now() }; }"""
+BOOKS = """() => { const c = document.querySelector('.msdlab-energy');
+return [Number(c.dataset.total), JSON.parse(c.dataset.bars).driven ?? 0]; }"""
 
 
 def browser_cpu() -> float:
@@ -77,17 +91,26 @@ def browser_cpu() -> float:
     return total
 
 
-def page_rate(page, seconds: float) -> np.ndarray:
-    """(frames, pictures drawn, position updates) a second in the page over ``seconds``,
-    and the CPU time of Chromium (ms a second, all its processes): the page draws a picture
-    in a frame when something changed (positions, camera, hand)."""
-    *counts0, t0 = page.evaluate(COUNTS)
-    cpu0 = browser_cpu()
+def page_counts(page, seconds: float) -> dict:
+    """A second's frames, new pictures and updates over ``seconds``; the longest gap
+    between new pictures and the gaps over 50 ms (ms; None for a page that does not
+    keep their times); the pace; Chromium's CPU (ms a second, all its processes)."""
+    before, cpu = page.evaluate(COUNTS), browser_cpu()
     time.sleep(seconds)
-    *counts1, t1 = page.evaluate(COUNTS)
-    cpu = browser_cpu() - cpu0
-    elapsed = (t1 - t0) / 1000
-    return np.array([*((np.array(counts1) - counts0) / elapsed), 1000 * cpu / elapsed])
+    after, cpu = page.evaluate(COUNTS), browser_cpu() - cpu
+    elapsed = (after["now"] - before["now"]) / 1000
+    rates = {k: (after[k] - before[k]) / elapsed for k in ("frames", "pictures", "updates")}
+    gaps = None
+    if after["times"] is not None:
+        times = np.array([t for t in after["times"] if t >= before["now"]])
+        gaps = np.diff(np.concatenate([[before["now"]], times, [after["now"]]]))
+    return {
+        **rates,
+        "longest gap": None if gaps is None else float(gaps.max()),
+        "gaps over 50 ms": None if gaps is None else int(np.sum(gaps > 50)),
+        "pace": after["pace"],
+        "cpu": 1000 * cpu / elapsed,
+    }
 
 
 def empty_page_rate(browser, seconds: float = 3.0) -> float:
@@ -98,25 +121,29 @@ def empty_page_rate(browser, seconds: float = 3.0) -> float:
     return rate
 
 
-def drag_delays(page, moves: int = 12) -> tuple[list[float], list[float]]:
-    """Delays (ms) from mouse moves to the frame drawing the held particle at the hand, and
-    to the engine's positions showing it there."""
-    canvas = page.locator(".msdlab-canvas")
-    box = canvas.bounding_box()
+def circular_drag(page, seconds: float = 2.0, radius: float = 60.0) -> dict:
+    """Press on the mesh's top-right particle and move the mouse around a circle of
+    ``radius`` px for ``seconds``; the delays (ms) from the moves to the frame drawing the
+    held particle at the hand and to the engine's positions with it there, and the
+    energy panel's total and "driven" bar before the press and a second after release."""
+    box = page.locator(".msdlab-canvas").bounding_box()
     screen = np.array(
         page.evaluate("() => Array.from(window.msdlabViews.at(-1).painter.screen)")
     ).reshape(-1, 2) + (box["x"] + 1, box["y"] + 1)
     particle = screen[int(np.argmax(screen[:, 0] - screen[:, 1]))]
+    books = page.evaluate(BOOKS)
     page.mouse.move(*particle)
     page.mouse.down()
-    time.sleep(0.5)
-    for i in range(1, moves + 1):
-        page.mouse.move(particle[0] - 15 * i, particle[1] - 5 * i)
-        time.sleep(0.3)
+    start = time.perf_counter()
+    while (elapsed := time.perf_counter() - start) < seconds:
+        angle = 2 * np.pi * elapsed / seconds * 2  # twice round
+        page.mouse.move(*(particle + radius * np.array([np.cos(angle) - 1, np.sin(angle)])))
+        time.sleep(1 / 60)
     page.mouse.up()
-    time.sleep(0.5)
+    time.sleep(1.0)
     drawn, engine = page.evaluate(DELAYS)
-    return drawn, engine
+    total, driven = np.array(page.evaluate(BOOKS)) - books
+    return {"drawn": drawn, "engine": engine, "total": total, "work": -driven}
 
 
 def shut_down_kernels(url: str, token: str) -> None:
@@ -130,71 +157,65 @@ def shut_down_kernels(url: str, token: str) -> None:
         urllib.request.urlopen(request).close()
 
 
-def agg_frame_time(build: str, pace: float | None, frames: int = 10) -> float:
-    """Seconds per frame of the matplotlib view on Agg: a frame's steps and a full draw."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    from msdlab import viz
-    from msdlab.scenes import SCENES  # noqa: F401  (used by ``build``)
-
-    sim = eval(build)
-    dragger = viz.Dragger(sim, steps_per_second=pace or 1.0 / sim.dt)
-    dragger.advance()  # compiles
-    dragger.ax.figure.canvas.draw()
-    start = time.perf_counter()
-    for _ in range(frames):
-        time.sleep(1 / 60)  # a frame's worth of steps are due
-        dragger.advance()
-        dragger.ax.figure.canvas.draw()
-    return (time.perf_counter() - start) / frames - 1 / 60
+def run_case(browser, url: str, token: str, tmp: Path, key: str, seconds: float) -> None:
+    """Show one case in a fresh notebook and print what the page counted."""
+    label, build, pace = CASES[key]
+    ceiling, load = empty_page_rate(browser), os.getloadavg()[0]
+    notebook = nbformat.v4.new_notebook(metadata={"kernelspec": KERNEL})
+    notebook.cells = [nbformat.v4.new_code_cell(CELL.format(build=build, pace=pace))]
+    nbformat.write(notebook, tmp / f"{key}.ipynb")
+    page = browser.new_page(viewport={"width": 1300, "height": 1000})
+    page.set_default_timeout(120_000)
+    run_notebook(page, url, token, f"{key}.ipynb")
+    page.wait_for_function("() => window.msdlabViews?.at(-1)?.stats.updates > 20")
+    time.sleep(2)
+    counts = page_counts(page, seconds)
+    drag = circular_drag(page) if key == "mesh" else None
+    page.screenshot(path=f"/tmp/live_view_{key}.png")
+    page.close()
+    shut_down_kernels(url, token)
+    gaps = (
+        ""
+        if counts["longest gap"] is None
+        else f"longest gap {counts['longest gap']:.0f} ms, {counts['gaps over 50 ms']} over 50 ms; "
+    )
+    print(
+        f"{label}: {counts['frames']:.1f} frames/s ({counts['frames'] / ceiling:.0%} of an "
+        f"empty page's {ceiling:.1f}), {counts['pictures']:.1f} new pictures/s, "
+        f"{counts['updates']:.1f} updates/s; {gaps}pace {counts['pace']:.2f}; "
+        f"Chromium's CPU {counts['cpu']:.0f} ms/s; load {load:.1f}",
+        flush=True,
+    )
+    if drag is not None:
+        for what in ("drawn", "engine"):
+            if drag[what]:
+                print(
+                    f"  drag delay, {what}: median {np.median(drag[what]):.0f} ms, "
+                    f"max {np.max(drag[what]):.0f} ms over {len(drag[what])} moves",
+                    flush=True,
+                )
+        print(
+            f"  drag's energy: the hand's work {drag['work']:.4g}, the total changed "
+            f"{drag['total']:.4g} ({drag['total'] / drag['work']:+.1%} of the work)",
+            flush=True,
+        )
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seconds", type=float, default=10.0)
+    parser.add_argument("--seconds", type=float, default=8.0)
     parser.add_argument("--cases", default=",".join(CASES))
+    parser.add_argument("--nodelay", action="store_true", help="TCP no-delay on the websocket")
     args = parser.parse_args()
     from playwright.sync_api import sync_playwright
 
-    rows = []
+    options = ["--ServerApp.kernel_websocket_connection_class=" + NODELAY] if args.nodelay else []
     with TemporaryDirectory() as folder, sync_playwright() as playwright:
         tmp = Path(folder)
-        with jupyterlab_server(tmp) as (url, token):
+        with jupyterlab_server(tmp, options) as (url, token):
             browser = launch(playwright)
             for key in args.cases.split(","):
-                label, build, pace = CASES[key]
-                ceiling, load = empty_page_rate(browser), os.getloadavg()[0]
-                notebook = nbformat.v4.new_notebook(metadata={"kernelspec": KERNEL})
-                notebook.cells = [nbformat.v4.new_code_cell(CELL.format(build=build, pace=pace))]
-                nbformat.write(notebook, tmp / f"{key}.ipynb")
-                page = browser.new_page(viewport={"width": 1300, "height": 1000})
-                page.set_default_timeout(120_000)
-                run_notebook(page, url, token, f"{key}.ipynb")
-                page.wait_for_function("() => window.msdlabViews?.at(-1)?.stats.updates > 20")
-                time.sleep(2)
-                fps, drawn_rate, updates, cpu = page_rate(page, args.seconds)
-                drawn, engine = drag_delays(page) if key == "mesh" else ([], [])
-                page.screenshot(path=f"/tmp/live_view_{key}.png")
-                page.close()
-                shut_down_kernels(url, token)
-                agg = agg_frame_time(build, pace)
-                rows.append((label, fps, updates, drawn, engine, agg))
-                print(
-                    f"{label}: page {fps:.1f} fps ({fps / ceiling:.0%} of an empty page's "
-                    f"{ceiling:.1f}), {drawn_rate:.1f} pictures/s, {updates:.1f} updates/s, "
-                    f"Chromium's CPU {cpu:.0f} ms/s; "
-                    f"matplotlib on Agg {1000 * agg:.0f} ms/frame = {1 / agg:.1f} fps; "
-                    f"load {load:.1f}",
-                    flush=True,
-                )
-                for what, delays in (("drawn at the hand", drawn), ("engine there", engine)):
-                    if delays:
-                        print(
-                            f"  drag delay, {what}: median {np.median(delays):.0f} ms, "
-                            f"max {np.max(delays):.0f} ms over {len(delays)} moves",
-                            flush=True,
-                        )
+                run_case(browser, url, token, tmp, key, args.seconds)
             browser.close()
 
 

@@ -19,6 +19,7 @@ from .errors import SimulationDiverged, check_finite_array, check_positive, show
 from .forces import Force
 from .integrators import Integrator, Verlet
 from .stability import describe_blowup
+from .units import SI, Units
 
 
 @dataclass
@@ -57,6 +58,8 @@ class Simulation:
     matters for small bodies in contact); frames still record the energies, and
     every loss then shows as drift.
     """
+
+    units: Units = SI  # what the numbers are in (views label with it); scenes may set it
 
     def __init__(
         self,

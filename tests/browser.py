@@ -13,6 +13,7 @@ import subprocess
 import sys
 import time
 import urllib.request
+from collections.abc import Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -68,10 +69,14 @@ def wait_until(condition, seconds: float, what: str):
 
 @contextmanager
 def jupyterlab_server(
-    tmp_path: Path, python: Path | str = sys.executable, root: Path | None = None
+    tmp_path: Path,
+    python: Path | str = sys.executable,
+    root: Path | None = None,
+    options: Sequence[str] = (),
 ):
     """A JupyterLab server of ``python`` (default: this one) on a free local port, serving
-    ``root`` (default: ``tmp_path``, which holds its settings and log)."""
+    ``root`` (default: ``tmp_path``, which holds its settings and log), with the
+    command-line ``options`` added (``--ServerApp.name=value``)."""
     port, token = free_port(), "msdlab-test"
     env = {
         **os.environ,
@@ -109,6 +114,7 @@ def jupyterlab_server(
             f"--ServerApp.root_dir={root or tmp_path}",
             "--LabApp.expose_app_in_browser=True",  # window.jupyterapp runs the cells
             "--allow-root",  # CI runs as root
+            *options,
         ],
         env=env,
         stdout=log,

@@ -40,6 +40,7 @@ from ..forces import Force, Gravity
 from ..integrators import VelocityVerlet
 from ..interaction import Drag, Prescribed, Walls
 from ..simulation import Simulation
+from ..units import PAGE
 from .frame_model import FrameEuler
 
 WIDTH, HEIGHT = 600.0, 400.0  # the page's canvas (px)
@@ -82,7 +83,9 @@ def simulation(
             forces.append(Walls((0.0, 0.0), (WIDTH, HEIGHT), mode))
         if damping < 1.0:
             forces.append(Drag(-math.log(damping)))
-    return Simulation(body, integrator, dt, [*forces, *extra], ledger=model != "frame")
+    sim = Simulation(body, integrator, dt, [*forces, *extra], ledger=model != "frame")
+    sim.units = PAGE
+    return sim
 
 
 def two_particles(

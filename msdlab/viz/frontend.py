@@ -92,10 +92,11 @@ def describe(
     view: Sequence[float] | None,
     strain_limit: float,
     spheres: Sequence[tuple[int, float]] = (),
-    energy_unit: str = "J",
+    energy_unit: str | None = None,
     energy: bool = True,
 ) -> dict:
-    """The scene dict of ``sim`` for ``live.js``: camera, colours, walls, floor, balls."""
+    """The scene dict of ``sim`` for ``live.js``: camera, colours, walls, floor, balls, and
+    the units of time and energy (``energy_unit``, default the simulation's, `sim.units`)."""
     positions = sim.body.positions
     low, high = positions.min(axis=0), positions.max(axis=0)
     middle, reach = 0.5 * (low + high), 0.75 * max(float(np.max(high - low)), 1e-9)
@@ -115,7 +116,8 @@ def describe(
         "world": {"edges": world},
         "spheres": [[int(p), float(r)] for p, r in spheres],
         "energy": energy,
-        "energy_unit": energy_unit,
+        "energy_unit": energy_unit or sim.units.energy,
+        "time_unit": sim.units.time,
         "width": SIZE[0],
         "height": SIZE[1],
     }

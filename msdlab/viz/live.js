@@ -1,7 +1,10 @@
 // msdlab's live view and replay player: a mass-spring body drawn on a canvas.
 //
-// The page draws at its own frame rate (requestAnimationFrame) from the latest
-// positions it has; it never waits for Python. 2-D bodies are drawn as they are;
+// The page draws at its own frame rate (requestAnimationFrame) and never waits for
+// Python. The kernel sends one message per state (positions, and every few states
+// the energies and the status line) at the page's frame rate, which the page reports;
+// the page queues the states and shows one a frame, so states that arrive together
+// (the network bunches small messages) are each shown, not only the last. 2-D bodies are drawn as they are;
 // 3-D ones through an orbit camera (orthographic: left-drag on empty space or
 // right-drag turns, the wheel zooms). Springs are coloured by strain on the
 // colour table the scene brings (matplotlib's coolwarm in 64 levels).
@@ -11,6 +14,9 @@ const PICK_RADIUS = 25; // px: how near the mouse a particle must be to be taken
 const HISTORY = 600; // points of the energy plot
 const DENSE = 3000; // springs from which lines are written as pixels (`Pixels`)
 const SURFACE_ONLY = 30000; // springs from which a 3-D body is drawn by its surface
+const QUEUED = 6; // states kept waiting at most: older ones are dropped (6 frames late at most)
+const PICTURE_TIMES = 1200; // times of the last new pictures kept in a view's stats
+const REPORT_EVERY = 1000; // ms between two reports of the page's frame rate to the kernel
 
 /** A typed array of `Type` over a DataView, ArrayBuffer or typed array. */
 function typed(data, Type) {
@@ -349,6 +355,8 @@ class EnergyPanel {
   constructor(parent, unit) {
     this.canvas = element("canvas", { width: 260, height: 480 }, parent);
     this.canvas.className = "msdlab-energy";
+    this.canvas.setAttribute("role", "img");
+    this.canvas.setAttribute("aria-label", "energy bars, and the total against time");
     this.canvas.style.maxWidth = "100%";
     this.unit = unit;
     this.history = [];
@@ -430,13 +438,31 @@ class EnergyPanel {
 }
 
 /** What a view counted (for benchmarks and tests): frames (requestAnimationFrame calls),
- * pictures drawn (frames in which something changed), new positions received (updates),
- * and the delays (ms) from a mouse move to the frame drawing the held particle at the hand
- * (`drawDelays`) and to the first positions from the engine with it there (`engineDelays`).
+ * pictures drawn (frames in which something changed), new positions shown (updates),
+ * states received from the kernel (`received`, the live view's),
+ * new pictures (frames showing positions that differ from the frame before) and the
+ * times (ms) of the last `PICTURE_TIMES` of them, and the delays (ms) from a mouse move
+ * to the frame drawing the held particle at the hand (`drawDelays`) and to the first
+ * positions from the engine with it there (`engineDelays`).
  * Each view is listed in `window.msdlabViews`. */
 function newStats() {
-  return { frames: 0, drawn: 0, updates: 0, drawDelays: [], engineDelays: [],
-    moved: null, pending: null };
+  return { frames: 0, drawn: 0, updates: 0, received: 0, pictures: 0, pictureTimes: [],
+    drawDelays: [], engineDelays: [], moved: null, pending: null };
+}
+
+/** Whether two position arrays hold different numbers. */
+function differ(a, b) {
+  if (a === b) return false;
+  if (!b || a.length !== b.length) return true;
+  for (let i = 0; i < a.length; i++) if (a[i] !== b[i]) return true;
+  return false;
+}
+
+/** Count a new picture (positions unlike the last shown) at time `now` (ms). */
+function countPicture(stats, now) {
+  stats.pictures++;
+  stats.pictureTimes.push(now);
+  if (stats.pictureTimes.length > PICTURE_TIMES) stats.pictureTimes.shift();
 }
 
 /** Whether particle `p` of `x` (dimension `d`) is at `target`, to float32's precision. */
@@ -455,6 +481,9 @@ export function mountView(el, scene, arrays, source) {
   row.style.cssText = "display: flex; flex-wrap: wrap; align-items: flex-start; gap: 6px";
   const canvas = element("canvas", { width: scene.width, height: scene.height }, row);
   canvas.className = "msdlab-canvas";
+  canvas.setAttribute("role", "img");
+  canvas.setAttribute("aria-label", "the body: drag a particle to move it"
+    + (scene.dim === 3 ? ", drag empty space to turn the view, the wheel zooms" : ""));
   canvas.style.cssText = "cursor: crosshair; border: 1px solid #ccc; max-width: 100%; height: auto";
   const energy = scene.energy ? new EnergyPanel(row, scene.energy_unit) : null;
   const status = element("div", { className: "msdlab-status" }, root);
@@ -466,7 +495,7 @@ export function mountView(el, scene, arrays, source) {
     alive: true };
   window.msdlabViews = window.msdlabViews || [];
   window.msdlabViews.push(view);
-  mouse(view, painter, source);
+  pointer(view, painter, source);
   let last = null, shown = [];
   const frame = () => {
     if (!view.alive) return;
@@ -474,16 +503,20 @@ export function mountView(el, scene, arrays, source) {
     if (positions) {
       if (positions !== last) {
         stats.updates++;
+        if (differ(positions, last)) countPicture(stats, performance.now());
         checkDelay(stats, positions, scene.dim);
       }
       letGo(view, positions, scene.dim);
       // Grab pins the held particle to the hand at the engine's next step: draw it there
       // now, not a round trip through the kernel later (only while the engine steps)
       const hand = source.stepping?.() ? view.hand : null;
+      const readings = source.readings?.() ?? null;
       // drawn again only if something changed: the same picture would cost a canvas upload
-      const now = [positions, hand, view.held, camera.azimuth, camera.elevation, camera.zoom];
+      const now = [positions, hand, view.held, camera.azimuth, camera.elevation, camera.zoom,
+        readings];
       if (now.some((value, i) => value !== shown[i])) {
         painter.draw(camera, hand ? painter.place(positions, hand) : positions, view.held);
+        if (readings) drawInstruments(painter, camera, readings);
         stats.drawn++;
         if (hand && stats.moved !== null) stats.drawDelays.push(performance.now() - stats.moved);
         shown = now;
@@ -518,9 +551,11 @@ function letGo(view, x, d) {
       || performance.now() - hand.released > 1000)) view.hand = null;
 }
 
-function mouse(view, painter, source) {
+/** Grab and orbit with pointer events: a mouse, a finger or a pen. */
+function pointer(view, painter, source) {
   const { canvas, camera, stats } = view;
-  let turning = null, depth = 0;
+  let turning = null, depth = 0, active = null; // `active`: the pointer holding or turning
+  canvas.style.touchAction = "none"; // a finger drags a particle, not the page
   const at = (event) => { // the canvas's pixel under the mouse (inside its border)
     const box = canvas.getBoundingClientRect();
     return [(event.clientX - box.left - canvas.clientLeft) * (canvas.width / canvas.clientWidth),
@@ -534,20 +569,28 @@ function mouse(view, painter, source) {
     stats.pending = [time, particle, target];
   };
   canvas.addEventListener("contextmenu", (event) => event.preventDefault());
-  canvas.addEventListener("mousedown", (event) => {
+  canvas.addEventListener("pointerdown", (event) => {
+    if (active !== null) return; // one hand at a time
     const [px, py] = at(event);
     const nearest = event.button === 0 && source.grab ? pick(painter, px, py) : null;
     if (nearest === null) {
       turning = camera.dim === 3 ? [px, py, camera.azimuth, camera.elevation] : null;
+      if (turning) take(event);
       return;
     }
+    take(event);
     // in 3-D the hand moves on the plane facing the camera through the particle
     view.held = nearest;
     depth = painter.depth[nearest];
     hold(nearest, camera.unproject(px, py, depth), event);
     source.grab(nearest, view.hand.target);
   });
-  window.addEventListener("mousemove", (event) => {
+  const take = (event) => {
+    active = event.pointerId;
+    try { canvas.setPointerCapture(event.pointerId); } catch { /* a pointer already gone */ }
+  };
+  canvas.addEventListener("pointermove", (event) => {
+    if (event.pointerId !== active) return;
     const [px, py] = at(event);
     if (view.held !== null) {
       hold(view.held, camera.unproject(px, py, depth), event);
@@ -558,12 +601,17 @@ function mouse(view, painter, source) {
       camera.elevation = Math.max(-1.55, Math.min(1.55, elevation));
     }
   });
-  window.addEventListener("mouseup", () => {
+  const letGoOf = (event) => {
+    if (event.pointerId !== active) return;
     if (view.held !== null) source.release();
     if (view.hand) view.hand.released = performance.now();
     view.held = null;
     turning = null;
-  });
+    active = null;
+  };
+  canvas.addEventListener("pointerup", letGoOf);
+  canvas.addEventListener("pointercancel", letGoOf);
+  canvas.addEventListener("lostpointercapture", letGoOf); // the page took the pointer away
   canvas.addEventListener("wheel", (event) => {
     event.preventDefault();
     camera.zoom *= Math.exp(-event.deltaY * 0.001);
@@ -580,9 +628,10 @@ function pick(painter, px, py) {
   return best;
 }
 
-/** A button in `parent` calling `act`. */
+/** A button in `parent` calling `act`; `title` is also its name for screen readers. */
 function button(parent, label, title, act) {
   const node = element("button", { textContent: label, title }, parent);
+  node.setAttribute("aria-label", title);
   node.addEventListener("click", act);
   return node;
 }
@@ -595,6 +644,7 @@ function slider(parent, setting, change) {
   const input = element("input", { type: "range", min: setting.min, max: setting.max,
     step: setting.step, value: setting.value }, label);
   input.dataset.setting = setting.name;
+  input.setAttribute("aria-label", setting.label);
   input.style.verticalAlign = "middle";
   const format = (value) => Number(value).toPrecision(3);
   const shown = element("span", { textContent: format(setting.value) }, label);
@@ -613,60 +663,369 @@ function render({ model, el }) {
     fixed: typed(model.get("fixed"), Uint8Array),
   };
   let positions = typed(model.get("positions"), Float32Array);
+  const states = []; // states received, not shown yet, oldest first
   const send = (message) => model.send(message);
+  const show = (state) => { // a state's positions, and its energies and status line if any
+    positions = state.positions;
+    if (state.energy && view.energy) view.energy.update(state.energy);
+    if (state.pace !== undefined) view.status.dataset.pace = String(state.pace);
+    if (state.status !== undefined) view.status.dataset.line = state.status;
+    if (state.status !== undefined && !model.get("error")) view.status.textContent = state.status;
+    if (state.readings !== undefined) tools.update(state.readings);
+  };
   const source = {
-    latest: () => positions,
+    latest: () => { // one state a frame
+      if (states.length) show(states.shift());
+      return positions;
+    },
     grab: (particle, target) => send({ type: "grab", particle, target }),
     move: (target) => send({ type: "move", target }),
     release: () => send({ type: "release" }),
     stepping: () => model.get("running") && !model.get("error"),
+    readings: () => tools.shown(),
   };
   const view = mountView(el, scene, arrays, source);
   const onPositions = () => (positions = typed(model.get("positions"), Float32Array));
-  const onEnergy = () => view.energy && view.energy.update(model.get("energy"));
-  const onStatus = () => {
+  const onMessage = (message, buffers) => {
+    if (message.type === "export") download(message, buffers);
+    if (message.type !== "state") return;
+    view.stats.received++;
+    states.push({ ...message, positions: typed(buffers[0], Float32Array) });
+    if (states.length > QUEUED) states.shift();
+  };
+  const onError = () => {
     const error = model.get("error");
-    view.status.textContent = error ? `stopped: ${error}` : model.get("status");
+    view.status.textContent = error ? `stopped: ${error}` : view.status.dataset.line ?? "";
     view.status.style.color = error ? "#b00" : "#333";
   };
   model.on("change:positions", onPositions);
-  model.on("change:energy", onEnergy);
-  model.on("change:status", onStatus);
-  model.on("change:error", onStatus);
-  controls(view.root, model, send);
-  onEnergy();
-  onStatus();
+  model.on("msg:custom", onMessage);
+  model.on("change:error", onError);
+  const bar = controls(view.root, model, send);
+  const tools = instrumentPanel(view.root, model, send);
+  keyboard(view.root, bar);
+  onError();
+  const report = reportFrames(view.stats, send);
   return () => {
     view.alive = false;
+    clearInterval(report);
+    tools.stop();
     model.off("change:positions", onPositions);
-    model.off("change:energy", onEnergy);
-    model.off("change:status", onStatus);
-    model.off("change:error", onStatus);
+    model.off("msg:custom", onMessage);
+    model.off("change:error", onError);
   };
 }
 
-/** Pause, step, reset, speed and the scene's settings. */
+/** Tell the kernel, every `REPORT_EVERY` ms, how many frames a second the page draws:
+ * it sends that many states. The interval's id. */
+function reportFrames(stats, send) {
+  let frames = stats.frames, since = performance.now();
+  return setInterval(() => {
+    const now = performance.now();
+    const rate = (1000 * (stats.frames - frames)) / (now - since);
+    if (rate > 0) send({ type: "frames", rate });
+    [frames, since] = [stats.frames, now];
+  }, REPORT_EVERY);
+}
+
+/** Pause, step, reset, speed and the scene's settings; the controls by name, for the
+ * keyboard. */
 function controls(parent, model, send) {
   const bar = element("div", { className: "msdlab-controls" }, parent);
-  const play = button(bar, "", "pause / run", () => {
+  const play = button(bar, "", "pause or run (space)", () => {
     model.set("running", !model.get("running"));
     model.save_changes();
   });
   const label = () => (play.textContent = model.get("running") ? "❚❚ pause" : "▶ run");
   model.on("change:running", label);
   label();
-  button(bar, "▶❚ step", "one step", () => send({ type: "step" }));
-  button(bar, "↺ reset", "back to the start", () => send({ type: "reset" }));
+  const step = button(bar, "▶❚ step", "one step (s)", () => send({ type: "step" }));
+  const reset = button(bar, "↺ reset", "back to the start (r)", () => send({ type: "reset" }));
   const speed = { name: "speed", label: "speed ×", min: 0.1, max: 4, step: 0.1,
     value: model.get("speed") };
-  slider(bar, speed, (value) => {
+  const sliders = [slider(bar, speed, (value) => {
     model.set("speed", value);
     model.save_changes();
-  });
-  const sliders = element("div", {}, parent);
+  })];
+  const row = element("div", { className: "msdlab-settings" }, parent);
   for (const setting of model.get("settings")) {
-    slider(sliders, setting, (value) => send({ type: "set", name: setting.name, value }));
+    sliders.push(slider(row, setting, (value) => send({ type: "set", name: setting.name, value })));
   }
+  return { play, step, reset, sliders };
+}
+
+// ------------------------------------------------------------------ the instruments
+// Python measures (msdlab/viz/instruments.py); the page draws what it reads.
+
+const TOOLS = ["stopwatch", "ruler", "trace", "lines", "arrows"];
+const TOOL_NAMES = { stopwatch: "stopwatch (simulated time)",
+  ruler: "ruler between the last two particles taken in hand",
+  trace: "trace of the particle last taken in hand, with its period",
+  lines: "natural-length and equilibrium lines of a hung mass",
+  arrows: "velocity and force arrows on the particle last taken in hand" };
+const ARROW = 60; // px: the longest arrow (PhET's vectors: scaled to show, not to units)
+
+/** The ruler, the lines and the arrows over the body just drawn. */
+function drawInstruments(painter, camera, readings) {
+  const g = painter.context, screen = painter.screen;
+  g.save();
+  g.font = "12px sans-serif";
+  if (readings.lines) drawLines(g, camera, readings.lines, painter.canvas.width);
+  if (readings.ruler) {
+    const [a, b] = readings.ruler.ends;
+    const [ax, ay, bx, by] = [screen[2 * a], screen[2 * a + 1], screen[2 * b], screen[2 * b + 1]];
+    g.strokeStyle = g.fillStyle = "#b8860b";
+    g.lineWidth = 2;
+    g.setLineDash([6, 3]);
+    g.beginPath();
+    g.moveTo(ax, ay);
+    g.lineTo(bx, by);
+    g.stroke();
+    g.fillText(readings.ruler.distance.toPrecision(4), (ax + bx) / 2 + 6, (ay + by) / 2 - 6);
+  }
+  if (readings.arrows) drawArrows(g, painter, camera, readings.arrows);
+  g.restore();
+}
+
+/** Dashed lines across the view through the natural-length and equilibrium points. */
+function drawLines(g, camera, lines, width) {
+  if (!lines) return;
+  const at = new Float32Array(2), depth = new Float32Array(1);
+  g.lineWidth = 1.5;
+  g.setLineDash([8, 4]);
+  for (const [name, colour] of [["natural", "#2a9d8f"], ["equilibrium", "#d62728"]]) {
+    camera.project(Float32Array.from(lines[name]), 1, at, depth);
+    g.strokeStyle = g.fillStyle = colour;
+    g.beginPath();
+    g.moveTo(0, at[1]);
+    g.lineTo(width, at[1]);
+    g.stroke();
+    g.fillText(name === "natural" ? "natural length" : "equilibrium", 6, at[1] - 4);
+  }
+  g.setLineDash([]);
+}
+
+/** The velocity (green) and force (blue) on the traced particle, each scaled by the
+ * largest seen so far, so that its length shows how it changes. */
+function drawArrows(g, painter, camera, arrows) {
+  const p = arrows.particle, d = camera.dim;
+  painter.largest = painter.largest ?? { velocity: 0, force: 0 };
+  const from = [painter.screen[2 * p], painter.screen[2 * p + 1]];
+  g.setLineDash([]);
+  g.lineWidth = 3;
+  for (const [name, colour] of [["velocity", "#2ca02c"], ["force", "#1f77b4"]]) {
+    const vector = arrows[name], size = Math.hypot(...vector);
+    painter.largest[name] = Math.max(painter.largest[name], size);
+    if (size === 0) continue;
+    const [right, top] = d === 3 ? camera.axes() : [[1, 0], [0, 1]];
+    const along = (axis) => vector.reduce((sum, v, k) => sum + v * axis[k], 0);
+    const scale = ARROW / painter.largest[name];
+    const to = [from[0] + scale * along(right), from[1] - scale * along(top)];
+    arrow(g, from, to, colour);
+  }
+}
+
+function arrow(g, [x0, y0], [x1, y1], colour) {
+  const angle = Math.atan2(y1 - y0, x1 - x0), head = 8;
+  g.strokeStyle = g.fillStyle = colour;
+  g.beginPath();
+  g.moveTo(x0, y0);
+  g.lineTo(x1, y1);
+  g.stroke();
+  g.beginPath();
+  g.moveTo(x1, y1);
+  g.lineTo(x1 - head * Math.cos(angle - 0.4), y1 - head * Math.sin(angle - 0.4));
+  g.lineTo(x1 - head * Math.cos(angle + 0.4), y1 - head * Math.sin(angle + 0.4));
+  g.fill();
+}
+
+/** The instruments' toggles and readouts, gravity presets and the export buttons.
+ * `update(readings)` shows the readings of a state; `shown()` is what to draw over the
+ * body: the last readings, or null when no instrument is on. */
+function instrumentPanel(parent, model, send) {
+  const panel = element("div", { className: "msdlab-tools" }, parent);
+  panel.setAttribute("role", "group");
+  panel.setAttribute("aria-label", "instruments");
+  element("span", { textContent: "instruments: " }, panel);
+  for (const name of TOOLS) toggle(panel, model, name);
+  const readouts = element("div", { className: "msdlab-readouts" }, parent);
+  const watch = stopwatch(readouts, send);
+  const trace = new TracePlot(readouts);
+  const ruler = element("span", { className: "msdlab-ruler" }, readouts);
+  ruler.setAttribute("aria-live", "off");
+  const presets = element("div", { className: "msdlab-presets" }, parent);
+  if (Object.keys(model.get("presets") ?? {}).length) {
+    element("span", { textContent: "gravity: " }, presets);
+  }
+  presetButtons(presets, model, send);
+  element("span", { textContent: "  export the run: " }, presets);
+  exportButtons(presets, send);
+  let last = {};
+  const shown = () => (Object.values(model.get("tools") ?? {}).some(Boolean) ? last : null);
+  const show = () => {
+    const readings = shown() ?? {};
+    watch.show(readings.stopwatch);
+    trace.show(readings.trace, readings.time);
+    ruler.hidden = !readings.ruler;
+    if (readings.ruler) ruler.textContent = `ruler ${readings.ruler.distance.toPrecision(4)}`
+      + ` between particles ${readings.ruler.ends.join(" and ")}`;
+  };
+  model.on("change:tools", show);
+  show();
+  return {
+    update: (readings) => { last = readings; show(); },
+    shown,
+    stop: () => model.off("change:tools", show),
+  };
+}
+
+/** A button that turns the instrument `name` on and off (the `tools` trait). */
+function toggle(parent, model, name) {
+  const node = button(parent, name, TOOL_NAMES[name], () => {
+    model.set("tools", { ...model.get("tools"), [name]: !model.get("tools")?.[name] });
+    model.save_changes();
+  });
+  node.dataset.tool = name;
+  const show = () => {
+    const on = !!model.get("tools")?.[name];
+    node.setAttribute("aria-pressed", String(on));
+    node.style.background = on ? "#cfe3f7" : "";
+  };
+  model.on("change:tools", show);
+  show();
+}
+
+/** The stopwatch's reading and its start / stop and reset buttons. */
+function stopwatch(parent, send) {
+  const box = element("span", { className: "msdlab-stopwatch" }, parent);
+  box.style.cssText = "margin-right: 12px; font-variant-numeric: tabular-nums";
+  element("span", { textContent: "stopwatch " }, box);
+  const reading = element("span", { textContent: "0.000" }, box);
+  const unit = element("span", { textContent: "" }, box);
+  reading.setAttribute("role", "timer");
+  reading.setAttribute("aria-label", "stopwatch reading");
+  let running = false;
+  const go = button(box, "start", "start or stop the stopwatch",
+    () => send({ type: "stopwatch", action: running ? "stop" : "start" }));
+  button(box, "0", "reset the stopwatch", () => send({ type: "stopwatch", action: "reset" }));
+  return {
+    show(watch) {
+      box.hidden = !watch;
+      if (!watch) return;
+      running = watch.running;
+      reading.textContent = watch.reading.toFixed(3);
+      unit.textContent = ` ${watch.unit} `;
+      go.textContent = running ? "stop" : "start";
+    },
+  };
+}
+
+/** The traced particle's position and velocity against time, and its period. */
+class TracePlot {
+  constructor(parent) {
+    this.canvas = element("canvas", { width: 320, height: 130 }, parent);
+    this.canvas.className = "msdlab-trace";
+    this.canvas.setAttribute("role", "img");
+    this.canvas.setAttribute("aria-label", "trace of a particle's position and velocity");
+    this.canvas.style.cssText = "vertical-align: top; border: 1px solid #ddd";
+  }
+
+  show(trace) {
+    this.canvas.hidden = !trace;
+    if (!trace) return;
+    const g = this.canvas.getContext("2d"), { width, height } = this.canvas;
+    const period = trace.period === null ? "not yet measured"
+      : `${trace.period.toPrecision(5)} ${trace.unit}`;
+    const axis = "xyz"[trace.axis];
+    this.canvas.dataset.period = String(trace.period);
+    this.canvas.setAttribute("aria-label", `trace of particle ${trace.particle}: `
+      + `position ${axis} and velocity v${axis} against time; period ${period}`);
+    g.fillStyle = "#fff";
+    g.fillRect(0, 0, width, height);
+    const points = trace.points;
+    if (points.length > 1) {
+      const t0 = points[0][0], t1 = points[points.length - 1][0];
+      for (const [column, colour] of [[1, "#1f77b4"], [2, "#ff7f0e"]]) {
+        const values = points.map((p) => p[column]);
+        const low = Math.min(...values), high = Math.max(...values);
+        g.strokeStyle = colour;
+        g.beginPath();
+        points.forEach((p, i) => {
+          const x = 4 + ((p[0] - t0) / (t1 - t0 || 1)) * (width - 8);
+          const y = height - 6 - ((p[column] - low) / (high - low || 1)) * (height - 30);
+          if (i === 0) g.moveTo(x, y);
+          else g.lineTo(x, y);
+        });
+        g.stroke();
+      }
+    }
+    g.fillStyle = "#000";
+    g.font = "11px sans-serif";
+    g.fillText(`particle ${trace.particle}: ${axis} (blue), v${axis} (orange)   period ${period}`,
+      4, 12);
+  }
+}
+
+/** Buttons setting gravity to Earth's, the Moon's, Jupiter's or none (in the scene's
+ * units), moving the gravity slider with it. */
+function presetButtons(parent, model, send) {
+  const presets = model.get("presets") ?? {};
+  for (const [name, value] of Object.entries(presets)) {
+    const node = button(parent, name, `gravity of ${name === "zero" ? "nothing" : name}: `
+      + `|g| = ${value.toPrecision(3)}`, () => {
+      const input = parent.closest(".msdlab-live")?.querySelector('input[data-setting="gravity"]');
+      if (input) {
+        input.value = value;
+        input.dispatchEvent(new Event("input"));
+      }
+      send({ type: "set", name: "gravity", value });
+    });
+    node.dataset.gravity = name;
+  }
+}
+
+function exportButtons(parent, send) {
+  for (const kind of ["csv", "npz"]) {
+    const node = button(parent, `⤓ ${kind.toUpperCase()}`,
+      `download the run shown (time, energies, positions, velocities) as ${kind.toUpperCase()}`,
+      () => send({ type: "export", format: kind }));
+    node.dataset.export = kind;
+  }
+}
+
+/** A file from the kernel (an export) handed to the browser to save. */
+function download(content, buffers) {
+  if (content?.type !== "export") return;
+  const url = URL.createObjectURL(new Blob([buffers[0]]));
+  const link = element("a", { href: url, download: content.name }, document.body);
+  link.click();
+  link.remove();
+  setTimeout(() => URL.revokeObjectURL(url), 10_000);
+}
+
+/** Keys while the view has the focus: space pauses or runs, s steps, r resets, [ and ]
+ * move the speed down or up. JupyterLab leaves the keys inside the view to it. */
+function keyboard(root, bar) {
+  root.tabIndex = 0;
+  root.setAttribute("data-lm-suppress-shortcuts", "true");
+  root.setAttribute("role", "region");
+  root.setAttribute("aria-label", "msdlab live view. Keys: space pauses or runs, s steps, "
+    + "r resets, [ and ] change the speed");
+  const nudge = (input, steps) => {
+    input.value = Number(input.value) + steps * Number(input.step);
+    input.dispatchEvent(new Event("input"));
+    input.dispatchEvent(new Event("change"));
+  };
+  const keys = { " ": () => bar.play.click(), s: () => bar.step.click(),
+    r: () => bar.reset.click(), "[": () => nudge(bar.sliders[0], -1),
+    "]": () => nudge(bar.sliders[0], 1) };
+  root.addEventListener("keydown", (event) => {
+    const act = keys[event.key];
+    const typing = event.target.tagName === "BUTTON" && event.key === " ";
+    if (!act || typing || event.ctrlKey || event.metaKey || event.altKey) return;
+    event.preventDefault();
+    act();
+  });
 }
 
 /** The replay page's player: recorded frames, play / pause, a scrubber, orbiting. */

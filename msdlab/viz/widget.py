@@ -1,15 +1,19 @@
 """The live view in a notebook: an anywidget whose page draws while Python steps.
 
-The browser (``live.js``) draws at its own frame rate from the latest positions
-it has and never waits for Python. Python steps the simulation in a background
-thread at the scene's pace (``steps_per_second`` × ``speed``: 60 a second for
-the gallery, real time, 1/dt a second, for physical scenes) and, up to
-`FRAME_RATE` times a second, sends the positions as a float32 buffer and the
-energies as JSON. A thread rather than an asyncio task: the kernel's event loop
+The browser (``live.js``) draws at its own frame rate and never waits for Python.
+Python steps the simulation in a background thread at the scene's pace
+(``steps_per_second`` × ``speed``: 60 a second for the gallery, real time, 1/dt a
+second, for physical scenes) and sends a state at the page's frame rate (which the
+page reports; `FRAME_RATE` at most): one message per state, the positions as a
+float32 buffer and, every `ENERGY_EVERY` states, the energies and the status line
+inside the same message. The page queues the states and shows one a frame, so two
+that arrive together are both shown. A thread rather than an asyncio task: the kernel's event loop
 stops while a cell runs, and a thread also runs outside Jupyter (tests,
 scripts); the kernel sends comm messages from any thread. What the page asks
-(grab, move, release, step, reset, a slider) arrives on the kernel's main
-thread and is queued, to be done by the stepping thread between two steps.
+(grab, move, release, step, reset, a slider, the stopwatch's buttons, an export)
+arrives on the kernel's main thread and is queued, to be done by the stepping thread
+between two steps. The instruments turned on (`instruments`) are read here and their
+readings ride in the states; the run shown is kept for export (`export.Recording`).
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ import queue
 import threading
 import time
 from collections.abc import Callable, Sequence
+from pathlib import Path
 
 import anywidget
 import numpy as np
@@ -29,13 +34,22 @@ from ..forces import Gravity
 from ..interaction import Grab, Ground, Walls
 from ..scenes.registry import Scene
 from ..simulation import Simulation
-from . import frontend, settings
+from ..units import SI
+from . import frontend, instruments, settings
+from .export import Recording
 from .upright import UPS, resolve_up
 from .view import LIVE_STRAIN_LIMIT, spheres_of
 
-FRAME_RATE = 60.0  # most frames sent a second
-ENERGY_EVERY = 4  # frames sent per energy update (15 a second)
-BUDGET = 0.5 / FRAME_RATE  # s of stepping between two frames sent, at most
+FRAME_RATE = 60.0  # most states sent a second
+SLOWEST = 5.0  # fewest states sent a second, whatever the page reports
+ENERGY_EVERY = 4  # states sent per energy update (15 a second)
+BUDGET = 0.75  # of the time between two states sent, spent stepping at most
+KEEPS_PACE = 0.97  # a pace below this share of the one asked is shown in the status line
+PACE_OVER = 10.0  # steps asked, at least, over which the pace kept is measured
+# requests done at the next state sent, not at once: a mouse moves 60 times a second,
+# and a state sent for each move beside the paced ones would be more than the page can
+# show (the page draws the held particle at the hand itself)
+PACED = ("move", "frames")
 _running: list[LiveView] = []  # views started by `show`, stopped when a new one starts
 
 
@@ -50,14 +64,28 @@ def ground_level(sim: Simulation, up: int) -> float:
     return float(sim.body.positions[:, up].min())
 
 
-def energies(sim: Simulation, taken_at_start: dict[str, float], level: float = 0.0) -> dict:
-    """The ledger's energies of ``sim`` now (as `Simulation.run` records them, J):
+def velocities_now(sim: Simulation) -> np.ndarray:
+    """The velocities at the positions' time, as the ledger takes them."""
+    x, v = sim.body.positions, sim.body.velocities
+    if sim.step_count == 0:
+        return v
+    return sim.integrator.velocity_at_positions(v, sim.dynamics.acceleration(x, v), sim.dt)
+
+
+def energies(
+    sim: Simulation,
+    taken_at_start: dict[str, float],
+    level: float = 0.0,
+    v: np.ndarray | None = None,
+) -> dict:
+    """The ledger's energies of ``sim`` now (as `Simulation.run` records them, in the
+    simulation's units, J in SI):
     kinetic, elastic, gravitational (counted from height ``level`` along gravity; ``zero``
     is the ledger's gravitational energy at that height), other potential, and what each
-    mechanism took out since the view started; the time (s)."""
-    x, v = sim.body.positions, sim.body.velocities
-    if sim.step_count > 0:  # the velocity at the positions' time, as the ledger takes it
-        v = sim.integrator.velocity_at_positions(v, sim.dynamics.acceleration(x, v), sim.dt)
+    mechanism took out since the view started; the time (s). ``v``: `velocities_now`,
+    if the caller has them."""
+    x = sim.body.positions
+    v = velocities_now(sim) if v is None else v
     gravities = [f for f in sim.forces if isinstance(f, Gravity)]
     gravitational = sum(f.potential_energy(sim.body, x) for f in gravities)
     potential = sum(f.potential_energy(sim.body, x) for f in sim.forces)
@@ -83,6 +111,8 @@ class LiveView(anywidget.AnyWidget):
     ``scene`` (a registered `Scene`) adds its build settings as sliders that rebuild it.
     ``steps_per_second`` defaults to real time (1/dt); ``view`` is (azimuth, elevation) in
     degrees and ``up`` the vertical axis (by default against gravity, `upright`).
+    Energies are labelled in ``energy_unit``, by default the simulation's (`sim.units`:
+    J in SI, px²/frame² for the gallery's unit masses in pixels and frames).
     """
 
     _esm = frontend.ESM
@@ -90,13 +120,13 @@ class LiveView(anywidget.AnyWidget):
     springs = traitlets.Bytes().tag(sync=True)
     rest = traitlets.Bytes().tag(sync=True)
     fixed = traitlets.Bytes().tag(sync=True)
-    positions = traitlets.Bytes().tag(sync=True)
-    energy = traitlets.Dict().tag(sync=True)
+    positions = traitlets.Bytes().tag(sync=True)  # at the start; then in the states sent
     settings = traitlets.List().tag(sync=True)
-    status = traitlets.Unicode().tag(sync=True)
     error = traitlets.Unicode().tag(sync=True)
     running = traitlets.Bool(True).tag(sync=True)
     speed = traitlets.Float(1.0).tag(sync=True)
+    tools = traitlets.Dict().tag(sync=True)  # which instruments are shown: name -> on
+    presets = traitlets.Dict().tag(sync=True)  # gravity presets, |g| in the scene's units
 
     def __init__(
         self,
@@ -106,7 +136,7 @@ class LiveView(anywidget.AnyWidget):
         steps_per_second: float | None = None,
         view: Sequence[float] | None = None,
         up: str | None = None,
-        energy_unit: str = "J",
+        energy_unit: str | None = None,
     ) -> None:
         super().__init__()
         self.scene_entry, self.pace = scene, steps_per_second
@@ -118,6 +148,13 @@ class LiveView(anywidget.AnyWidget):
         self._values: dict[str, float] = {}
         self._frames = 0
         self._moved = False  # the hand moved since the last frame
+        self.send_rate = FRAME_RATE  # states sent a second: the page's frame rate
+        self.energy: dict = {}  # the energies last sent (`energies`)
+        self.status = ""  # the status line last sent
+        self.achieved = 1.0  # steps done over steps asked since the last energy update
+        self.stopwatch = instruments.Stopwatch(lambda: self.sim.time)
+        self.readings: dict = {}  # what the instruments turned on read, as last sent
+        self.tools = {name: False for name in instruments.TOOLS}
         self.attach(sim)
         self.on_msg(self._on_message)
 
@@ -131,8 +168,10 @@ class LiveView(anywidget.AnyWidget):
         self._initial = (sim.body.positions.copy(), sim.body.velocities.copy())
         self._taken = dict(sim.dissipated)
         up = resolve_up(self._look[1], sim, sim.body.dim)
-        self._level = ground_level(sim, UPS.index(up))
+        self._up = UPS.index(up)
+        self._level = ground_level(sim, self._up)
         self._owed, self._clock = 0.0, time.perf_counter()
+        self._asked = self._done = 0.0
         view, _, energy_unit = self._look
         live = settings.live_settings(sim)
         rebuild = (
@@ -155,42 +194,71 @@ class LiveView(anywidget.AnyWidget):
                 setattr(self, name, data)
             self.settings = [s.as_dict() for s in (*live, *rebuild)]
             self.error = ""
-            self.publish()
+            self.positions = self._positions()
+        self.set_up_instruments()
+        self.publish()
 
     @property
     def steps_per_second(self) -> float:
         """The pace at speed 1: ``steps_per_second`` as given, or real time."""
         return self.pace if self.pace is not None else 1.0 / self.sim.dt
 
-    def publish(self, energy: bool = True) -> None:
-        """Send the positions (float32 buffer) and, if ``energy``, the energies and the
-        status line (the energies cost a force evaluation, the line a layout of the page:
-        the thread sends them every `ENERGY_EVERY` frames)."""
-        sim = self.sim
-        with self.hold_sync():
-            self.positions = sim.body.positions.astype(np.float32).tobytes()
-            if energy:
-                self.energy = energies(sim, self._taken, self._level)
-                self.status = f"t = {sim.time:.4g}   steps {sim.step_count}"
+    def _positions(self) -> bytes:
+        return self.sim.body.positions.astype(np.float32).tobytes()
 
-    def advance(self, seconds: float, budget: float = BUDGET, early: bool = False) -> int:
+    def publish(self, energy: bool = True) -> None:
+        """Send the state: one message, the positions (a float32 buffer) and, if
+        ``energy``, the energies and the status line (the energies cost a force
+        evaluation, the line a layout of the page: the thread sends them every
+        `ENERGY_EVERY` states)."""
+        content: dict = {"type": "state"}
+        if energy:
+            velocities = velocities_now(self.sim)
+            self.energy = energies(self.sim, self._taken, self._level, velocities)
+            content["energy"] = self.energy
+            self.status = content["status"] = self.status_line()
+            content["pace"] = self.achieved
+            self.recording.add(self.sim.time, self.sim.body.positions, velocities, self.energy)
+        if any(self.tools.values()) or self.readings:  # once more, empty, when all go off
+            self.readings = content["readings"] = self.measure() if any(self.tools.values()) else {}
+        self.send(content, buffers=[self._positions()])
+
+    def status_line(self) -> str:
+        """The time, the steps and, when the engine falls behind, the pace it keeps."""
+        sim, unit = self.sim, self.scene["time_unit"]
+        line = f"t = {sim.time:.4g} {unit}   steps {sim.step_count}"
+        if self._asked >= PACE_OVER:
+            self.achieved = min(1.0, self._done / self._asked)
+            self._asked = self._done = 0.0
+        if self.running and self.achieved < KEEPS_PACE:
+            asked = "real time" if self.pace is None else f"{self.steps_per_second:g} steps/s"
+            line += f"   pace {self.achieved:.2f} × {asked} (the engine cannot keep up)"
+        return line
+
+    def advance(self, seconds: float, budget: float | None = None, early: bool = False) -> int:
         """Step for ``seconds`` of wall-clock time at the pace (at most ``budget`` s of
         stepping: a slow engine runs slower than real time rather than falling behind);
         stop with the diagnosis on a blow-up. ``early``: a step now even if none is due yet
         (the hand moved: `Grab` pins the particle at the next step), one step ahead of the
         pace at most, taken from the steps owed later. The number of steps done."""
-        self._owed += seconds * self.steps_per_second * self.speed
+        if budget is None:
+            budget = BUDGET / self.send_rate
+        asked = seconds * self.steps_per_second * self.speed
+        self._owed += asked
         lent = 1.0 if early and 0.0 <= self._owed < 1.0 else 0.0
         self._owed += lent
         done, start = 0, time.perf_counter()
         try:
             while self._owed >= 1.0 and time.perf_counter() - start < budget:
                 self.sim.step()
+                self.trace.record(self.sim)
                 self._owed -= 1.0
                 done += 1
         except SimulationDiverged as error:
             self.running, self.error = False, str(error)
         self._owed = min(self._owed, 1.0) - lent  # what was not done in time is dropped
+        self._asked += asked
+        self._done += done
         return done
 
     def do_pending(self) -> None:
@@ -223,13 +291,17 @@ class LiveView(anywidget.AnyWidget):
             "step": self.step_once,
             "reset": self.reset,
             "set": lambda: self.set(content["name"], content["value"]),
+            "frames": lambda: self.match_frames(content["rate"]),
+            "stopwatch": lambda: self.press_stopwatch(content["action"]),
+            "export": lambda: self.send_export(content["format"]),
         }
         command = handlers.get(content.get("type"))
         if command is not None:
             self._commands.put(command)
             if self._thread is None:
                 self.do_pending()
-            self._wake.set()  # a frame now: the hand should not wait for the next one
+            if content["type"] not in PACED:
+                self._wake.set()  # a frame now: a grab, a step, a slider need not wait
 
     def _hold(self, particle: int | None, target: list[float]) -> None:
         """The hand at ``target`` holding ``particle`` (none: the move of a hand let go)."""
@@ -237,9 +309,14 @@ class LiveView(anywidget.AnyWidget):
             return
         if particle != self.grab.particle:
             self.grab.hold(self.sim.body, particle, target)
+            self.pick(particle)
         else:
             self.grab.move(target)
         self._moved = True
+
+    def match_frames(self, rate: float) -> None:
+        """Send as many states a second as the page draws frames (``rate``, 1/s)."""
+        self.send_rate = min(FRAME_RATE, max(SLOWEST, float(rate)))
 
     def step_once(self) -> None:
         """One step, paused or not."""
@@ -256,6 +333,7 @@ class LiveView(anywidget.AnyWidget):
         self.sim.time, self.sim.step_count = 0.0, 0
         self._taken = dict(self.sim.dissipated)
         self.error = ""
+        self.set_up_instruments(keep_picks=True)
 
     def set(self, name: str, value: float) -> None:
         """Apply a slider: in place between steps, or by rebuilding the scene."""
@@ -268,6 +346,115 @@ class LiveView(anywidget.AnyWidget):
             self.attach(self.scene_entry.build(**built))
         else:
             settings.apply(self.sim, name, value, self._start)
+
+    # ------------------------------------------------------------------ the instruments
+    def set_up_instruments(self, keep_picks: bool = False) -> None:
+        """A new run: the trace, the recording and the stopwatch start over; the trace
+        follows the lowest free particle, the ruler runs from the first pinned one to it
+        (``keep_picks``: the particles picked before)."""
+        sim = self.sim
+        self.stopwatch.stop()
+        self.stopwatch.reset()
+        units = (self.scene["time_unit"], self.scene["energy_unit"])
+        self.recording = Recording(len(sim.body), sim.body.dim, *units)
+        if keep_picks:
+            self.follow(self.trace.particle)
+            return
+        traced = instruments.lowest_free(sim, self._up)
+        pinned = np.flatnonzero(sim.body.fixed)
+        start = int(pinned[0]) if len(pinned) else int(traced == 0)
+        self.follow(traced)
+        self.ruler_ends = (start, traced)
+        self.presets = self.gravity_presets()
+
+    def toggle(self, tool: str, on: bool | None = None) -> None:
+        """Show the instrument ``tool`` (stopwatch, ruler, trace, lines, arrows) or hide
+        it: ``on``, or the other way round from now."""
+        if tool not in self.tools:
+            raise ValueError(f"no instrument {tool!r}: choose one of {', '.join(self.tools)}")
+        self.tools = {**self.tools, tool: not self.tools[tool] if on is None else bool(on)}
+
+    def press_stopwatch(self, button: str) -> None:
+        """The stopwatch's button ``button``: start, stop or reset."""
+        watch = self.stopwatch
+        actions = {"start": watch.start, "stop": watch.stop, "reset": watch.reset}
+        if button not in actions:
+            raise ValueError(f"the stopwatch has no button {button!r}: start, stop or reset")
+        actions[button]()
+
+    def gravity_presets(self) -> dict[str, float]:
+        """|g| of Earth, Moon, Jupiter and zero in the scene's units: Earth's is 9.81 in
+        SI, else the scene's own gravity at the start; none without gravity."""
+        gravity = instruments.gravity_of(self.sim)
+        if gravity is None:
+            return {}
+        if self._start["gravity"] is None:  # no direction yet: along the view's down
+            self._start["gravity"] = -np.eye(self.sim.body.dim)[self._up]
+        si = self.sim.units == SI
+        earth = instruments.GRAVITY["Earth"] if si else float(np.linalg.norm(gravity.g))
+        return instruments.GravityPresets(earth or instruments.GRAVITY["Earth"]).values()
+
+    def set_gravity(self, preset: str) -> None:
+        """Set gravity to a preset: "Earth", "Moon", "Jupiter" or "zero"."""
+        if not self.presets:
+            raise ValueError("this scene has no gravity to set: it was built without msd.Gravity")
+        if preset not in self.presets:
+            raise ValueError(
+                f"no gravity preset {preset!r}: choose one of {', '.join(self.presets)}"
+            )
+        self.set("gravity", self.presets[preset])
+
+    def follow(self, particle: int, axis: int | None = None) -> None:
+        """Trace ``particle`` along ``axis`` (default: the vertical) from now on."""
+        self.trace = instruments.Trace(particle, self._up if axis is None else axis)
+
+    def pick(self, particle: int) -> None:
+        """A particle taken in hand: the trace follows it, the ruler runs from the one
+        picked before to it."""
+        if particle != self.trace.particle:
+            self.ruler_ends = (self.trace.particle, particle)
+            self.follow(particle)
+
+    def measure(self) -> dict:
+        """What each instrument turned on in `tools` reads now, for the page."""
+        sim, traced, on = self.sim, self.trace.particle, self.tools
+        unit = self.recording.units["time"]
+        readings: dict = {"time": sim.time}
+        if on.get("stopwatch"):
+            watch = self.stopwatch
+            readings["stopwatch"] = {
+                "reading": watch.reading,
+                "running": watch.running,
+                "unit": unit,
+            }
+        if on.get("ruler"):
+            distance = instruments.distance(sim, self.ruler_ends)
+            readings["ruler"] = {"ends": list(self.ruler_ends), "distance": distance}
+        if on.get("trace"):
+            period = self.trace.period()
+            readings["trace"] = {
+                "particle": traced,
+                "axis": self.trace.axis,
+                "points": self.trace.shown(),
+                "period": period,
+                "unit": unit,
+            }
+        if on.get("lines"):
+            readings["lines"] = instruments.hanging_lines(sim, traced)
+        if on.get("arrows"):
+            readings["arrows"] = {"particle": traced, **instruments.arrows(sim, traced)}
+        return readings
+
+    def export(self, path: str | Path) -> Path:
+        """Write the run shown to ``path``, a .csv table or a .npz of NumPy arrays: time,
+        energies, positions and velocities of each state sent with its energies (every
+        `ENERGY_EVERY`-th while it runs, 15 a second at 60; each one paused)."""
+        return self.recording.write(path)
+
+    def send_export(self, kind: str) -> None:
+        """Send the page the run shown as a file to download (``kind``: csv or npz)."""
+        data = self.recording.npz() if kind == "npz" else self.recording.csv()
+        self.send({"type": "export", "name": f"msdlab-run.{kind}"}, [data])
 
     # ------------------------------------------------------------------ the thread
     def start(self) -> LiveView:
@@ -288,11 +475,16 @@ class LiveView(anywidget.AnyWidget):
         self._thread = None
 
     def _loop(self) -> None:
+        """Send a state every 1/`send_rate` s on a fixed beat (a late one does not shift
+        the next), and at once when the page asks something."""
+        beat = time.perf_counter()
         while not self._stop.is_set():
-            began = time.perf_counter()
             self._wake.clear()
             self.frame()
-            self._wake.wait(max(0.0, 1.0 / FRAME_RATE - (time.perf_counter() - began)))
+            now = time.perf_counter()
+            while beat <= now:  # the beats a slow frame overran are skipped, not caught up
+                beat += 1.0 / self.send_rate
+            self._wake.wait(beat - now)
 
 
 def in_notebook() -> bool:

@@ -149,3 +149,52 @@ def test_the_replay_page_holds_positions_and_asks_the_network_for_nothing(tmp_pa
     assert "data:image/png" not in page
     assert not re.search(r"(src|href)=\"?https?:", page)
     assert '"frames": "' in page and "export async function replay" in page
+
+
+def sent_by(view: LiveView) -> list[tuple[dict, list]]:
+    """The messages ``view`` sends the page from now on: (content, buffers)."""
+    messages: list[tuple[dict, list]] = []
+    view.send = lambda content, buffers=None: messages.append((content, buffers))
+    return messages
+
+
+def test_each_state_is_one_message_with_its_energies_inside():
+    sim = gallery.mesh()
+    view = LiveView(sim, steps_per_second=60)
+    messages = sent_by(view)
+    for _ in range(viz.widget.ENERGY_EVERY):
+        view.frame()
+    assert len(messages) == viz.widget.ENERGY_EVERY  # one a state, no pair
+    content, (positions,) = messages[-1]
+    np.testing.assert_array_equal(
+        np.frombuffer(positions, np.float32).reshape(-1, 2), sim.body.positions.astype(np.float32)
+    )
+    assert content["energy"]["time"] == sim.time and content["status"].startswith("t = ")
+    assert "energy" not in messages[0][0]  # the energies every few states only
+
+
+def test_the_view_sends_as_many_states_as_the_page_draws_frames():
+    view = LiveView(gallery.mesh(), steps_per_second=60)
+    ask(view, type="frames", rate=37.5)
+    assert view.send_rate == 37.5
+    ask(view, type="frames", rate=500.0)
+    assert view.send_rate == viz.widget.FRAME_RATE
+
+
+def test_a_view_that_cannot_keep_pace_says_so():
+    sim = SCENES["jelly-cube"].build(size=3)
+    view = LiveView(sim)  # real time
+    view.advance(8.0, budget=60)  # 20 steps of 0.4 s
+    assert "pace" not in view.status_line()
+    view.advance(8.0, budget=0.0)  # no time to step
+    assert "pace 0.00 × real time (the engine cannot keep up)" in view.status_line()
+    gallery_view = LiveView(gallery.mesh(), steps_per_second=60)
+    gallery_view.advance(0.5, budget=0.0)
+    assert "pace 0.00 × 60 steps/s" in gallery_view.status_line()
+
+
+def test_energies_are_in_the_scenes_units():
+    assert LiveView(gallery.mesh()).scene["energy_unit"] == "px²/frame²"
+    assert LiveView(gallery.mesh()).scene["time_unit"] == "frame"
+    assert LiveView(SCENES["jelly-cube"].build(size=3)).scene["energy_unit"] == "J"
+    assert LiveView(gallery.mesh(), energy_unit="kJ").scene["energy_unit"] == "kJ"

@@ -156,3 +156,40 @@ def test_the_widget_draws_drags_sets_and_adds_up(page_with_widget):
     assert in_body == pytest.approx(paused["ledger_total"], rel=1e-9, abs=1e-9)
     total = float(page.locator(".msdlab-energy").get_attribute("data-total"))
     assert total == pytest.approx(sum(bars.values()), rel=1e-12)
+
+
+COUNTS = """() => { const s = window.msdlabViews.at(-1).stats;
+return [s.received, s.updates, s.pictures, performance.now()]; }"""
+BOOKS = """() => { const c = document.querySelector('.msdlab-energy');
+return [Number(c.dataset.total), JSON.parse(c.dataset.bars).driven ?? 0]; }"""
+
+
+def test_every_state_is_shown_and_a_hands_circle_is_booked(page_with_widget):
+    page, state = page_with_widget
+    wait_until(lambda: (s := state()) and s["steps"] > 120, 60, "the mesh settling")
+    screen = screen_of(page)
+    particle = screen[int(np.argmax(screen[:, 0] - screen[:, 1]))]
+    books = page.evaluate(BOOKS)
+    counts = page.evaluate(COUNTS)
+    page.mouse.move(*particle)
+    page.mouse.down()
+    start = time.perf_counter()
+    while (elapsed := time.perf_counter() - start) < 4.0:  # once round a circle of 30 px
+        angle = 2 * np.pi * elapsed / 4.0
+        page.mouse.move(*(particle + 30.0 * np.array([np.cos(angle) - 1.0, np.sin(angle)])))
+        time.sleep(1 / 60)
+    received, shown, pictures, now = np.array(page.evaluate(COUNTS)) - counts
+    page.mouse.up()
+    time.sleep(1.5)  # the energies of a state after the release
+    total, driven = np.array(page.evaluate(BOOKS)) - books
+    # each state that came is shown, in a frame of its own, as a picture of its own
+    assert shown >= 0.7 * received and pictures >= 0.7 * received  # before: 0.6
+    # a floor that holds on a loaded 2-core machine (12 a second seen with 14 processes
+    # waiting for its cores; 55 or more on a quiet one)
+    assert 1000 * pictures / now >= 8.0, f"{1000 * pictures / now:.1f} new pictures a second"
+    # the energy panel's total (in the body and taken out) moves by the hand's work only
+    assert -driven > 50.0  # the hand put energy in (px²/frame², unit masses)
+    # within 1 % at the page's pace; a loaded machine's kernel steps less often, so the
+    # hand moves further in a step, and the booking's error grows with the step's move
+    drift = f"the total moved {total:.4g} for the hand's work {-driven:.4g}"
+    assert abs(total) <= 0.1 * -driven, drift  # before: -89 %, the hand's stops unbooked
