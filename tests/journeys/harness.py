@@ -1,0 +1,108 @@
+"""Walking a person's path through msdlab: a fresh virtual environment, commands typed at a
+shell, what they print.
+
+The journey tests (test_student.py, test_instructor.py) import it (``from harness import
+...``: pytest puts this folder on the path):
+
+- `Terminal`: a person's shell in a fresh virtual environment; `Terminal.type` runs a
+  command line as written (bash, the environment's ``bin/`` first on ``PATH``) and
+  returns what it printed and its exit status.
+- `quick_start`: the command lines of a README's quick-start block, as written.
+- `release`: ``msdlab release`` of this checkout, as an instructor runs it.
+
+The environment is new, but it borrows the packages of the one running the tests (a
+``.pth`` file, as the student bundle's own test does): ``pip install`` finds every
+dependency installed and downloads nothing, while msdlab itself is installed from the
+folder the person is in, so the commands prove that what they install works there.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import site
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+"""The course checkout under test."""
+
+
+@dataclass
+class Typed:
+    """A command line a person typed, its exit status and what it printed (both streams)."""
+
+    command: str
+    status: int
+    output: str
+
+    def __str__(self) -> str:
+        return f"$ {self.command}\n{self.output}(exit status {self.status})"
+
+
+class Terminal:
+    """A shell in a fresh virtual environment at ``home / 'venv'``."""
+
+    def __init__(self, home: Path) -> None:
+        self.home = Path(home)
+        self.venv = self.home / "venv"
+        subprocess.run([sys.executable, "-m", "venv", str(self.venv)], check=True)
+        packages = subprocess.check_output(
+            [self.python, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+            text=True,
+        ).strip()
+        # borrowed, not downloaded: this Python's packages, after the environment's own
+        (Path(packages) / "borrowed.pth").write_text("\n".join(site.getsitepackages()) + "\n")
+
+    @property
+    def python(self) -> Path:
+        """The environment's Python."""
+        return self.venv / "bin" / "python"
+
+    def environment(self) -> dict[str, str]:
+        """The variables of a shell with the environment activated (no choice of task files,
+        no test settings of the process running the journey)."""
+        inherited = {
+            key: value
+            for key, value in os.environ.items()
+            if not key.startswith(("MSDLAB_", "PYTEST_", "PYTHON")) and key != "VIRTUAL_ENV"
+        }
+        path = os.pathsep.join([str(self.venv / "bin"), inherited.get("PATH", "")])
+        return {**inherited, "PATH": path, "VIRTUAL_ENV": str(self.venv)}
+
+    def type(self, command: str, cwd: Path, timeout: float = 600) -> Typed:
+        """Run ``command`` as typed at the prompt in ``cwd``; what it printed, its status."""
+        done = subprocess.run(
+            ["bash", "-c", command],
+            cwd=cwd,
+            env=self.environment(),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            timeout=timeout,
+        )
+        return Typed(command, done.returncode, done.stdout)
+
+
+def quick_start(readme: Path) -> list[str]:
+    """The command lines of the first ``bash`` block under a README's "Quick start" heading."""
+    text = readme.read_text(encoding="utf-8")
+    section = re.search(r"^#+ Quick start\s*$(.*?)(?=^#+ |\Z)", text, re.M | re.S)
+    block = section and re.search(r"```bash\n(.*?)```", section[1], re.S)
+    if not block:
+        raise ValueError(f"{readme} has no bash block under a 'Quick start' heading")
+    lines = [line.split("  #")[0].strip() for line in block[1].splitlines()]
+    return [line for line in lines if line and not line.startswith("#")]
+
+
+def release(out: Path, course: Path = ROOT) -> Path:
+    """The student bundle of ``course``, made by ``msdlab release`` as an instructor types it."""
+    subprocess.run(
+        [sys.executable, "-m", "msdlab", "release", str(out), "--course", str(course)],
+        cwd=out.parent,
+        check=True,
+        capture_output=True,
+    )
+    return out
