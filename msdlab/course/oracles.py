@@ -10,6 +10,7 @@ answers (for the hidden checks) stay with the instructor's checks.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -165,14 +166,29 @@ def wrapped_border_pairs(shape: Sequence[int]) -> np.ndarray:
     return np.concatenate(pairs) if pairs else np.zeros((0, 2), dtype=np.int64)
 
 
-TEMPLATE_STIFFNESS = 0.5  # k of the tasks' templates
-TEMPLATE_SPACING = 0.1  # 2/N of the template, N = 20
+def task_constant(task: Any, name: str) -> float | None:
+    """The number ``name`` (``STIFFNESS``, ``SPACING``, ``DT``) of a submission's task module:
+    what its code uses where it ignores the argument of that name. None without a module,
+    or where the module has no such number."""
+    if task is None:
+        return None
+    try:
+        value = getattr(task, name)
+    except Exception:  # not there, or the submission's process failed: no such cause
+        return None
+    is_number = isinstance(value, (int, float, np.floating, np.integer))
+    return float(value) if is_number and not isinstance(value, bool) else None
 
 
 def spring_list_mistakes(
-    positions: np.ndarray, springs: np.ndarray, rest_lengths: np.ndarray | float, stiffness: float
+    positions: np.ndarray,
+    springs: np.ndarray,
+    rest_lengths: np.ndarray | float,
+    stiffness: float,
+    task: Any = None,
 ) -> dict[str, np.ndarray]:
-    """Accelerations (N, 3) that typical mistakes in a sum of spring forces give, by cause."""
+    """Accelerations (N, 3) that typical mistakes in a sum of spring forces give, by cause
+    (with the submission's ``task`` module, also its own STIFFNESS used for the argument)."""
     positions = np.asarray(positions, dtype=float)
     springs = np.asarray(springs, dtype=np.int64).reshape(-1, 2)
     rest = np.broadcast_to(np.asarray(rest_lengths, dtype=float), (len(springs),))
@@ -183,11 +199,12 @@ def spring_list_mistakes(
     unnormalised.stiffness[:] = stiffness * np.maximum(length, 1e-300)  # k|d| (l - |d|) d̂
     count = np.bincount(springs.ravel(), minlength=len(positions)).astype(float)
     mistakes = {}
-    if not np.isclose(stiffness, TEMPLATE_STIFFNESS):
+    constant = task_constant(task, "STIFFNESS")
+    if constant is not None and not np.isclose(stiffness, constant):
         mistakes[
-            f"the stiffness argument is ignored (k = {TEMPLATE_STIFFNESS} used instead of "
-            f"k = {stiffness:g})"
-        ] = right * TEMPLATE_STIFFNESS / stiffness
+            f"the stiffness argument is ignored (your STIFFNESS = {constant:g} used instead "
+            f"of k = {stiffness:g})"
+        ] = right * constant / stiffness
     mistakes |= {
         "-f_ij is never added to particle j: each spring acts on both of its ends": one_sided,
         "the force is not divided by the spring length: f_ij = k (l - |x_i - x_j|) times the "
@@ -207,8 +224,11 @@ def spring_list_mistakes(
     return mistakes
 
 
-def axis_spring_mistakes(x: np.ndarray, spacing: float, stiffness: float) -> dict[str, np.ndarray]:
-    """Accelerations (nx, ny, nz, 3) that typical mistakes in task 2 give, by cause."""
+def axis_spring_mistakes(
+    x: np.ndarray, spacing: float, stiffness: float, task: Any = None
+) -> dict[str, np.ndarray]:
+    """Accelerations (nx, ny, nz, 3) that typical mistakes in task 2 give, by cause (with the
+    submission's ``task`` module, also its own SPACING and STIFFNESS used for the arguments)."""
     shape = x.shape[:3]
     flat = np.asarray(x, dtype=float).reshape(-1, 3)
     body = grid_body(shape, spacing, stiffness)
@@ -238,17 +258,18 @@ def axis_spring_mistakes(x: np.ndarray, spacing: float, stiffness: float) -> dic
             "rest length 1 in world units: 'rest length 1' means one grid spacing, "
             f"l = spacing = {spacing:g}"
         ] = spring_acceleration(spring_body(flat, springs, 1.0, stiffness), flat).reshape(x.shape)
-    if not np.isclose(spacing, TEMPLATE_SPACING):
+    constant = task_constant(task, "SPACING")
+    if constant is not None and not np.isclose(spacing, constant):
         mistakes[
-            f"the spacing argument is ignored (rest length {TEMPLATE_SPACING} used instead of "
-            f"the spacing {spacing:g})"
-        ] = spring_acceleration(
-            spring_body(flat, springs, TEMPLATE_SPACING, stiffness), flat
-        ).reshape(x.shape)
+            f"the spacing argument is ignored (your SPACING = {constant:g} used as the rest "
+            f"length instead of the spacing {spacing:g})"
+        ] = spring_acceleration(spring_body(flat, springs, constant, stiffness), flat).reshape(
+            x.shape
+        )
     if along_z.any() and not along_z.all():
         mistakes["only two of the three axes have springs: loop over all three"] = (
             spring_acceleration(spring_body(flat, springs[~along_z], spacing, stiffness), flat)
         ).reshape(x.shape)
-    for cause, values in spring_list_mistakes(flat, springs, spacing, stiffness).items():
+    for cause, values in spring_list_mistakes(flat, springs, spacing, stiffness, task).items():
         mistakes.setdefault(cause, values.reshape(x.shape))
     return mistakes

@@ -362,7 +362,8 @@ def _judge_failure(status: int, printed: str) -> str:
     in its sandbox)."""
     lines = [line.strip() for line in printed.splitlines() if line.strip()]
     raised = [line.removeprefix("E").strip() for line in lines if line.startswith("E ")]
-    tail = " | ".join(dict.fromkeys(raised[-1:] + lines[-1:])) or "it printed nothing (see above)"
+    tail = " | ".join(dict.fromkeys(raised[-1:] + lines[-1:]))
+    tail = tail or "it printed nothing (an error before pytest started is on the grader's stderr)"
     if status in (0, 1):  # 1: some checks failed, which is a normal grade
         return f"the checks ended without a report: {tail}"
     return f"the checks could not run (pytest exit {status}): {tail}"

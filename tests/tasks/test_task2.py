@@ -45,14 +45,14 @@ def student_acceleration(task2, x, spacing, stiffness):
     return as_array(got, "spring_acceleration", x.shape)
 
 
-def compare_with_engine(got, x, spacing, stiffness, what):
+def compare_with_engine(task2, got, x, spacing, stiffness, what):
     """Fail with the worst particle and the typical mistake that explains the difference."""
     expected = expected_acceleration(x, spacing, stiffness)
     error = relative_error(got, expected)
     if error < 1e-9:
         return
     worst = np.unravel_index(np.argmax(np.linalg.norm(got - expected, axis=-1)), x.shape[:3])
-    mistake = matching_variant(got, oracles.axis_spring_mistakes(x, spacing, stiffness))
+    mistake = matching_variant(got, oracles.axis_spring_mistakes(x, spacing, stiffness, task2))
     expect(
         False,
         saw=f"{what}: the {grid_place(worst, x.shape[:3])} gets a = {vec(got[worst])}, eq. "
@@ -88,6 +88,7 @@ def test_grid_at_rest_feels_no_force(task2):
 def test_stretched_pulls_compressed_pushes(task2):
     """Two particles: a stretched spring pulls them together, a compressed one pushes apart."""
     k, h = STIFFNESS, SPACING
+    constant = oracles.task_constant(task2, "STIFFNESS")  # what ignoring the argument uses
     for factor, verb in ((1.5, "stretched"), (0.6, "compressed")):
         x = np.array([[[[0.0, 1.0, 0.0]]], [[[factor * h, 1.0, 0.0]]]])  # shape (2, 1, 1, 3)
         a = student_acceleration(task2, x, h, k)
@@ -99,13 +100,13 @@ def test_stretched_pulls_compressed_pushes(task2):
             saw=f"a spring {verb} to {factor}·h between particles at x = 0 and x = "
             f"{num(factor * h)} gives accelerations {vec(a[0, 0, 0])} and {vec(a[1, 0, 0])}; "
             f"expected {vec(expected)} and {vec(-expected)}",
-            cause=two_particle_cause(a[0, 0, 0], a[1, 0, 0], expected, factor * h),
+            cause=two_particle_cause(a[0, 0, 0], a[1, 0, 0], expected, factor * h, k, constant),
         )
 
 
-def two_particle_cause(first, second, expected, length):
+def two_particle_cause(first, second, expected, length, stiffness, constant):
     """The usual cause of wrong accelerations of two particles joined by one spring of
-    ``length``."""
+    ``length`` and ``stiffness`` (the submission's STIFFNESS is ``constant``)."""
     if np.allclose(first, -expected) and np.allclose(second, expected):
         return "the sign of (l - |x_i - x_j|) or of the direction x_i - x_j"
     if np.allclose(first, expected) or np.allclose(second, -expected):
@@ -114,12 +115,19 @@ def two_particle_cause(first, second, expected, length):
             "equal and opposite to f_ij on i)"
         )
     if np.allclose(first, -second) and first[0] * expected[0] > 0:
-        return size_cause(first[0] / expected[0], length)
+        return size_cause(first[0] / expected[0], length, stiffness, constant)
     return "the sign of (l - |x_i - x_j|), the rest length (one spacing h), or the stiffness"
 
 
-def size_cause(ratio, length):
-    """Why a spring force is ``ratio`` × eq. (1.2) for a spring of ``length``."""
+def size_cause(ratio, length, stiffness, constant):
+    """Why a spring force is ``ratio`` × eq. (1.2) for a spring of ``length`` and
+    ``stiffness`` (the submission's STIFFNESS is ``constant``)."""
+    ignored = constant is not None and not np.isclose(constant, stiffness)
+    if ignored and np.isclose(ratio, constant / stiffness):
+        return (
+            f"the stiffness argument is ignored (your STIFFNESS = {constant:g} used instead "
+            f"of k = {stiffness:g})"
+        )
     if np.isclose(ratio, 0.5):
         return (
             "half of each spring force: particle i gets all of f_ij and particle j all of "
@@ -144,7 +152,7 @@ def test_matches_equations_on_a_deformed_grid(task2):
     for shape in (SHAPE, (5, 2, 1), (1, 3, 2)):
         x = perturbed_grid(shape, SPACING, rng)
         got = student_acceleration(task2, x, SPACING, STIFFNESS)
-        compare_with_engine(got, x, SPACING, STIFFNESS, f"on a deformed {shape} grid")
+        compare_with_engine(task2, got, x, SPACING, STIFFNESS, f"on a deformed {shape} grid")
 
 
 @pytest.mark.points(2)
@@ -217,8 +225,10 @@ def test_energy_is_conserved_in_a_verlet_run(task2):
     start = energy(flat, v)
     a = acceleration(flat)
     expect_nontrivial(a, flat, "spring_acceleration on a deformed grid")
-    template_rest = expected_acceleration(x, SPACING, STIFFNESS).reshape(-1, 3)
-    ignored = relative_error(a, template_rest) < 1e-9
+    constant = oracles.task_constant(task2, "SPACING")  # what ignoring the argument uses
+    ignored = constant is not None and (
+        relative_error(a, expected_acceleration(x, constant, STIFFNESS).reshape(-1, 3)) < 1e-9
+    )
     for _ in range(steps):
         v_half = v + 0.5 * dt * a
         flat = flat + dt * v_half
@@ -231,8 +241,8 @@ def test_energy_is_conserved_in_a_verlet_run(task2):
         f"{steps} velocity-Verlet steps at "
         f"dt = {num(dt)} (the predicted stable limit is {num(limit)}); it should stay within "
         "2 %",
-        cause=f"the spacing argument is ignored: rest length {SPACING} (2/N) instead of the "
-        f"given spacing {spacing}"
+        cause=f"the spacing argument is ignored: your SPACING = {constant:g} is the rest "
+        f"length instead of the given spacing {spacing}"
         if ignored
         else "forces that are not the gradient of the spring energy: a wrong sign, a wrong "
         "rest length, or forces that are not equal and opposite",

@@ -73,7 +73,7 @@ def test_any_spring_list(task3, seed, n, e):
         saw=f"for {e} random springs between {n} particles the accelerations are off by "
         f"{num(relative_error(got, expected) if got.shape == x.shape else np.inf)} (relative)",
         cause=(
-            matching_variant(got, oracles.spring_list_mistakes(x, springs, rest, 0.7))
+            matching_variant(got, oracles.spring_list_mistakes(x, springs, rest, 0.7, task3))
             if got.shape == x.shape
             else None
         )

@@ -84,6 +84,16 @@ BUGS = [
         "verlet_step_is_the_kernel",
         "instead of the dt argument",
     ),
+    Variant(  # an adapted course: the template's dt changed
+        "verlet_step ignores dt, the template's dt changed",
+        1,
+        (
+            ("DT = 0.1  # time step", "DT = 0.05  # time step"),
+            (T1_VERLET, T1_VERLET.replace("dt**2", "DT**2")),
+        ),
+        "verlet_step_is_the_kernel",
+        "your DT = 0.05 instead of the dt argument",
+    ),
     bug(
         "verlet_step a dt",
         1,
@@ -271,6 +281,16 @@ BUGS += [
         T2_FORCE.replace("(spacing", "(SPACING"),
         "any_grid_size_spacing_and_stiffness",
         "spacing argument is ignored",
+    ),
+    Variant(  # an adapted course: the template's k changed, the checks' diagnosis follows it
+        "stiffness ignored, the template's k changed",
+        2,
+        (
+            ("STIFFNESS = 0.5  # k of every spring", "STIFFNESS = 0.8  # k of every spring"),
+            (T2_FORCE, T2_FORCE.replace("f = stiffness", "f = STIFFNESS")),
+        ),
+        "any_grid_size_spacing_and_stiffness",
+        "your STIFFNESS = 0.8 used instead",
     ),
     bug(
         "two axes only",
