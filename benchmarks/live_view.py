@@ -7,7 +7,7 @@ each case with `viz.show` in a fresh notebook and counts, over ``--seconds``:
 - frames: the page's requestAnimationFrame callbacks a second;
 - new pictures: frames showing positions that differ from the frame before (what the
   eye sees move), and the longest gap between two of them and the gaps over 50 ms;
-- updates: the states received from the kernel a second;
+- states shown (frames showing a new state) and received from the kernel, a second;
 - pace: the share of the asked steps the engine did (1.00: it keeps up);
 - Chromium's CPU time (psutil, which ipykernel installs).
 
@@ -73,6 +73,7 @@ return [s.drawDelays, s.engineDelays]; }"""
 # a page without new-picture counts (an older live.js) counts the pictures drawn
 COUNTS = """() => { const v = window.msdlabViews.at(-1), s = v.stats;
 return { frames: s.frames, pictures: s.pictures ?? s.drawn, updates: s.updates,
+  received: s.received ?? s.updates,
   times: s.pictureTimes ?? null, pace: Number(v.status.dataset.pace ?? NaN),
   now: performance.now() }; }"""
 BOOKS = """() => { const c = document.querySelector('.msdlab-energy');
@@ -99,7 +100,8 @@ def page_counts(page, seconds: float) -> dict:
     time.sleep(seconds)
     after, cpu = page.evaluate(COUNTS), browser_cpu() - cpu
     elapsed = (after["now"] - before["now"]) / 1000
-    rates = {k: (after[k] - before[k]) / elapsed for k in ("frames", "pictures", "updates")}
+    counted = ("frames", "pictures", "updates", "received")
+    rates = {k: (after[k] - before[k]) / elapsed for k in counted}
     gaps = None
     if after["times"] is not None:
         times = np.array([t for t in after["times"] if t >= before["now"]])
@@ -182,7 +184,8 @@ def run_case(browser, url: str, token: str, tmp: Path, key: str, seconds: float)
     print(
         f"{label}: {counts['frames']:.1f} frames/s ({counts['frames'] / ceiling:.0%} of an "
         f"empty page's {ceiling:.1f}), {counts['pictures']:.1f} new pictures/s, "
-        f"{counts['updates']:.1f} updates/s; {gaps}pace {counts['pace']:.2f}; "
+        f"{counts['updates']:.1f} states shown/s of {counts['received']:.1f} received; "
+        f"{gaps}pace {counts['pace']:.2f}; "
         f"Chromium's CPU {counts['cpu']:.0f} ms/s; load {load:.1f}",
         flush=True,
     )
