@@ -215,7 +215,7 @@ def main() -> None:
     options = ["--ServerApp.kernel_websocket_connection_class=" + NODELAY] if args.nodelay else []
     with TemporaryDirectory() as folder, sync_playwright() as playwright:
         tmp = Path(folder)
-        with jupyterlab_server(tmp, options) as (url, token):
+        with jupyterlab_server(tmp, options=options) as (url, token):
             browser = launch(playwright)
             for key in args.cases.split(","):
                 run_case(browser, url, token, tmp, key, args.seconds)
