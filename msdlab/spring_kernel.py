@@ -110,6 +110,18 @@ def checked_kernel_name(name: str, what: str) -> str:
     return name
 
 
+def compiling_first() -> bool:
+    """Whether a run on the default kernel starts by compiling the numba kernel's loops
+    (a first run on a machine: `msdlab.compiled.loops_cached` is False)."""
+    if default_kernel() != "numba":
+        return False
+    try:
+        from .compiled import loops_cached
+    except ImportError:  # `make_kernel` warns and runs on numpy
+        return False
+    return loops_cached() is False
+
+
 def make_kernel(name: str | None = None) -> SpringKernel:
     """The kernel called ``name`` ("numba" or "numpy"; default `default_kernel()`).
 

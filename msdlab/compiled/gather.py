@@ -264,10 +264,11 @@ def gather_serial(x, v, shape, triples, rows_of, o2s, values, columns, rows, scr
     pad = (scratch.shape[1] - len(x)) // 2
     damped = np.any(values[:, :, 2] != 0.0)
     scratch[6:, :] = 0.0
-    for q in range(x.shape[1]):
-        scratch[q, pad : pad + len(x)] = x[:, q]
-        if damped:
-            scratch[3 + q, pad : pad + len(x)] = v[:, q]
+    for p in range(len(x)):  # loops, not slices: numba compiles them much faster
+        for q in range(x.shape[1]):
+            scratch[q, p + pad] = x[p, q]
+            if damped:
+                scratch[3 + q, p + pad] = v[p, q]
     units = shape[0] if shape[0] > 1 else (shape[1] + rows - 1) // rows
     squares = np.zeros(units)
     powers = np.zeros(units)
@@ -276,8 +277,9 @@ def gather_serial(x, v, shape, triples, rows_of, o2s, values, columns, rows, scr
             squares[unit], powers[unit] = _push_unit(
                 scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, unit
             )
-    for q in range(x.shape[1] if add else 0):
-        out[:, q] += scratch[6 + q, pad : pad + len(x)]
+    for p in range(len(x) if add else 0):
+        for q in range(x.shape[1]):
+            out[p, q] += scratch[6 + q, p + pad]
     return _totals(squares, powers)
 
 
