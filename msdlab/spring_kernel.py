@@ -11,6 +11,7 @@ only the methods of `SpringKernel`; it never knows which backend runs:
 from __future__ import annotations
 
 import os
+import sys
 import warnings
 from collections.abc import Callable
 from typing import Protocol
@@ -94,13 +95,17 @@ class SpringKernel(Protocol):
 
 
 def default_kernel() -> str:
-    """The spring kernel to use: ``MSDLAB_KERNEL`` if set, else "numba".
+    """The spring kernel to use: ``MSDLAB_KERNEL`` if set; else "numpy" while a debugger
+    traces the program (`sys.gettrace`), so its breakpoints in `msdlab.equations` and in
+    an integrator's update stop; else "numba".
 
     "numba" is the compiled loop of `msdlab.compiled`; "numpy" is the readable
     array version of `msdlab.kernels`. Both apply the same `msdlab.equations`.
     """
     name = os.environ.get("MSDLAB_KERNEL", "").strip().lower()
-    return checked_kernel_name(name, "MSDLAB_KERNEL") if name else "numba"
+    if name:
+        return checked_kernel_name(name, "MSDLAB_KERNEL")
+    return "numpy" if sys.gettrace() is not None else "numba"
 
 
 def checked_kernel_name(name: str, what: str) -> str:
