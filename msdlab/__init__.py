@@ -5,6 +5,10 @@ body = msd.Body.grid((10, 10, 10), spacing=0.1, stiffness=5000.0, neighbours=(1,
 sim = msd.Simulation(body, msd.Verlet(damping=0.01), dt=1e-3,
                      forces=[msd.Gravity((0, -9.81, 0)), msd.Ground(height=0.0)])
 trajectory = sim.run(duration=1.0, record_every=10)
+
+Debugging: under a debugger, or with ``MSDLAB_KERNEL=numpy`` set, the step runs on the
+readable numpy kernel, so a breakpoint in ``msdlab.equations`` (``spring_force``) or in an
+integrator's update (``verlet_update``) stops there.
 """
 
 from .analysis import (

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Sequence
+from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
@@ -12,6 +14,15 @@ from .body import Body
 from .forces import Force
 from .jacobian import JacobianPattern
 from .spring_kernel import SpringKernel, Update, make_kernel
+
+
+class SpringPass(NamedTuple):
+    """The dashpot power (W) a pass over all springs summed with their forces, and the
+    state (x, v) it read, referred to weakly."""
+
+    x: weakref.ref
+    v: weakref.ref
+    power: float
 
 
 class Dynamics:
@@ -32,6 +43,7 @@ class Dynamics:
         self.forces = list(forces)
         self.springs: SpringKernel = make_kernel(kernel)
         self.max_stretch = 0.0  # largest |d|/l seen in the last force evaluation
+        self._last_pass: SpringPass | None = None  # of the last force evaluation
         self._pattern: JacobianPattern | None = None
         self._buffer = np.zeros((0, 0))  # scratch forces of `advance` and `acceleration`
 
@@ -65,7 +77,9 @@ class Dynamics:
     ) -> None:
         """Add the spring, dashpot and external forces at (x, v) to ``total``, but those
         of the forces whose `Force.uniform_acceleration` is given in ``fields`` (not None)."""
-        self.max_stretch, _ = self.springs.add_spring_forces(self.body, x, v, total, None)
+        stretch, power = self.springs.add_spring_forces(self.body, x, v, total, None)
+        self.max_stretch = stretch
+        self._last_pass = SpringPass(weakref.ref(x), weakref.ref(v), power)
         for i, force in enumerate(self.forces):
             if fields is None or fields[i] is None:
                 force.add_to(self.body, x, v, total)
@@ -84,7 +98,9 @@ class Dynamics:
             field += g
         if self._buffer.shape != x.shape:
             self._buffer = np.empty_like(x)
-        a, self.max_stretch, _ = self.springs.acceleration(self.body, x, v, self._buffer, field)
+        a, stretch, power = self.springs.acceleration(self.body, x, v, self._buffer, field)
+        self.max_stretch = stretch
+        self._last_pass = SpringPass(weakref.ref(x), weakref.ref(v), power)
         return a
 
     def advance(
@@ -109,13 +125,27 @@ class Dynamics:
             uniform = uniform and g is not None
             field += 0.0 if g is None else g
         if uniform:  # the springs' forces only: the kernel sums them
-            x_new, v_new, self.max_stretch, _ = self.springs.advance_with_springs(
+            x_new, v_new, stretch, power = self.springs.advance_with_springs(
                 update, self.body, x, v, self._buffer, field, dt, coefficients
             )
+            self.max_stretch = stretch
+            self._last_pass = SpringPass(weakref.ref(x), weakref.ref(v), power)
             return x_new, v_new
         self._buffer.fill(0.0)
         self._add_forces(x, v, self._buffer, fields)
         return self.springs.advance(update, self.body, x, v, self._buffer, field, dt, coefficients)
+
+    def dashpot_power(self, x: np.ndarray, v: np.ndarray) -> float:
+        """Power (W) the dashpots take out at (x, v), Σ c ((v_a - v_b)·n)², always >= 0.
+
+        When the last pass over the springs read these very arrays (the integrator's
+        at the start of a step), it is the power that pass summed with the forces;
+        otherwise the kernel sums it.
+        """
+        last = self._last_pass
+        if last is not None and last.x() is x and last.v() is v:
+            return last.power
+        return self.springs.dashpot_power(self.body, x, v)
 
     def acceleration_of(
         self,

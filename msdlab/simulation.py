@@ -191,8 +191,10 @@ class Simulation:
             damping = 0.0
         else:  # Integrator.dissipated_energy's work of the velocity factor, summed by the kernel
             damping = kernel.damping_work(body.masses, v, v_new, factor)
-        booked = {"dashpot": kernel.dashpot_power(body, x, v) * dt, "integrator": damping}
+        booked = {"dashpot": self.dynamics.dashpot_power(x, v) * dt, "integrator": damping}
         for force in self.dynamics.forces:
+            if type(force).dissipated_power is Force.dissipated_power:
+                continue  # a conservative force: nothing to book
             lost = force.dissipated_power(body, x, v)
             if lost:
                 booked[force.ledger_name] = booked.get(force.ledger_name, 0.0) + lost * dt

@@ -11,6 +11,7 @@ only the methods of `SpringKernel`; it never knows which backend runs:
 from __future__ import annotations
 
 import os
+import sys
 import warnings
 from collections.abc import Callable
 from typing import Protocol
@@ -94,13 +95,17 @@ class SpringKernel(Protocol):
 
 
 def default_kernel() -> str:
-    """The spring kernel to use: ``MSDLAB_KERNEL`` if set, else "numba".
+    """The spring kernel to use: ``MSDLAB_KERNEL`` if set; else "numpy" while a debugger
+    traces the program (`sys.gettrace`), so its breakpoints in `msdlab.equations` and in
+    an integrator's update stop; else "numba".
 
     "numba" is the compiled loop of `msdlab.compiled`; "numpy" is the readable
     array version of `msdlab.kernels`. Both apply the same `msdlab.equations`.
     """
     name = os.environ.get("MSDLAB_KERNEL", "").strip().lower()
-    return checked_kernel_name(name, "MSDLAB_KERNEL") if name else "numba"
+    if name:
+        return checked_kernel_name(name, "MSDLAB_KERNEL")
+    return "numpy" if sys.gettrace() is not None else "numba"
 
 
 def checked_kernel_name(name: str, what: str) -> str:
@@ -108,6 +113,18 @@ def checked_kernel_name(name: str, what: str) -> str:
     if name not in KERNELS:
         raise ValueError(f"{what} must be one of {', '.join(KERNELS)}, got {name!r}")
     return name
+
+
+def compiling_first() -> bool:
+    """Whether a run on the default kernel starts by compiling the numba kernel's loops
+    (a first run on a machine: `msdlab.compiled.loops_cached` is False)."""
+    if default_kernel() != "numba":
+        return False
+    try:
+        from .compiled import loops_cached
+    except ImportError:  # `make_kernel` warns and runs on numpy
+        return False
+    return loops_cached() is False
 
 
 def make_kernel(name: str | None = None) -> SpringKernel:

@@ -24,5 +24,17 @@ threads with ``NUMBA_NUM_THREADS`` or `numba.set_num_threads`.
 """
 
 from .kernel import NumbaKernel
+from .reductions import finite
 
-__all__ = ["NumbaKernel"]
+
+def loops_cached() -> bool | None:
+    """Whether numba's disk cache holds this version's compiled loops: False on the first
+    run on a machine (or after an upgrade, or with an empty ``NUMBA_CACHE_DIR``), None if
+    numba's cache cannot be read (its layout is numba's own)."""
+    try:
+        return bool(finite._cache._cache_file._load_index())  # empty: missing or stale
+    except (AttributeError, OSError):
+        return None
+
+
+__all__ = ["NumbaKernel", "loops_cached"]

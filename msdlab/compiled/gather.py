@@ -249,15 +249,26 @@ def _push_unit(scratch, pad, columns, shape, rows, triples, rows_of, o2s, values
 
 
 @numba.njit(cache=True, error_model="numpy")
+def _totals(squares, powers):
+    """The largest stretch |d|/l from the units' largest squared ones, and the units'
+    dashpot powers (W) added in order: the same on one thread or several."""
+    power = 0.0
+    for unit in range(len(powers)):
+        power += powers[unit]
+    return math.sqrt(squares.max()), power
+
+
+@numba.njit(cache=True, error_model="numpy")
 def gather_serial(x, v, shape, triples, rows_of, o2s, values, columns, rows, scratch, out, add):
     """One thread: `gather_parallel`'s work in the same order, so the same sums."""
     pad = (scratch.shape[1] - len(x)) // 2
     damped = np.any(values[:, :, 2] != 0.0)
     scratch[6:, :] = 0.0
-    for q in range(x.shape[1]):
-        scratch[q, pad : pad + len(x)] = x[:, q]
-        if damped:
-            scratch[3 + q, pad : pad + len(x)] = v[:, q]
+    for p in range(len(x)):  # loops, not slices: numba compiles them much faster
+        for q in range(x.shape[1]):
+            scratch[q, p + pad] = x[p, q]
+            if damped:
+                scratch[3 + q, p + pad] = v[p, q]
     units = shape[0] if shape[0] > 1 else (shape[1] + rows - 1) // rows
     squares = np.zeros(units)
     powers = np.zeros(units)
@@ -266,17 +277,19 @@ def gather_serial(x, v, shape, triples, rows_of, o2s, values, columns, rows, scr
             squares[unit], powers[unit] = _push_unit(
                 scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, unit
             )
-    for q in range(x.shape[1] if add else 0):
-        out[:, q] += scratch[6 + q, pad : pad + len(x)]
-    return squares, powers
+    for p in range(len(x) if add else 0):
+        for q in range(x.shape[1]):
+            out[p, q] += scratch[6 + q, p + pad]
+    return _totals(squares, powers)
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
 def gather_parallel(x, v, shape, triples, rows_of, o2s, values, columns, rows, scratch, out, add):
     """Add to ``out`` (N, d) the forces of a grid body's springs, each computed once, from
-    the particle behind (`_push_unit`); return each unit's largest squared stretch
-    |d|²/l² and dashpot power (W). Without ``add`` the forces stay in ``scratch``
-    (rows 6 to 8) for the caller to add in a loop of its own (see `advance.compile_advance`).
+    the particle behind (`_push_unit`); return the largest stretch |d|/l and the dashpot
+    power (W), summed over the units in order. Without ``add`` the forces stay in
+    ``scratch`` (rows 6 to 8) for the caller to add in a loop of its own (see
+    `advance.compile_advance`).
 
     The threads push every third unit at once, in three rounds, so no two
     write the same particle.
@@ -301,4 +314,4 @@ def gather_parallel(x, v, shape, triples, rows_of, o2s, values, columns, rows, s
     for p in numba.prange(len(x) if add else 0):
         for q in range(x.shape[1]):
             out[p, q] += scratch[6 + q, p + pad]
-    return squares, powers
+    return _totals(squares, powers)

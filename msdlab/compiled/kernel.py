@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import warnings
 from collections.abc import Callable
 from typing import TYPE_CHECKING
@@ -136,16 +135,15 @@ class NumbaKernel:
                 self.grid_stencil(body)
             stencil = self._stencil if self._uniform else None
             if stencil is not None:
-                self._threads = numba.get_num_threads()
-                threads = stencil.starts[-1] >= PARALLEL_MIN_GATHERED and self._threads > 1
+                big = stencil.starts[-1] >= PARALLEL_MIN_GATHERED
+                threads = big and numba.get_num_threads() > 1  # asked only when it matters
                 gather = gather_parallel if threads else gather_serial
                 if self._scratch.shape != (10, len(x) + 2 * self._pad):
                     self._scratch = np.zeros((10, len(x) + 2 * self._pad))  # 2-D: x2 = v2 = 0
                 triples, _, o2s, rows_of = self._triples
                 columns, rows = self._columns
                 layout = (stencil.shape, triples, rows_of, o2s, self._triple_values, columns, rows)
-                squares, powers = gather(x, v, *layout, self._scratch, out, reduce)
-                stretch, power = math.sqrt(squares.max()), float(powers.sum())  # any threads
+                stretch, power = gather(x, v, *layout, self._scratch, out, reduce)
                 if reduce:
                     return stretch, power, (out, none)
                 by_coordinate = self._scratch[6 : 6 + x.shape[1], self._pad : self._pad + len(x)]
@@ -202,9 +200,11 @@ class NumbaKernel:
     def _parallel(self, body: Body, least: int | None = None) -> bool:
         """Whether the springs of ``body`` are worth splitting between threads: at least
         ``least`` of them (default `PARALLEL_MIN_SPRINGS`)."""
-        self._threads = numba.get_num_threads()
         least = PARALLEL_MIN_SPRINGS if least is None else least
-        return body.n_springs >= least and self._threads > 1
+        if body.n_springs < least:
+            return False
+        self._threads = numba.get_num_threads()
+        return self._threads > 1
 
     def _grid_sum(self, body: Body, x: np.ndarray, v: np.ndarray, power: bool) -> float | None:
         """The springs' energy (J), or with ``power`` their dashpot power (W), summed by offset

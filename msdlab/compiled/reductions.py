@@ -46,20 +46,33 @@ def _kick_dots(masses, v_before, v_after, block):
     return total
 
 
-@numba.njit(cache=True, parallel=True)
 def damping_work(masses, v_before, v_after, factor):
     """`equations.damping_work`: (1 - factor)·½ Σ m v_before·(v_before + v_after) (J).
 
     Summed by blocks of `BLOCK` particles, on the threads for a big state
     (`PARALLEL_MIN_PARTICLES`), then over the blocks in order: the same sum either way.
+    A small state never compiles the threaded loop.
     """
+    big = len(masses) >= PARALLEL_MIN_PARTICLES
+    work = damping_work_parallel if big else damping_work_serial
+    return work(masses, v_before, v_after, factor)
+
+
+@numba.njit(cache=True)
+def damping_work_serial(masses, v_before, v_after, factor):
+    """`damping_work` on one thread, the blocks one after the other."""
+    total = 0.0
+    for block in range((len(masses) + BLOCK - 1) // BLOCK):
+        total += _kick_dots(masses, v_before, v_after, block)
+    return (1.0 - factor) * (0.5 * total)
+
+
+@numba.njit(cache=True, parallel=True)
+def damping_work_parallel(masses, v_before, v_after, factor):
+    """`damping_work` with the blocks shared between the threads, then added in order."""
     sums = np.empty((len(masses) + BLOCK - 1) // BLOCK)
-    if len(masses) < PARALLEL_MIN_PARTICLES:
-        for block in range(len(sums)):
-            sums[block] = _kick_dots(masses, v_before, v_after, block)
-    else:
-        for block in numba.prange(len(sums)):
-            sums[block] = _kick_dots(masses, v_before, v_after, block)
+    for block in numba.prange(len(sums)):
+        sums[block] = _kick_dots(masses, v_before, v_after, block)
     total = 0.0
     for block in range(len(sums)):
         total += sums[block]

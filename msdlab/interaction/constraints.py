@@ -100,17 +100,20 @@ class Ground(Constraint):
         if len(below) == 0:
             return 0.0
         x = state.x.take(below, axis=0)
-        x = x + (self.height - heights[below])[:, None] * n  # depth > 0 along n
-        v = state.v.take(below, axis=0)
+        x += (self.height - heights[below])[:, None] * n  # depth > 0 along n
         state.x[below] = x
-        landing = v @ n
+        v = state.v.take(below, axis=0)
+        landing = v @ n  # the normal velocity the step ended with (m/s)
         normal_speed = (x - state.x_old.take(below, axis=0)) @ n / state.dt
         tangential = v - landing[:, None] * n
-        state.v[below] = (1.0 - self.friction) * tangential + normal_speed[:, None] * n
+        kept = (1.0 - self.friction) * tangential if self.friction else tangential
+        state.v[below] = kept + normal_speed[:, None] * n
+        # the ledger, along the normal: the kick normal_speed - landing at the mean velocity
         masses = state.body.masses.take(below)
-        kick = (normal_speed - landing)[:, None] * n
-        normal_before = (state.v_old.take(below, axis=0) @ n)[:, None] * n
-        work = energy.contact_work(masses, kick, normal_before, normal_speed[:, None] * n)
+        before = state.v_old.take(below, axis=0) @ n
+        work = energy.contact_work(
+            masses, (normal_speed - landing)[:, None], before[:, None], normal_speed[:, None]
+        )
         rubbed = (
             energy.kinetic_energy_removed(masses, tangential, 1.0 - self.friction)
             if self.friction

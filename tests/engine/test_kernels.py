@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 import warnings
 
 import numpy as np
@@ -190,6 +191,34 @@ def test_kernel_choice(monkeypatch: pytest.MonkeyPatch) -> None:
         spring_kernel.default_kernel()
     with pytest.raises(ValueError, match="kernel must be one of"):
         msd.Simulation(body, kernel="cuda")
+
+
+def test_under_a_debugger_the_step_runs_the_readable_equations(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A tracer (what a debugger installs) picks the numpy kernel, whose step calls
+    `equations.spring_force` where a breakpoint stops; ``MSDLAB_KERNEL`` still wins."""
+    monkeypatch.delenv("MSDLAB_KERNEL")
+    stopped = []
+
+    def tracer(frame, event: str, argument: object):
+        if event == "call" and frame.f_code is msd.equations.spring_force.__code__:
+            stopped.append(frame.f_code.co_name)
+
+    sys.settrace(tracer)
+    try:
+        sim = msd.Simulation(deformed_body(2), msd.Verlet())
+        sim.step()
+    finally:
+        sys.settrace(None)
+    assert sim.dynamics.kernel == "numpy"
+    assert "spring_force" in stopped
+    monkeypatch.setenv("MSDLAB_KERNEL", "numba")
+    sys.settrace(tracer)
+    try:
+        assert msd.Simulation(deformed_body(2)).dynamics.kernel == "numba"
+    finally:
+        sys.settrace(None)
 
 
 def test_kernel_follows_topology_and_parameter_changes() -> None:

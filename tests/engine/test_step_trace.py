@@ -1,10 +1,15 @@
 """A student with a debugger who steps into `sim.step()` reads physics: one warm step of the
-README's jelly cube enters at most 20 distinct msdlab functions, on either kernel."""
+README's jelly cube enters at most 20 distinct msdlab functions, on either kernel; and the
+springs are walked once a step: the energy ledger takes the dashpots' power from the pass
+that summed their forces."""
 
 from __future__ import annotations
 
 import sys
 from pathlib import Path
+
+import numpy as np
+import pytest
 
 import msdlab as msd
 
@@ -49,3 +54,39 @@ def test_a_step_of_the_jelly_cube_enters_few_functions(kernel: str) -> None:
     print(f"{len(entered)} functions entered by one step ({kernel} kernel):", *entered, sep="\n  ")
     assert "simulation.Simulation.step" in entered
     assert len(entered) <= MOST, f"{len(entered)} functions: {entered}"
+
+
+def damped_cloth() -> msd.Body:
+    """A 12×12 cloth of stretch and shear springs with dashpots, two corners pinned."""
+    n, spacing = 12, 0.05
+    ij = np.stack(np.meshgrid(np.arange(n), np.arange(n), indexing="ij"), -1).reshape(-1, 2)
+    index = ij[:, 0] * n + ij[:, 1]
+    pairs = []
+    for di, dj in ((1, 0), (0, 1), (1, 1), (1, -1)):
+        inside = (ij[:, 0] + di < n) & (ij[:, 1] + dj >= 0) & (ij[:, 1] + dj < n)
+        pairs.append(np.column_stack([index[inside], index[inside] + di * n + dj]))
+    positions = np.column_stack([ij * spacing, np.zeros(len(ij))])
+    fixed = (ij[:, 1] == n - 1) & ((ij[:, 0] == 0) | (ij[:, 0] == n - 1))
+    body = msd.Body.from_arrays(
+        positions, np.vstack(pairs), masses=0.01, fixed=fixed, stiffness=200.0, damping=0.02
+    )
+    body.velocities[:] = np.random.default_rng(3).normal(0.0, 0.1, body.velocities.shape)
+    return body
+
+
+def test_the_ledger_books_the_dashpots_from_the_pass_over_the_springs(kernel: str) -> None:
+    body = damped_cloth()
+    sim = msd.Simulation(
+        body, msd.SymplecticEuler(), dt=1e-3, forces=[msd.Gravity((0, 0, -9.81))], kernel=kernel
+    )
+    sim.run(steps=3)
+    x, v = body.positions.copy(), body.velocities.copy()
+    before = sim.dissipated["dashpot"]
+    entered = functions_entered(sim)
+    print(f"one step of a damped cloth ({kernel} kernel):", *entered, sep="\n  ")
+    kernels = ("kernels.", "compiled.")  # their own walks; `equations.dashpot_power` is a formula
+    walks = [name for name in entered if name.startswith(kernels) and "dashpot_power" in name]
+    assert walks == [], f"the step walked the springs again for the dashpots: {walks}"
+    expected = sim.dynamics.springs.dashpot_power(body, x, v) * sim.dt  # a walk of its own
+    assert sim.dissipated["dashpot"] - before == pytest.approx(expected, rel=1e-12)
+    assert expected > 0.0
