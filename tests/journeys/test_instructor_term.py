@@ -1,11 +1,13 @@
-"""An instructor's term: a class with a late, an extended and an overridden submission,
-graded with a due date, kept through --resume and a one-student regrade, exported to
-Canvas and read back as Canvas reads a gradebook import; every command as typed in the
-instructor's folder (the `shell` of the journey tests)."""
+"""An instructor's term: a class with a late, an extended, a copied and an overridden
+submission, graded with a due date and the similarity report, kept through --resume and
+a one-student regrade, exported to Canvas and read back as Canvas reads a gradebook
+import; every command as typed in the instructor's folder (the `shell` of the journey
+tests)."""
 
 from __future__ import annotations
 
 import csv
+import importlib.util
 import os
 import shutil
 from datetime import datetime, timezone
@@ -16,6 +18,7 @@ from msdlab.instructor import sandbox
 
 SOLUTIONS = PROJECT_ROOT / "solutions"
 CHECKS = PROJECT_ROOT / "tests" / "tasks"
+COPIES = PROJECT_ROOT / "tests" / "course" / "similarity" / "copies.py"
 WRONG_COUNT = """
 def particle_count(n: int = N) -> int:
     return n * n  # wrong on purpose
@@ -27,15 +30,31 @@ HANDED_IN = {  # UTC; due 2027-03-01 23:59 in Berlin is 22:59 UTC
     "bob": datetime(2027, 3, 2, 23, 30, tzinfo=timezone.utc),  # 24 h 31 min late: 2 days
     "carol": datetime(2027, 3, 3, 12, 0, tzinfo=timezone.utc),  # late, but extended
     "dave": datetime(2027, 3, 1, 21, 0, tzinfo=timezone.utc),
+    "erin": datetime(2027, 3, 1, 22, 0, tzinfo=timezone.utc),  # bob's work, names changed
 }
 
 
+def planted_copies():
+    """The similarity tests' planted class: honest answers and disguised copies."""
+    spec = importlib.util.spec_from_file_location("msdlab_journey_copies", COPIES)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 def handed_in_class(root: Path) -> list[Path]:
+    """Alice, carol and dave hand in the reference answer (dave with a bug), bob an answer
+    of his own (loops), erin bob's with its variables renamed."""
+    copies = planted_copies()
+    own = copies.answered(1, PROJECT_ROOT / "tests" / "course" / "alternatives")
     folders = []
     for student, moment in HANDED_IN.items():
         folder = root / "class" / student / "assignments"
         folder.mkdir(parents=True)
         shutil.copy(SOLUTIONS / "task1.py", folder)
+        if student in ("bob", "erin"):
+            answer = own if student == "bob" else copies.renamed(own)
+            (folder / "task1.py").write_text(answer, encoding="utf-8")
         if student == "dave":
             (folder / "task1.py").write_text((folder / "task1.py").read_text() + WRONG_COUNT)
         os.utime(folder / "task1.py", (moment.timestamp(), moment.timestamp()))
@@ -88,9 +107,16 @@ def test_late_extended_and_overridden_work_lasts_and_reaches_canvas(tmp_path, sh
         " --due 2027-03-01T23:59 --timezone Europe/Berlin"
         " --late-policy grace=15m,penalty=10%/day,cap=50% --extensions extensions.csv" + ISOLATION
     )
-    done = shell("msdlab grade class/*/assignments" + common, tmp_path)
+    done = shell("msdlab grade class/*/assignments --similarity" + common, tmp_path)
     assert done.returncode == 0 and "manual changes: 1 from" in done.stdout, done.stdout
     rows = read_rows(out)
+    flagged = {
+        frozenset((row["first"], row["second"])): row["flagged"]
+        for row in csv.DictReader((tmp_path / "similarity" / "similarity.csv").open())
+    }
+    assert flagged[frozenset(("bob", "erin"))] == "yes"  # the copy, names changed
+    assert flagged[frozenset(("alice", "bob"))] == "no"  # two honest answers
+    assert rows["erin"]["total"] == rows["bob"]["points"]  # flagged, not docked
     full = rows["(max points)"]["task1"]
     assert rows["alice"]["total"] == full and rows["alice"]["late_penalty"] == ""
     assert rows["bob"]["late_penalty"] == str(2 * int(full) / 10).removesuffix(".0")
@@ -109,13 +135,13 @@ def test_late_extended_and_overridden_work_lasts_and_reaches_canvas(tmp_path, sh
     with (tmp_path / "grades.adjustments.csv").open("a") as handle:
         handle.write("alice,,+2,best report of the class\n")
     done = shell("msdlab grade class/*/assignments --resume" + common, tmp_path)
-    assert done.returncode == 0 and "4 unchanged since graded, skipped" in done.stdout
+    assert done.returncode == 0 and "5 unchanged since graded, skipped" in done.stdout
     rows = read_rows(out)
     assert float(rows["alice"]["total"]) == int(full) + 2 and rows["dave"]["total"] == full
     assert "best report of the class" in (notes / "students" / "alice.md").read_text()
 
     # regrading one student keeps his override and everyone else's row
-    dave = folders[3]
+    dave = folders[list(HANDED_IN).index("dave")]
     os.utime(dave / "task1.py", (HANDED_IN["dave"].timestamp(),) * 2)
     assert shell("msdlab grade class/dave/assignments" + common, tmp_path).returncode == 0
     again = read_rows(out)
