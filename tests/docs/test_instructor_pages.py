@@ -22,8 +22,10 @@ def blocks(page: Path, language: str) -> list[str]:
 
 
 def msdlab_commands(page: Path) -> list[str]:
-    """The ``msdlab ...`` lines of a page's bash blocks, without their comments."""
-    lines = [line for block in blocks(page, "bash") for line in block.splitlines()]
+    """The ``msdlab ...`` commands of a page's bash blocks (a line ending in ``\\`` goes on
+    in the next), without their comments."""
+    joined = (block.replace("\\\n", " ") for block in blocks(page, "bash"))
+    lines = [line for block in joined for line in block.splitlines()]
     return [line.split("  #")[0].strip() for line in lines if line.startswith("msdlab ")]
 
 
