@@ -27,10 +27,17 @@ def screen(point):
     return [widget.winfo_rootx() + x, widget.winfo_rooty() + widget.winfo_height() - y]
 
 
+def publish(name: str, value: dict) -> None:
+    """Write ``value`` to ``work/name`` whole: the test reads it as soon as it appears."""
+    partial = work / (name + ".part")
+    partial.write_text(json.dumps(value))
+    partial.replace(work / name)
+
+
 def aim():
     start = dragger.sim.body.positions[PARTICLE]
     aims = {"press": screen(start), "release": screen(start + PULL), "start": start.tolist()}
-    (work / "aim.json").write_text(json.dumps(aims))
+    publish("aim.json", aims)
 
 
 def poll():
@@ -41,7 +48,7 @@ def poll():
             "position": dragger.sim.body.positions[PARTICLE].tolist(),
             "on_screen": screen(dragger.sim.body.positions[PARTICLE]),
         }
-        (work / "result.json").write_text(json.dumps(result))
+        publish("result.json", result)
         plt.close("all")
 
 
