@@ -5,7 +5,6 @@ the default, the checks and the release are those of the template."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import shutil
 import subprocess
@@ -13,6 +12,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from modules import module_at
 
 from msdlab.course import PROJECT_ROOT, oracles, own_numbers
 from msdlab.course.report import CheckReport
@@ -56,11 +56,7 @@ def test_two_students_get_different_numbers_from_their_ids():
 
 def test_the_defaults_are_the_templates_numbers():
     """Off (no student): the checks use exactly the numbers they always used."""
-    spec = importlib.util.spec_from_file_location(
-        "template_task1", PROJECT_ROOT / "assignments" / "task1.py"
-    )
-    template = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(template)
+    template = module_at(PROJECT_ROOT / "assignments" / "task1.py", "template_task1")
     default = own_numbers.numbers(None)
     assert default.bottom == template.ORIGIN[1] and default.gravity == template.GRAVITY[1]
     assert default.gravity == oracles.TEMPLATE_GRAVITY[1] and default.cost_size == 6

@@ -13,13 +13,13 @@ changes.
 
 from __future__ import annotations
 
-import importlib.util
 import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from modules import module_at
 
 from msdlab.course import PROJECT_ROOT, TASKS, delegation
 from msdlab.course.report import CheckReport
@@ -30,12 +30,7 @@ SOLUTIONS = PROJECT_ROOT / "solutions"
 
 
 def _variants():
-    path = Path(__file__).parent / "planted" / "variants.py"
-    spec = importlib.util.spec_from_file_location("msdlab_planted_variants", path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
+    return module_at(Path(__file__).parent / "planted" / "variants.py", "msdlab_planted_variants")
 
 
 VARIANTS = _variants()

@@ -9,10 +9,10 @@ import csv
 import importlib.util
 import itertools
 import shutil
-import sys
 from pathlib import Path
 
 import pytest
+from modules import module_at
 
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT, TASKS
@@ -20,12 +20,7 @@ from msdlab.course import PROJECT_ROOT, TASKS
 
 def _copies():
     """The planted class's module, beside this file."""
-    path = Path(__file__).parent / "similarity" / "copies.py"
-    spec = importlib.util.spec_from_file_location("msdlab_planted_copies", path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
+    return module_at(Path(__file__).parent / "similarity" / "copies.py", "msdlab_planted_copies")
 
 
 copies = _copies()

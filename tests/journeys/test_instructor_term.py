@@ -7,11 +7,12 @@ tests)."""
 from __future__ import annotations
 
 import csv
-import importlib.util
 import os
 import shutil
 from datetime import datetime, timezone
 from pathlib import Path
+
+from modules import module_at
 
 from msdlab.course import PROJECT_ROOT
 from msdlab.instructor import sandbox
@@ -36,10 +37,7 @@ HANDED_IN = {  # UTC; due 2027-03-01 23:59 in Berlin is 22:59 UTC
 
 def planted_copies():
     """The similarity tests' planted class: honest answers and disguised copies."""
-    spec = importlib.util.spec_from_file_location("msdlab_journey_copies", COPIES)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return module_at(COPIES, "msdlab_planted_copies")
 
 
 def handed_in_class(root: Path) -> list[Path]:
