@@ -1,12 +1,13 @@
 """Walking a person's path through msdlab: a fresh virtual environment, commands typed at a
 shell, what they print.
 
-The journey tests (test_student.py, test_instructor.py) import it (``from harness import
-...``: pytest puts this folder on the path):
+The journey tests import it (``from harness import ...``: pytest puts this folder on the
+path):
 
-- `Terminal`: a person's shell in a fresh virtual environment; `Terminal.type` runs a
-  command line as written (bash, the environment's ``bin/`` first on ``PATH``) and
-  returns what it printed and its exit status.
+- `typed`: a command line run as written (bash, a virtual environment's ``bin/`` first
+  on ``PATH``); it returns what it printed and its exit status.
+- `Terminal`: a person's shell in a fresh virtual environment; `Terminal.type` is `typed`
+  there.
 - `quick_start`: the command lines of a README's quick-start block, as written.
 - `release`: ``msdlab release`` of this checkout, as an instructor runs it.
 
@@ -42,6 +43,29 @@ class Typed:
         return f"$ {self.command}\n{self.output}(exit status {self.status})"
 
 
+def typed(command: str, cwd: Path, venv: Path, timeout: float = 600) -> Typed:
+    """``command`` as typed at a shell prompt in ``cwd`` with the virtual environment
+    ``venv`` activated (its ``bin/`` first on ``PATH``), and no msdlab, pytest or Python
+    settings of the process running the tests: what it printed, its exit status."""
+    inherited = {
+        key: value
+        for key, value in os.environ.items()
+        if not key.startswith(("MSDLAB_", "PYTEST_", "PYTHON")) and key != "VIRTUAL_ENV"
+    }
+    path = os.pathsep.join([str(venv / "bin"), inherited.get("PATH", "")])
+    done = subprocess.run(
+        ["bash", "-c", command],
+        cwd=cwd,
+        env={**inherited, "PATH": path, "VIRTUAL_ENV": str(venv)},
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        timeout=timeout,
+        check=False,
+    )
+    return Typed(command, done.returncode, done.stdout)
+
+
 class Terminal:
     """A shell in a fresh virtual environment at ``home / 'venv'``."""
 
@@ -61,29 +85,9 @@ class Terminal:
         """The environment's Python."""
         return self.venv / "bin" / "python"
 
-    def environment(self) -> dict[str, str]:
-        """The variables of a shell with the environment activated (no choice of task files,
-        no test settings of the process running the journey)."""
-        inherited = {
-            key: value
-            for key, value in os.environ.items()
-            if not key.startswith(("MSDLAB_", "PYTEST_", "PYTHON")) and key != "VIRTUAL_ENV"
-        }
-        path = os.pathsep.join([str(self.venv / "bin"), inherited.get("PATH", "")])
-        return {**inherited, "PATH": path, "VIRTUAL_ENV": str(self.venv)}
-
     def type(self, command: str, cwd: Path, timeout: float = 600) -> Typed:
         """Run ``command`` as typed at the prompt in ``cwd``; what it printed, its status."""
-        done = subprocess.run(
-            ["bash", "-c", command],
-            cwd=cwd,
-            env=self.environment(),
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-            timeout=timeout,
-        )
-        return Typed(command, done.returncode, done.stdout)
+        return typed(command, cwd, self.venv, timeout)
 
 
 def quick_start(readme: Path) -> list[str]:

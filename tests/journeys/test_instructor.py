@@ -37,7 +37,7 @@ def home(tmp_path_factory, shell) -> Path:
     """The instructor's folder: the clone ``msdlab/`` and the ``class/`` of five, graded."""
     home = tmp_path_factory.mktemp("term")
     cloned = shell(f"git clone -q {PROJECT_ROOT} msdlab", home)
-    assert cloned.returncode == 0, cloned.stdout
+    assert cloned.status == 0, cloned.output
     course, room = home / "msdlab", home / "class"
     hand_in(room / "alice", course / "solutions")
     hand_in(room / "bob", course / "assignments")  # the templates as released: nothing done
@@ -58,8 +58,8 @@ def graded(home: Path, shell) -> str:
         + ISOLATION,
         home,
     )
-    assert done.returncode == 0, done.stdout  # every submission graded
-    return done.stdout
+    assert done.status == 0, done.output  # every submission graded
+    return done.output
 
 
 def grades(home: Path) -> dict[str, dict[str, str]]:
@@ -102,7 +102,7 @@ def test_one_student_regraded_from_inside_the_clone_keeps_the_class(home, graded
         + ISOLATION,
         home / "msdlab",
     )
-    assert done.returncode == 0 and "4 rows of earlier runs kept" in done.stdout, done.stdout
+    assert done.status == 0 and "4 rows of earlier runs kept" in done.output, done.output
     after = grades(home)
     assert after["carol"]["total"] == after["(max points)"]["total"]
     assert {k: v for k, v in after.items() if k != "carol"} == {

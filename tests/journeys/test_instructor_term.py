@@ -106,7 +106,7 @@ def test_late_extended_and_overridden_work_lasts_and_reaches_canvas(tmp_path, sh
         " --late-policy grace=15m,penalty=10%/day,cap=50% --extensions extensions.csv" + ISOLATION
     )
     done = shell("msdlab grade class/*/assignments --similarity" + common, tmp_path)
-    assert done.returncode == 0 and "manual changes: 1 from" in done.stdout, done.stdout
+    assert done.status == 0 and "manual changes: 1 from" in done.output, done.output
     rows = read_rows(out)
     flagged = {
         frozenset((row["first"], row["second"])): row["flagged"]
@@ -133,7 +133,7 @@ def test_late_extended_and_overridden_work_lasts_and_reaches_canvas(tmp_path, sh
     with (tmp_path / "grades.adjustments.csv").open("a") as handle:
         handle.write("alice,,+2,best report of the class\n")
     done = shell("msdlab grade class/*/assignments --resume" + common, tmp_path)
-    assert done.returncode == 0 and "5 unchanged since graded, skipped" in done.stdout
+    assert done.status == 0 and "5 unchanged since graded, skipped" in done.output
     rows = read_rows(out)
     assert float(rows["alice"]["total"]) == int(full) + 2 and rows["dave"]["total"] == full
     assert "best report of the class" in (notes / "students" / "alice.md").read_text()
@@ -141,7 +141,7 @@ def test_late_extended_and_overridden_work_lasts_and_reaches_canvas(tmp_path, sh
     # regrading one student keeps his override and everyone else's row
     dave = folders[list(HANDED_IN).index("dave")]
     os.utime(dave / "task1.py", (HANDED_IN["dave"].timestamp(),) * 2)
-    assert shell("msdlab grade class/dave/assignments" + common, tmp_path).returncode == 0
+    assert shell("msdlab grade class/dave/assignments" + common, tmp_path).status == 0
     again = read_rows(out)
     assert again["dave"]["total"] == full and again["dave"]["adjustment"] != ""
     assert {k: again[k]["total"] for k in again} == {k: rows[k]["total"] for k in rows}
@@ -159,7 +159,7 @@ def test_late_extended_and_overridden_work_lasts_and_reaches_canvas(tmp_path, sh
         " --assignment 'MSD lab 1'",
         tmp_path,
     )
-    assert done.returncode == 0, done.stdout
+    assert done.status == 0, done.output
     possible, scores = read_as_canvas(tmp_path / "canvas.csv")
     assert possible == {"MSD lab 1": float(again["(max points)"]["total"])}
     assert scores == {
