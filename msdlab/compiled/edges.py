@@ -18,7 +18,7 @@ import math
 import numba
 import numpy as np
 
-from .equations import dashpot_power, spring_energy, spring_force, transverse_stiffness
+from .equations import dashpot_power, spring_energy, spring_tension, transverse_stiffness
 
 # Odd constants that mix the bits of the spring values into a hash (see `spring_classes`).
 _MIX = (np.uint64(0x9E3779B97F4A7C15), np.uint64(0xC2B2AE3D27D4EB4F), np.uint64(0x165667B19E3779F9))
@@ -33,6 +33,9 @@ def _add_spring_forces(x, v, a, b, kinds, k, rest, c, first, stop, out, three):
     ``kinds[s]`` (see `spring_classes`), or at s when ``kinds`` is None. Along a
     run of springs with the same end a, a's position and force stay in registers:
     its force is summed in the same order as in memory, so the sums do not change.
+    The force is `equations.spring_force`'s, f_a = [k (l - |d|) - c ṡ] d/|d|, with
+    |d| and ṡ computed once for the force, the stretch and the dashpot power (the
+    same operations, so the same bits).
     """
     peak = np.zeros(1)  # the stretch, in memory: a register would make it divide every time
     power = 0.0
@@ -60,12 +63,14 @@ def _add_spring_forces(x, v, a, b, kinds, k, rest, c, first, stop, out, three):
             peak[0] = length / rest[m]
         if length == 0.0:  # coincident ends: no direction, no force
             continue
-        w0 = w1 = w2 = 0.0  # v_a - v_b, read only for a dashpot
+        rate = 0.0  # ṡ = (v_a - v_b)·n, read only for a dashpot
         if c[m] != 0.0:
             w0, w1 = v[i, 0] - v[j, 0], v[i, 1] - v[j, 1]
             w2 = v[i, 2] - v[j, 2] if three else 0.0
-            power += dashpot_power(c[m], (w0 * d0 + w1 * d1 + w2 * d2) / length)
-        g0, g1, g2 = spring_force(k[m], rest[m], c[m], (d0, d1, d2), (w0, w1, w2))
+            rate = (w0 * d0 + w1 * d1 + w2 * d2) / length
+            power += dashpot_power(c[m], rate)
+        scale = spring_tension(k[m], rest[m], length, c[m], rate) / length  # |f_a| / |d|
+        g0, g1, g2 = scale * d0, scale * d1, scale * d2
         f0 += g0
         out[j, 0] -= g0
         f1 += g1

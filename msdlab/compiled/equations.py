@@ -21,7 +21,6 @@ def _compiled(function: Callable, **helpers: Callable) -> Callable:
 
 
 spring_tension = _compiled(equations.spring_tension)
-spring_force = _compiled(equations.spring_force, spring_tension=spring_tension)
 spring_energy = _compiled(equations.spring_energy)
 dashpot_power = _compiled(equations.dashpot_power)
 transverse_stiffness = _compiled(equations.transverse_stiffness)
