@@ -56,7 +56,8 @@ def ground_alone(sim):
     body, ground = sim.body, sim.constraints[0]
     x, v = body.positions, body.velocities
     x_new, v_new = sim._integrate(x, v)
-    state = StepState(body, x, v, x_new.copy(), v_new.copy(), sim.time, sim.dt, lambda p: 0.0)
+    arrays = (x, v, x_new.copy(), v_new.copy())
+    state = StepState(body, *arrays, sim.time, sim.dt, lambda p: 0.0, sim.dynamics.springs)
 
     def apply() -> None:
         state.x[...] = x_new

@@ -11,10 +11,14 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .body import Body
+
+if TYPE_CHECKING:
+    from .spring_kernel import SpringKernel
 
 
 @dataclass
@@ -29,6 +33,7 @@ class StepState:
     time: float  # time at the end of the step (s)
     dt: float  # step (s)
     energy_of: Callable[[np.ndarray], float]  # energy (J) involving these particles now
+    kernel: SpringKernel | None = None  # the simulation's kernel: its compiled loops, if any
 
 
 class Constraint(ABC):

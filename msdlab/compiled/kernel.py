@@ -13,6 +13,7 @@ import scipy.sparse as sp
 from .. import equations
 from ..body import Body
 from .advance import accelerations, accelerations_parallel, compile_advance, divide_by_masses
+from .contact import ground_clamp
 from .edges import (
     dashpot_power_parallel,
     dashpot_power_serial,
@@ -98,6 +99,7 @@ class NumbaKernel:
     name = "numba"
     finite = staticmethod(finite)
     damping_work = staticmethod(damping_work)
+    ground_clamp = staticmethod(ground_clamp)  # `interaction.Ground`'s clamp, if present
 
     def add_spring_forces(
         self,

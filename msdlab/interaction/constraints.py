@@ -63,6 +63,10 @@ class Ground(Constraint):
     any in (the mean normal velocity is (x(t+dt) - x(t-dt))·n/2dt ≤ 0 when
     x(t+dt) is on the plane and x(t-dt) was not below it). A body at rest on the
     ground books nothing. Friction books the kinetic energy it takes out of the tangential velocity.
+
+    A kernel with a ``ground_clamp`` loop (the numba kernel) does all this in one
+    compiled pass over the particles, the same arithmetic per particle; `apply` on
+    numpy arrays is the readable reference that loop is tested against.
     """
 
     ledger_name = "ground"
@@ -94,6 +98,11 @@ class Ground(Constraint):
 
     def apply(self, state: StepState) -> float:
         n = _UP[state.body.dim] if self.normal is None else self.normal
+        clamp = getattr(state.kernel, "ground_clamp", None)  # the kernel's loop, if it has one
+        if clamp is not None:
+            body = state.body
+            arrays = (state.x, state.v, state.x_old, state.v_old, body.masses, body.fixed, n)
+            return clamp(*arrays, self.height, state.dt, self.friction)
         heights = state.x[:, 1] if self.normal is None else (state.x * n).sum(axis=1)  # x·n (m)
         candidates = (heights < self.height).nonzero()[0]
         below = candidates[~state.body.fixed[candidates]]  # fixed ones only among the few below
