@@ -488,6 +488,8 @@ class Body:
     def springs_touching(self, particles: np.ndarray) -> np.ndarray:
         """Indices of the springs with an end in ``particles`` (sorted, unique)."""
         start, springs = self.incident_springs()
+        if len(particles) == 1:  # one slice (a wall's bounce asks for one particle at a time)
+            return np.unique(springs[start[particles[0]] : start[particles[0] + 1]])
         counts = start[particles + 1] - start[particles]
         first = np.repeat(start[particles] - (np.cumsum(counts) - counts), counts)
         return np.unique(springs[first + np.arange(counts.sum())])

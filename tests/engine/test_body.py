@@ -138,3 +138,11 @@ def test_store_state_copies_the_arrays_of_new_state_after_particles_were_added()
     body.add_particles([(5.0, 6.0)])
     with pytest.raises(ValueError, match="broadcast"):
         body.store_state(x_new, v_new)
+
+
+@pytest.mark.parametrize("particles", [[7], [0, 7], [3, 8, 40]])
+def test_springs_touching_are_the_springs_with_an_end_among_the_particles(particles) -> None:
+    body = msd.Body.grid((6, 9), neighbours=(1, 2))
+    wanted = np.isin(body.spring_a, particles) | np.isin(body.spring_b, particles)
+    touching = body.springs_touching(np.array(particles))
+    np.testing.assert_array_equal(touching, np.flatnonzero(wanted))
