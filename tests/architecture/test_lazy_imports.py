@@ -24,6 +24,17 @@ def test_importing_msdlab_imports_no_engine():
     assert not imported_after("import msdlab") & {"numpy", "scipy", "numba", "matplotlib"}
 
 
+def test_a_run_imports_no_dense_linear_algebra():
+    """scipy.linalg (0.3 s to import) only where a mode or an implicit step is asked for:
+    not in a check that runs a body with Verlet."""
+    code = "import msdlab as msd\n"
+    code += "body = msd.Body.grid((3, 3), neighbours=(1,))\n"
+    code += "msd.Simulation(body, msd.Verlet(), kernel='numpy').run(steps=2)\n"
+    code += "import sys; print(*[m for m in sys.modules if m.startswith('scipy.linalg')])"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert done.stdout.split() == []
+
+
 def test_the_check_command_starts_without_numpy():
     code = "from msdlab.cli import build_parser, named_command\n"
     code += "build_parser(named_command(['check', '2'])).parse_args(['check', '2'])"
