@@ -5,7 +5,8 @@ on the reference answers (every check runs to the end) and on the templates (eve
 check stops at the first call). Each command runs as the student types it, in a
 fresh process from the course folder ``--root`` (default: this checkout; its own
 ``msdlab/`` is imported, whichever is installed), after one run that writes the
-bytecode caches (a warm machine). ``--root A --root B`` times two checkouts
+bytecode caches (a warm machine; ``PYTHONDONTWRITEBYTECODE`` is left out, as a
+student's shell does not set it). ``--root A --root B`` times two checkouts
 interleaved, e.g. a branch against main.
 
 The machine is shared, so the yardstick runs interleaved with them: a fresh Python
@@ -43,7 +44,8 @@ def seconds(command: list[str], root: Path) -> float:
     """Wall-clock seconds of one run of ``command`` in ``root`` with ``root``'s own msdlab
     (its output discarded)."""
     environment = {**os.environ, "PYTHONPATH": str(root)}
-    environment.pop("MSDLAB_IMPL", None)
+    for name in ("MSDLAB_IMPL", "PYTHONDONTWRITEBYTECODE"):  # as in a student's shell
+        environment.pop(name, None)
     started = time.perf_counter()
     subprocess.run(
         command, cwd=root, env=environment, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL

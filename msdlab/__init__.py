@@ -6,58 +6,71 @@ sim = msd.Simulation(body, msd.Verlet(damping=0.01), dt=1e-3,
                      forces=[msd.Gravity((0, -9.81, 0)), msd.Ground(height=0.0)])
 trajectory = sim.run(duration=1.0, record_every=10)
 
+Its names are imported when first used (`__getattr__`), so ``import msdlab`` alone
+is quick: ``msd.Body`` imports `msdlab.body`, ``msd.max_stable_dt`` `msdlab.analysis`.
+
 Debugging: under a debugger, or with ``MSDLAB_KERNEL=numpy`` set, the step runs on the
 readable numpy kernel, so a breakpoint in ``msdlab.equations`` (``spring_force``) or in an
 integrator's update (``verlet_update``) stops there.
 """
 
-from .analysis import (
-    Convergence,
-    Mode,
-    bisect_blowup,
-    convergence_order,
-    max_stable_dt,
-    measure_blowup_dt,
-    stability_limit,
-    stiffest_mode,
-)
-from .body import Body, rotation_matrix
-from .constraint import Constraint, StepState
-from .dynamics import Dynamics
-from .energy import (
-    EnergyLedger,
-    angular_momentum,
-    elastic_energy,
-    gravitational_energy,
-    kinetic_energy,
-    momentum,
-)
-from .errors import SimulationDiverged
-from .forces import Force, Gravity, ViscousDamping
-from .integrators import (
-    RK4,
-    ExplicitEuler,
-    ImplicitEuler,
-    Integrator,
-    SymplecticEuler,
-    VelocityVerlet,
-    Verlet,
-)
-from .interaction import Drag, Grab, Ground, Prescribed, SphereContact, Walls
-from .particle import Particle
-from .simulation import Simulation, Trajectory
-from .spring import Spring
+from __future__ import annotations
+
+import importlib
+from typing import Any
 
 __version__ = "0.1.0"
 
-# fmt: off
-__all__ = [
-    "RK4", "Body", "Constraint", "Convergence", "Drag", "Dynamics", "EnergyLedger",
-    "ExplicitEuler", "Force", "Grab", "Gravity", "Ground", "ImplicitEuler", "Integrator", "Mode",
-    "Particle", "Prescribed", "Simulation", "SimulationDiverged", "SphereContact", "Spring",
-    "StepState", "SymplecticEuler", "Trajectory", "VelocityVerlet", "Verlet", "ViscousDamping",
-    "Walls", "angular_momentum", "bisect_blowup", "convergence_order", "elastic_energy",
-    "gravitational_energy", "kinetic_energy", "max_stable_dt", "measure_blowup_dt", "momentum",
-    "rotation_matrix", "stability_limit", "stiffest_mode",
-]
-# fmt: on
+# The public names, by the module that defines them (`msdlab.analysis` imports scipy).
+_PUBLIC = {
+    "analysis": (
+        "Convergence", "Mode", "bisect_blowup", "convergence_order", "max_stable_dt",
+        "measure_blowup_dt", "stability_limit", "stiffest_mode",
+    ),
+    "body": ("Body", "rotation_matrix"),
+    "constraint": ("Constraint", "StepState"),
+    "dynamics": ("Dynamics",),
+    "energy": (
+        "EnergyLedger", "angular_momentum", "elastic_energy", "gravitational_energy",
+        "kinetic_energy", "momentum",
+    ),
+    "errors": ("SimulationDiverged",),
+    "forces": ("Force", "Gravity", "ViscousDamping"),
+    "integrators": (
+        "RK4", "ExplicitEuler", "ImplicitEuler", "Integrator", "SymplecticEuler",
+        "VelocityVerlet", "Verlet",
+    ),
+    "interaction": ("Drag", "Grab", "Ground", "Prescribed", "SphereContact", "Walls"),
+    "particle": ("Particle",),
+    "simulation": ("Simulation", "Trajectory"),
+    "spring": ("Spring",),
+}  # fmt: skip
+_DEFINED_IN = {name: module for module, names in _PUBLIC.items() for name in names}
+
+__all__ = sorted(_DEFINED_IN)
+
+
+def __getattr__(name: str) -> Any:
+    """``msdlab.Body`` and the other public names, and submodules (``msdlab.analysis``),
+    imported on first use."""
+    if name in _DEFINED_IN:
+        value = getattr(importlib.import_module(f".{_DEFINED_IN[name]}", __name__), name)
+    else:
+        value = _submodule(name)
+    globals()[name] = value
+    return value
+
+
+def _submodule(name: str) -> Any:
+    """The submodule ``msdlab.<name>``, imported; AttributeError if there is none."""
+    if not name.startswith("__"):
+        try:
+            return importlib.import_module(f".{name}", __name__)
+        except ModuleNotFoundError as missing:
+            if missing.name != f"{__name__}.{name}":
+                raise
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

@@ -23,7 +23,6 @@ from functools import cache
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from threadpoolctl import ThreadpoolController
 
 from .dynamics import Dynamics
@@ -235,6 +234,8 @@ def _solve_spd(
     place (the sparsity stays), then Jacobi-preconditioned CG solves, or a
     direct solve if CG stalls.
     """
+    import scipy.sparse.linalg as spla  # imported here: scipy.linalg with it, 0.3 s
+
     if rhs.size == 0:
         return rhs
     if not free.all():

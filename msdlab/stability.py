@@ -16,9 +16,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from . import kernels
 from .body import Body
@@ -45,6 +43,9 @@ def stiffest_mode(body: Body, forces: Sequence[Force] = (), x: np.ndarray | None
     ω² is the largest eigenvalue of M⁻¹K; γ is the damping (dashpots and
     viscous forces) seen by that mode, uᵀCu / uᵀMu.
     """
+    import scipy.linalg  # here: 0.3 s to import, spared where no mode is asked for (a check)
+    import scipy.sparse.linalg as spla
+
     x = body.positions if x is None else x
     jx, jv = kernels.spring_jacobians(body, x)
     for force in forces:

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from ..analysis import max_stable_dt
 from ..scenes import get_scene
+from .first_run import start_engine
 from .progress import step_bar
 
 
@@ -35,6 +36,7 @@ def run(args: argparse.Namespace) -> int:
     from ..viz import plot_energy, save_animation
 
     started = time.perf_counter()
+    start_engine()
     scene = get_scene("jelly-cube")
     sim = scene.build(size=args.size)
     limit = max_stable_dt(sim.body, sim.integrator)

@@ -23,6 +23,7 @@ from ..integrators import (
 from ..scenes import SCENES, Scene, get_scene, sweep
 from ..scenes.trampoline import EXPERIMENTS, experiment_table, run_experiment
 from ..simulation import Simulation, Trajectory
+from .first_run import start_engine
 from .progress import count_bar, step_bar
 
 INTEGRATORS: dict[str, type[Integrator]] = {
@@ -100,6 +101,7 @@ def run(args: argparse.Namespace) -> int:
         from ..viz.interactive import check_display
 
         check_display()
+    start_engine()
     if args.experiments:
         return _experiments(scene, settings, args)
     if args.sweep:

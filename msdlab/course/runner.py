@@ -19,8 +19,9 @@ from . import PROJECT_ROOT, TASKS, loader
 from .report import CheckReport
 
 CHECKS = Path("tests") / "tasks"
-PLUGINS = ("msdlab.course.pytest_plugin", "_hypothesis_pytestplugin")
-"""The pytest plugins the checks run with: the course's and Hypothesis'."""
+PLUGINS = ("msdlab.course.pytest_plugin", "_hypothesis_pytestplugin", "pytest_timeout")
+"""The pytest plugins the checks run with: the course's, Hypothesis' and pytest-timeout (the
+course's pytest config sets its ``timeout``)."""
 CALL_TIMEOUT = 10.0
 """Seconds one call into a task file may take by default (`call_limit`); the slowest call the
 reference solutions make takes well under a second."""
@@ -67,8 +68,9 @@ def run_checks(
                 cwd=checks,
                 env={
                     "MSDLAB_KERNEL": "numpy",
+                    # compiled modules kept, but outside the task and check folders
+                    "PYTHONPYCACHEPREFIX": str(bytecode_cache()),
                     **os.environ,
-                    "PYTHONDONTWRITEBYTECODE": "1",
                     # only the plugins the checks use (`PLUGINS`): the others installed
                     # beside them (xdist, anyio, nbval, ...) cost a second to load
                     "PYTEST_DISABLE_PLUGIN_AUTOLOAD": "1",
@@ -92,9 +94,18 @@ def run_checks(
         return CheckReport.read(report_path), output
 
 
+def bytecode_cache() -> Path:
+    """Where the checks' process keeps the modules it compiled (``PYTHONPYCACHEPREFIX``), so
+    the next run loads them (about a second less): the user's cache folder, not
+    ``__pycache__`` folders beside the task files and checks."""
+    cache = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(cache) / "msdlab" / "bytecode"
+
+
 def missing_test_tools() -> list[str]:
-    """The modules the checks need that are not installed (pytest, hypothesis)."""
-    return [name for name in ("pytest", "hypothesis") if importlib.util.find_spec(name) is None]
+    """The modules the checks need that are not installed (pytest and its plugins)."""
+    needed = ("pytest", "hypothesis", "pytest_timeout")
+    return [name for name in needed if importlib.util.find_spec(name) is None]
 
 
 def install_command(cwd: Path) -> str:

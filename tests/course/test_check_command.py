@@ -50,6 +50,28 @@ def test_checks_run_on_the_graders_kernel_unless_chosen(chosen, expected, monkey
     assert report.checks and all(check.passed for check in report.checks), output
 
 
+def test_pytests_own_output_has_no_warning_about_the_courses_config(capsys):
+    """``msdlab check -v`` shows pytest's output: the course's pytest config (its
+    ``timeout``) is understood by the plugins the checks run with."""
+    assert main(["check", "1", "--impl", str(SOLUTIONS), "-v"]) == 0
+    out = capsys.readouterr().out
+    assert "passed" in out and "Unknown config option" not in out
+
+
+def test_the_checks_keep_compiled_modules_in_the_cache_not_in_the_course(monkeypatch, tmp_path):
+    """The next ``msdlab check`` loads the modules it compiled (a second less to wait), and
+    no ``__pycache__`` appears beside the task files or the checks."""
+    monkeypatch.delenv("PYTHONDONTWRITEBYTECODE", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    tasks, checks = tmp_path / "tasks", tmp_path / "checks"
+    shutil.copytree(SOLUTIONS, tasks, ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(CHECKS, checks, ignore=shutil.ignore_patterns("__pycache__", "*hidden*"))
+    report, output = runner.run_checks(checks, tasks, 1)
+    assert report.all_passed, output
+    assert not [*tasks.rglob("__pycache__"), *checks.rglob("__pycache__")]
+    assert any(runner.bytecode_cache().rglob("task1*.pyc"))
+
+
 def test_templates_fail_with_what_to_do_each_said_once(capsys):
     assert main(["check", "task1", "--impl", "assignments"]) == 1
     out = capsys.readouterr().out

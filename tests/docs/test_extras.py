@@ -137,8 +137,8 @@ def test_the_grade_extra_holds_what_the_checks_import():
     assert not error, f"with only the grade extra installed: {error}"
 
 
-def test_the_test_extra_holds_every_other_extra():
-    others = {canonicalize_name(name) for name in EXTRAS} - {"test"}
+def test_the_test_extra_holds_every_other_extra_but_the_benchmarks_peers():
+    others = {canonicalize_name(name) for name in EXTRAS} - {"test", "bench"}
     (brought,) = [Requirement(r) for r in EXTRAS["test"] if Requirement(r).name == "msdlab"]
     assert set(brought.extras) == others
 
@@ -162,6 +162,23 @@ def test_the_student_release_offers_only_what_students_use():
     assert offered == {name: EXTRAS[name] for name in ("grade", "notebooks")}
     named = {e for group in NAMED_EXTRA.findall(release.STUDENT_README) for e in group.split(",")}
     assert named == set(offered)
+
+
+def test_pytest_knows_the_release_configs_options_with_the_grade_extra(tmp_path):
+    """A student (or the autograder) runs pytest with the release's pyproject.toml and only
+    the grade extra installed: every option of its pytest config is known, no warning."""
+    pyproject = release.student_pyproject((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    (tmp_path / "pyproject.toml").write_text(pyproject, encoding="utf-8")
+    (tmp_path / "test_nothing.py").write_text("def test_nothing():\n    pass\n")
+    allowed = required_closure(extra_requirements("grade"))
+    absent = [
+        f"-p no:{plugin.name}" for plugin in metadata.entry_points(group="pytest11")
+        if canonicalize_name(plugin.dist.name) not in allowed
+    ]  # fmt: skip
+    command = [sys.executable, "-m", "pytest", "--collect-only", "-q", *" ".join(absent).split()]
+    done = subprocess.run(command, cwd=tmp_path, capture_output=True, text=True)
+    assert done.returncode == 0, done.stdout
+    assert "Unknown config option" not in done.stdout + done.stderr, done.stdout
 
 
 def documented_pages() -> list[Path]:

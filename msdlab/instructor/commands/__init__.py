@@ -1,5 +1,4 @@
-"""The instructor's sub-commands of the ``msdlab`` command line."""
+"""The instructor's sub-commands of the ``msdlab`` command line, one module each, named as
+the command (`msdlab.commands.command_module` imports one when it is used)."""
 
-from . import export, grade, gradescope, release, similarity, templates, validate
-
-COMMANDS = [templates, grade, similarity, export, gradescope, release, validate]
+COMMANDS = ("templates", "grade", "similarity", "export", "gradescope", "release", "validate")
