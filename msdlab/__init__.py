@@ -8,7 +8,7 @@ trajectory = sim.run(duration=1.0, record_every=10)
 
 Debugging: under a debugger, or with ``MSDLAB_KERNEL=numpy`` set, the step runs on the
 readable numpy kernel, so a breakpoint in ``msdlab.equations`` (``spring_force``) or in an
-integrator's update (``verlet_update``) stops there.
+integrator's equation (``Verlet.update``) stops there.
 """
 
 from .analysis import (
