@@ -47,6 +47,7 @@ class Dynamics:
         self.max_stretch = 0.0  # largest |d|/l seen in the last force evaluation
         self._last_pass: SpringPass | None = None  # of the last force evaluation
         self._pattern: JacobianPattern | None = None
+        self._dashpots = ((-1, -1), True)  # (body versions, whether any spring has a dashpot)
         # `equations.damping_work` (J) for the ledger: the kernel's compiled sum, if it has one
         self.damping_work = getattr(self.springs, "damping_work", equations.damping_work)
 
@@ -92,10 +93,11 @@ class Dynamics:
                 force.add_to(self.body, x, v, total)
             else:
                 field += g
-        masses = self.body.masses[:, None]
-        if field.any():
-            total += masses * field
-        return equations.acceleration(total, masses, ~self.body.fixed[:, None])
+        masses, free, a = self.body.masses, ~self.body.fixed, np.empty_like(x)
+        for q in range(x.shape[1]):  # by coordinate: numpy is fastest on whole columns
+            force = total[:, q] + masses * field[q] if field[q] else total[:, q]
+            a[:, q] = equations.acceleration(force, masses, free)
+        return a
 
     def advance(
         self, update: Update, x: np.ndarray, v: np.ndarray, dt: float, *coefficients: float
@@ -133,7 +135,19 @@ class Dynamics:
         last = self._last_pass
         if last is not None and last.x() is x and last.v() is v:
             return last.power
+        if not self._has_dashpots():
+            return 0.0
         return self.springs.spring_forces(self.body, x, v, np.zeros_like(x)).power
+
+    def _has_dashpots(self) -> bool:
+        """Whether any spring has a dashpot (checked again when the springs are edited)."""
+        body = self.body
+        if body.grid_springs is not None:  # one dashpot for all, without laying springs out
+            return body.grid_springs.damping != 0.0
+        versions = (body.topology_version, body.parameters_version)
+        if self._dashpots[0] != versions:
+            self._dashpots = (versions, bool(body.spring_values[2].any()))
+        return self._dashpots[1]
 
     def acceleration_of(
         self,
