@@ -11,7 +11,7 @@ is quick: ``msd.Body`` imports `msdlab.body`, ``msd.max_stable_dt`` `msdlab.anal
 
 Debugging: under a debugger, or with ``MSDLAB_KERNEL=numpy`` set, the step runs on the
 readable numpy kernel, so a breakpoint in ``msdlab.equations`` (``spring_force``) or in an
-integrator's update (``verlet_update``) stops there.
+integrator's equation (``Verlet.update``) stops there.
 """
 
 from __future__ import annotations

@@ -35,7 +35,9 @@ class Dynamics:
 
     ``kernel`` picks the spring kernel (`msdlab.spring_kernel`): "numba" (compiled,
     threaded) or "numpy" (readable); the default is ``MSDLAB_KERNEL`` or "numba".
-    Both apply the same `msdlab.equations`; nothing here depends on which runs.
+    Both apply the same `msdlab.equations`; nothing here depends on which runs:
+    the springs' forces, energy and Jacobians come from the kernel, the rest
+    (a = F/m, the uniform fields, the other forces) is computed here.
     """
 
     def __init__(self, body: Body, forces: Sequence[Force] = (), kernel: str | None = None) -> None:
@@ -45,7 +47,9 @@ class Dynamics:
         self.max_stretch = 0.0  # largest |d|/l seen in the last force evaluation
         self._last_pass: SpringPass | None = None  # of the last force evaluation
         self._pattern: JacobianPattern | None = None
-        self._buffer = np.zeros((0, 0))  # scratch forces of `advance` and `acceleration`
+        self._dashpots = ((-1, -1), True)  # (body versions, whether any spring has a dashpot)
+        # `equations.damping_work` (J) for the ledger: the kernel's compiled sum, if it has one
+        self.damping_work = getattr(self.springs, "damping_work", equations.damping_work)
 
     @property
     def kernel(self) -> str:
@@ -65,42 +69,34 @@ class Dynamics:
     def force(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Total force on each particle (N, d) in N."""
         total = np.zeros_like(x)
-        self._add_forces(x, v, total)
+        self._spring_pass(x, v, total)
+        for force in self.forces:
+            force.add_to(self.body, x, v, total)
         return total
 
-    def _add_forces(
-        self,
-        x: np.ndarray,
-        v: np.ndarray,
-        total: np.ndarray,
-        fields: list[np.ndarray | None] | None = None,
-    ) -> None:
-        """Add the spring, dashpot and external forces at (x, v) to ``total``, but those
-        of the forces whose `Force.uniform_acceleration` is given in ``fields`` (not None)."""
-        stretch, power = self.springs.add_spring_forces(self.body, x, v, total, None)
-        self.max_stretch = stretch
-        self._last_pass = SpringPass(weakref.ref(x), weakref.ref(v), power)
-        for i, force in enumerate(self.forces):
-            if fields is None or fields[i] is None:
-                force.add_to(self.body, x, v, total)
+    def _spring_pass(self, x: np.ndarray, v: np.ndarray, total: np.ndarray) -> None:
+        """Add the spring and dashpot forces at (x, v) to ``total``; keep the largest
+        stretch and the dashpot power (W) the pass found (for `dashpot_power`)."""
+        sums = self.springs.spring_forces(self.body, x, v, total)
+        self.max_stretch = sums.stretch
+        self._last_pass = SpringPass(weakref.ref(x), weakref.ref(v), sums.power)
 
     def acceleration(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """Acceleration of each particle (N, d) in m/s²; zero for fixed particles.
-
-        When every force is a uniform field g (gravity), the kernel computes
-        a = F/m + g of the springs' F in one go (`SpringKernel.acceleration`).
-        """
-        field = np.zeros(x.shape[1])  # Σ g (m/s²) of the uniform fields
+        """Acceleration of each particle (N, d) in m/s², a = (F + m·g)/m: F the spring,
+        dashpot and other forces, g the uniform fields (gravity, `Force.uniform_acceleration`);
+        zero for fixed particles."""
+        total, field = np.zeros_like(x), np.zeros(x.shape[1])
+        self._spring_pass(x, v, total)
         for force in self.forces:
             g = force.uniform_acceleration(self.body)
-            if g is None:  # a force of its own kind: added to the others, then divided
-                return self.springs.to_acceleration(self.body, self.force(x, v))
-            field += g
-        if self._buffer.shape != x.shape:
-            self._buffer = np.empty_like(x)
-        a, stretch, power = self.springs.acceleration(self.body, x, v, self._buffer, field)
-        self.max_stretch = stretch
-        self._last_pass = SpringPass(weakref.ref(x), weakref.ref(v), power)
+            if g is None:
+                force.add_to(self.body, x, v, total)
+            else:
+                field += g
+        masses, free, a = self.body.masses, ~self.body.fixed, np.empty_like(x)
+        for q in range(x.shape[1]):  # by coordinate: numpy is fastest on whole columns
+            force = total[:, q] + masses * field[q] if field[q] else total[:, q]
+            a[:, q] = equations.acceleration(force, masses, free)
         return a
 
     def advance(
@@ -108,44 +104,50 @@ class Dynamics:
     ) -> tuple[np.ndarray, np.ndarray]:
         """``update(x, v, a, dt, *coefficients)`` with a = `acceleration` (x, v): one step.
 
-        ``update`` is a function of arrays or numbers (like `integrators.verlet_update`)
-        returning the new (x, v); the numba kernel compiles it into one loop with
-        a = F/m + g, g the forces' `Force.uniform_acceleration` (gravity). When every
-        force is such a g, F is the springs' alone and the kernel computes it and the
-        update in one go (`SpringKernel.advance_with_springs`).
+        ``update`` is a function of arrays or numbers (like `integrators.Verlet.update`)
+        returning the new (x, v). A kernel with a fused `SpringKernel.advance` (the
+        numba kernel) runs the springs' pass, a and the update together, compiled into
+        one loop; otherwise this is the update on whole arrays.
         """
-        if self._buffer.shape != x.shape:
-            self._buffer = np.empty_like(x)
-        field = np.zeros(x.shape[1])  # Σ g (m/s²) of the uniform fields
-        fields: list[np.ndarray | None] = []  # per force: its g, or None if it is not one
-        uniform = True
+        fused = getattr(self.springs, "advance", None)
+        if fused is None:
+            return update(x, v, self.acceleration(x, v), dt, *coefficients)
+        field, others = np.zeros(x.shape[1]), None  # Σ g (m/s²); the other forces (N)
         for force in self.forces:
             g = force.uniform_acceleration(self.body)
-            fields.append(g)
-            uniform = uniform and g is not None
-            field += 0.0 if g is None else g
-        if uniform:  # the springs' forces only: the kernel sums them
-            x_new, v_new, stretch, power = self.springs.advance_with_springs(
-                update, self.body, x, v, self._buffer, field, dt, coefficients
-            )
-            self.max_stretch = stretch
-            self._last_pass = SpringPass(weakref.ref(x), weakref.ref(v), power)
-            return x_new, v_new
-        self._buffer.fill(0.0)
-        self._add_forces(x, v, self._buffer, fields)
-        return self.springs.advance(update, self.body, x, v, self._buffer, field, dt, coefficients)
+            if g is not None:
+                field += g
+                continue
+            others = np.zeros_like(x) if others is None else others
+            force.add_to(self.body, x, v, others)
+        step = fused(update, self.body, x, v, field, dt, coefficients, others)
+        self.max_stretch = step.stretch
+        self._last_pass = SpringPass(weakref.ref(x), weakref.ref(v), step.power)
+        return step.x, step.v
 
     def dashpot_power(self, x: np.ndarray, v: np.ndarray) -> float:
         """Power (W) the dashpots take out at (x, v), Σ c ((v_a - v_b)·n)², always >= 0.
 
         When the last pass over the springs read these very arrays (the integrator's
         at the start of a step), it is the power that pass summed with the forces;
-        otherwise the kernel sums it.
+        otherwise a pass of its own sums it.
         """
         last = self._last_pass
         if last is not None and last.x() is x and last.v() is v:
             return last.power
-        return self.springs.dashpot_power(self.body, x, v)
+        if not self._has_dashpots():
+            return 0.0
+        return self.springs.spring_forces(self.body, x, v, np.zeros_like(x)).power
+
+    def _has_dashpots(self) -> bool:
+        """Whether any spring has a dashpot (checked again when the springs are edited)."""
+        body = self.body
+        if body.grid_springs is not None:  # one dashpot for all, without laying springs out
+            return body.grid_springs.damping != 0.0
+        versions = (body.topology_version, body.parameters_version)
+        if self._dashpots[0] != versions:
+            self._dashpots = (versions, bool(body.spring_values[2].any()))
+        return self._dashpots[1]
 
     def acceleration_of(
         self,
@@ -161,7 +163,7 @@ class Dynamics:
         if springs is None:
             springs = self.body.springs_touching(particles)
         total = np.zeros_like(x)
-        self.springs.add_spring_forces(self.body, x, v, total, springs)
+        self.springs.spring_forces(self.body, x, v, total, springs)
         for force in self.forces:
             force.add_to(self.body, x, v, total)
         masses, free = self.body.masses[particles, None], ~self.body.fixed[particles, None]

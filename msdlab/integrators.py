@@ -6,9 +6,9 @@ few lines that read like its formula. The `Simulation` calls the integrator's
 `step` every step, then pins fixed particles and applies the constraints
 (ground, drag, ...).
 
-A scheme that needs a(x, v) once, at the current state, can write its update as
+A scheme that needs a(x, v) once, at the current state, writes its equation as
 a plain function of numbers ``update(x, v, a, dt, *coefficients) -> (x_new, v_new)``
-(like `verlet_update`) and step with ``dynamics.advance(update, x, v, dt, *coefficients)``.
+(like `Verlet.update`) and steps with ``dynamics.advance(update, x, v, dt, *coefficients)``.
 On whole arrays that is ``update(x, v, dynamics.acceleration(x, v), dt, ...)``;
 the numba kernel compiles the same function into one loop with a = F/m, for
 any integrator, the engine's or a user's. A scheme that takes energy out
@@ -30,28 +30,6 @@ from .energy import damping_work
 from .equations import kinetic_energy
 
 State = tuple[np.ndarray, np.ndarray]
-
-
-def explicit_euler_update(x: float, v: float, a: float, dt: float) -> tuple[float, float]:
-    """Forward Euler: x + dt·v and v + dt·a, both from the old state (numbers or arrays)."""
-    return x + dt * v, v + dt * a
-
-
-def symplectic_euler_update(x: float, v: float, a: float, dt: float) -> tuple[float, float]:
-    """Semi-implicit Euler: v_new = v + dt·a, then x + dt·v_new (numbers or arrays)."""
-    v_new = v + dt * a
-    return x + dt * v_new, v_new
-
-
-def verlet_update(x: float, v: float, a: float, dt: float, damping: float) -> tuple[float, float]:
-    """Position Verlet with damping λ, eq. (1.4), from x(t), the stored v and a(t)::
-
-    x(t - dt) = x - v dt,   x(t + dt) = (2 - λ) x - (1 - λ) x(t - dt) + a dt²,
-    v_new = (x(t + dt) - x) / dt        (numbers or arrays)
-    """
-    x_old = x - v * dt  # the template's `old` buffer
-    x_new = (2.0 - damping) * x - (1.0 - damping) * x_old + a * dt**2  # eq. (1.4)
-    return x_new, (x_new - x) / dt
 
 
 class Integrator(ABC):
@@ -101,8 +79,14 @@ class ExplicitEuler(Integrator):
     without damping); it is here to show why better schemes exist.
     """
 
+    @staticmethod
+    def update(x: float, v: float, a: float, dt: float) -> tuple[float, float]:
+        """x + dt·v and v + dt·a, both from the old state (numbers or arrays)."""
+        return x + dt * v, v + dt * a
+
     def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: Dynamics) -> State:
-        return dynamics.advance(explicit_euler_update, x, v, dt)
+        """`update` with a = F(x, v)/m (`Dynamics.advance`)."""
+        return dynamics.advance(self.update, x, v, dt)
 
 
 class SymplecticEuler(Integrator):
@@ -111,8 +95,15 @@ class SymplecticEuler(Integrator):
     Symplectic: energy stays bounded for dt below 2/ω of the stiffest mode.
     """
 
+    @staticmethod
+    def update(x: float, v: float, a: float, dt: float) -> tuple[float, float]:
+        """v_new = v + dt·a, then x + dt·v_new (numbers or arrays)."""
+        v_new = v + dt * a
+        return x + dt * v_new, v_new
+
     def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: Dynamics) -> State:
-        return dynamics.advance(symplectic_euler_update, x, v, dt)
+        """`update` with a = F(x, v)/m (`Dynamics.advance`)."""
+        return dynamics.advance(self.update, x, v, dt)
 
 
 class Verlet(Integrator):
@@ -143,8 +134,17 @@ class Verlet(Integrator):
             )
         self.damping = damping
 
+    @staticmethod
+    def update(x: float, v: float, a: float, dt: float, damping: float) -> tuple[float, float]:
+        """Eq. (1.4) from x(t), the stored v and a(t), with damping λ (numbers or arrays)."""
+        old = x - v * dt  # x(t - dt), the template's old buffer
+        new = (2.0 - damping) * x - (1.0 - damping) * old + a * dt**2  # eq. (1.4)
+        return new, (new - x) / dt
+
     def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: Dynamics) -> State:
-        return dynamics.advance(verlet_update, x, v, dt, self.damping)
+        """x(t + dt) and v by eq. (1.4), `update`, with a(t) = F(x, v)/m: `Dynamics.advance`
+        computes a and applies the equation (on the numba kernel, in one compiled loop)."""
+        return dynamics.advance(self.update, x, v, dt, self.damping)
 
     def velocity_at_positions(self, v: np.ndarray, a: np.ndarray, dt: float) -> np.ndarray:
         """v(t) ≈ v(t - dt/2) + ½ a(t) dt: the stored velocity is half a step behind x."""

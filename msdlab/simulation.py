@@ -186,13 +186,13 @@ class Simulation:
         """Add to `dissipated` the energy (J) each mechanism took out in the step from (x, v)
         to velocities ``v_new``: the dashpots, the integrator's damping, the dissipative
         forces, and the constraints (``removed``: (ledger name, energy) of each)."""
-        body, dt, integrator, kernel = self.body, self._dt, self.integrator, self.dynamics.springs
+        body, dt, integrator = self.body, self._dt, self.integrator
         if type(integrator).dissipated_energy is not Integrator.dissipated_energy:
             damping = integrator.dissipated_energy(v, body.masses, v_new)  # its own booking
         elif (factor := integrator.velocity_factor) == 1.0:
             damping = 0.0
-        else:  # Integrator.dissipated_energy's work of the velocity factor, summed by the kernel
-            damping = kernel.damping_work(body.masses, v, v_new, factor)
+        else:  # Integrator.dissipated_energy's work of the velocity factor
+            damping = self.dynamics.damping_work(body.masses, v, v_new, factor)
         booked = {"dashpot": self.dynamics.dashpot_power(x, v) * dt, "integrator": damping}
         for force in self.dynamics.forces:
             if type(force).dissipated_power is Force.dissipated_power:

@@ -1,11 +1,14 @@
 """The spring kernel interface: what `Dynamics` needs from a backend, and choosing one.
 
 A spring kernel computes, for all springs of a body at once, what `Spring.force`
-computes for one (eq. 1.1-1.2 with the dashpot), their energy, dashpot power
-and Jacobians, and runs an integrator's update with a = F/m. `Dynamics` calls
-only the methods of `SpringKernel`; it never knows which backend runs:
-`kernels.NumpyKernel` (readable, whole arrays) or `msdlab.compiled.NumbaKernel`
-(compiled loops, the default). Both apply the same `msdlab.equations`.
+computes for one (eq. 1.1-1.2 with the dashpot), their energy and their
+Jacobians. `SpringKernel` is the whole contract, five methods, the last one
+optional; `Dynamics` calls only these and never knows which backend runs:
+`kernels.NumpyKernel` (readable, whole arrays, the reference every backend is
+tested against) or `msdlab.compiled.NumbaKernel` (compiled loops, the default).
+Both apply the same `msdlab.equations`. Everything else (a = F/m, the ledger's
+sums) is plain numpy in `Dynamics` and `msdlab.energy`. What the methods return is named in
+`msdlab.kernel_results`.
 """
 
 from __future__ import annotations
@@ -17,10 +20,10 @@ from collections.abc import Callable
 from typing import Protocol
 
 import numpy as np
-import scipy.sparse as sp
 
 from .body import Body
 from .jacobian import JacobianPattern
+from .kernel_results import Advanced, Jacobians, SpringSums
 from .kernels import NumpyKernel
 
 KERNELS = ("numba", "numpy")
@@ -28,42 +31,36 @@ Update = Callable[..., tuple[np.ndarray, np.ndarray]]
 
 
 class SpringKernel(Protocol):
-    """What `Dynamics` needs from a spring kernel; `NumpyKernel` and `NumbaKernel` have it."""
+    """What `Dynamics` needs from a spring kernel; `NumpyKernel` and `NumbaKernel` have it.
+
+    ``body`` is a `Body` (its spring arrays ``spring_a``, ``spring_b``,
+    ``spring_values``; ``masses``, ``fixed``), ``x`` and ``v`` are positions (m) and
+    velocities (m/s), (N, d) float64 with d = 2 or 3. ``springs`` (indices) restricts
+    a method to some springs. `advance` is optional: without it `Dynamics`
+    computes a = F/m and runs the update on whole arrays. A kernel may also offer
+    a faster `equations.damping_work` for the ledger (the numba kernel does).
+    """
 
     name: str
 
-    def add_spring_forces(
-        self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray, springs: np.ndarray | None
-    ) -> tuple[float, float]:
-        """Add the spring and dashpot forces (N) to ``out``; return (largest stretch, power W)."""
+    def spring_forces(
+        self,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        out: np.ndarray,
+        springs: np.ndarray | None = None,
+    ) -> SpringSums:
+        """Add the spring and dashpot forces (N), eq. (1.1)-(1.2), to ``out`` (N, d)."""
 
-    def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None) -> float:
-        """Energy (J) stored in the springs (or in the given ones)."""
+    def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
+        """Energy (J) stored in the springs, Σ ½ k (|x_a - x_b| - l)²."""
 
-    def dashpot_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
-        """Power (W) the dashpots take out at (x, v)."""
+    def jacobians(self, body: Body, x: np.ndarray, pattern: JacobianPattern) -> Jacobians:
+        """∂F/∂x and ∂F/∂v of the springs on ``pattern`` (see `kernels.spring_jacobians`)."""
 
     def finite(self, x: np.ndarray, v: np.ndarray) -> bool:
         """Whether every position and velocity (N, d) is a finite number."""
-
-    def damping_work(
-        self, masses: np.ndarray, v_before: np.ndarray, v_after: np.ndarray, factor: float
-    ) -> float:
-        """`equations.damping_work`: the energy (J) a velocity factor per step takes out."""
-
-    def jacobians(
-        self, body: Body, x: np.ndarray, pattern: JacobianPattern
-    ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
-        """∂F/∂x and ∂F/∂v of the springs on ``pattern`` (see `kernels.spring_jacobians`)."""
-
-    def acceleration(
-        self, body: Body, x: np.ndarray, v: np.ndarray, forces: np.ndarray, field: np.ndarray
-    ) -> tuple[np.ndarray, float, float]:
-        """a = (F + m·g)/m (N, d), F the spring forces, g = ``field`` (d,) in m/s², 0 for fixed;
-        with the largest stretch and the dashpot power (W). ``forces`` (N, d) is scratch."""
-
-    def to_acceleration(self, body: Body, forces: np.ndarray) -> np.ndarray:
-        """Accelerations a = F/m (N, d) from forces (N, d), 0 for fixed (may reuse ``forces``)."""
 
     def advance(
         self,
@@ -71,27 +68,17 @@ class SpringKernel(Protocol):
         body: Body,
         x: np.ndarray,
         v: np.ndarray,
-        forces: np.ndarray,
         field: np.ndarray,
         dt: float,
         coefficients: tuple[float, ...],
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """``update(x, v, a, dt, *coefficients)`` with a = (F + m·g)/m, g = ``field`` (d,)
-        in m/s² (0 for fixed particles)."""
+        forces: np.ndarray | None = None,
+    ) -> Advanced:
+        """``update(x, v, a, dt, *coefficients)`` with a = (F + m·g)/m, 0 for fixed particles.
 
-    def advance_with_springs(
-        self,
-        update: Update,
-        body: Body,
-        x: np.ndarray,
-        v: np.ndarray,
-        forces: np.ndarray,
-        field: np.ndarray,
-        dt: float,
-        coefficients: tuple[float, ...],
-    ) -> tuple[np.ndarray, np.ndarray, float, float]:
-        """The spring forces, then `advance`: (x_new, v_new, largest stretch, dashpot power W).
-        ``forces`` (N, d) is the kernel's scratch: its content is not read."""
+        F is the spring forces plus ``forces`` (N, d) in N, the other forces, if given;
+        g = ``field`` (d,) in m/s². Optional: a backend that has it runs the springs'
+        pass, a = F/m and the update together (the numba kernel: one loop).
+        """
 
 
 def default_kernel() -> str:

@@ -8,13 +8,11 @@ then sums them per particle. `NumbaKernel` compiles the same functions
 - `gather`: grid bodies (`stencil`) whose springs share their values per
   offset go by offset instead, with no list of springs;
 - `advance`: an integrator's update function (for example
-  `integrators.verlet_update`) compiled into one loop over the particles that
+  `integrators.Verlet.update`) compiled into one loop over the particles that
   computes a = F/m (plus gravity's g) and the update together; it is compiled
-  once per process and update. When the springs' forces are all the forces
-  (`NumbaKernel.advance_with_springs`), the spring forces not yet summed (the
-  edge loop's threads' buffers, or the gather's forces by coordinate) are
-  added in that loop too, not in a pass of their own. `advance.accelerations` is
-  the same loop without an update, for `Dynamics.acceleration`;
+  once per process and update (`NumbaKernel.advance`). The spring forces not
+  yet summed (the edge loop's threads' buffers, or the gather's forces by
+  coordinate) are added in that loop too, not in a pass of their own;
 - `kernel`: `NumbaKernel`, which keeps what a body needs between calls and
   picks the loops.
 

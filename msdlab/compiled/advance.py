@@ -1,9 +1,8 @@
 """The update loop: an integrator's update function compiled into one loop over the particles.
 
-`compile_advance` turns an update such as `integrators.verlet_update` into a
+`compile_advance` turns an update such as `integrators.Verlet.update` into a
 loop that computes a = F/m (plus gravity's g) and the update together, and adds
-the spring forces the spring loops left pending in the same pass. `accelerations`
-is that loop without an update: a = F/m (plus g) alone.
+the spring forces the spring loops left pending in the same pass.
 """
 
 from __future__ import annotations
@@ -15,14 +14,6 @@ import numba
 from .equations import acceleration
 
 
-@numba.njit(cache=True)
-def divide_by_masses(forces, masses, fixed):
-    """Turn forces (N, d) into accelerations in place: a = F/m, and 0 for fixed particles."""
-    for i in range(len(masses)):
-        for q in range(forces.shape[1]):
-            forces[i, q] = acceleration(forces[i, q], masses[i], not fixed[i])
-
-
 @numba.njit(cache=True, inline="always")
 def particle_acceleration(i, q, forces, partial, field, masses, fixed):
     """a = (F + m·g)/m (m/s²) of particle i along q, 0 if fixed. F is ``forces`` (N, d)
@@ -32,22 +23,6 @@ def particle_acceleration(i, q, forces, partial, field, masses, fixed):
     for t in range(len(partial)):
         total += partial[t, i, q]
     return acceleration(total + masses[i] * field[q], masses[i], not fixed[i])
-
-
-@numba.njit(cache=True)
-def accelerations(forces, partial, field, masses, fixed, out):
-    """Write into ``out`` (N, d) every particle's `particle_acceleration` (m/s²)."""
-    for i in range(len(masses)):
-        for q in range(out.shape[1]):
-            out[i, q] = particle_acceleration(i, q, forces, partial, field, masses, fixed)
-
-
-@numba.njit(cache=True, parallel=True)
-def accelerations_parallel(forces, partial, field, masses, fixed, out):
-    """`accelerations`, the particles split between the threads."""
-    for i in numba.prange(len(masses)):
-        for q in range(out.shape[1]):
-            out[i, q] = particle_acceleration(i, q, forces, partial, field, masses, fixed)
 
 
 def compile_advance(update: Callable, threads: bool) -> Callable:

@@ -1,4 +1,4 @@
-"""The edge loop: spring forces, energy, dashpot power and Jacobians, one spring at a time.
+"""The edge loop: spring forces, energy and Jacobians, one spring at a time.
 
 For each spring it computes the length, the force along it (eq. 1.2 plus the
 dashpot), adds it to particle a and its opposite to particle b (eq. 1.1), and
@@ -162,42 +162,6 @@ def spring_classes(k_bits, rest_bits, c_bits, slots, kinds, table):
             slots[slot] = count
         kinds[s] = slots[slot] - 1
     return count
-
-
-@numba.njit(cache=True, inline="always")
-def _dashpot_power_of_springs(x, v, a, b, c, first, stop):
-    """Power (W) taken by the dashpots of springs ``first`` to ``stop - 1``."""
-    power = 0.0
-    for s in range(first, stop):
-        if c[s] != 0.0:
-            i, j = a[s], b[s]
-            squared = 0.0
-            closing = 0.0
-            for q in range(x.shape[1]):
-                d = x[i, q] - x[j, q]
-                squared += d * d
-                closing += (v[i, q] - v[j, q]) * d
-            if squared > 0.0:
-                power += dashpot_power(c[s], closing / math.sqrt(squared))
-    return power
-
-
-@numba.njit(cache=True)
-def dashpot_power_serial(x, v, a, b, c):
-    """One thread: Σ c ((v_a - v_b)·d/|d|)² over all springs (W)."""
-    return _dashpot_power_of_springs(x, v, a, b, c, 0, len(a))
-
-
-@numba.njit(cache=True, parallel=True)
-def dashpot_power_parallel(x, v, a, b, c, blocks):
-    """Threads: Σ c ((v_a - v_b)·d/|d|)² over all springs (W), in ``blocks`` blocks."""
-    count = len(a)
-    powers = np.zeros(blocks)
-    for t in numba.prange(blocks):
-        powers[t] = _dashpot_power_of_springs(
-            x, v, a, b, c, t * count // blocks, (t + 1) * count // blocks
-        )
-    return powers.sum()
 
 
 @numba.njit(cache=True, inline="always")

@@ -1,5 +1,5 @@
-"""Energy and dashpot power of a grid's springs kept per offset (`lattice.GridSprings`),
-compiled: each offset's springs visited in grid order, with no list of springs.
+"""Energy of a grid's springs kept per offset (`lattice.GridSprings`), compiled: each
+offset's springs visited in grid order, with no list of springs.
 
 The grid is laid out as in `stencil.GridStencil`: shape (3,) in C order (2-D grids as
 (1, n0, n1)) and offsets (M, 3); spring m of particle p joins it to p + offset m.
@@ -10,53 +10,47 @@ import math
 import numba
 import numpy as np
 
-from .equations import dashpot_power, spring_energy
+from .equations import spring_energy
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _plane_sum(x, v, shape, offsets, values, m, plane, power):
+def _plane_sum(x, shape, offsets, values, m, plane):
     """Σ over the springs of offset m from the particles of grid ``plane``: their energy
-    ½ k (|d| - l)² (J), or with ``power`` the power c ((v_p - v_q)·d/|d|)² (W) their
-    dashpots take; d = x_p - x_q, and ``values[:, m]`` are k (N/m), l (m) and c (N·s/m)."""
+    ½ k (|d| - l)² (J), d = x_p - x_q, with ``values[:, m]`` k (N/m) and l (m)."""
     n1, n2 = shape[1], shape[2]
     o1, o2 = offsets[m, 1], offsets[m, 2]
-    k, rest, c = values[0, m], values[1, m], values[2, m]
+    k, rest = values[0, m], values[1, m]
     shift = (offsets[m, 0] * n1 + o1) * n2 + o2
     total = 0.0
     for row in range(max(0, -o1), n1 - max(0, o1)):
         start = (plane * n1 + row) * n2
         for p in range(start + max(0, -o2), start + n2 - max(0, o2)):
             q = p + shift
-            squared, rate = 0.0, 0.0
+            squared = 0.0
             for axis in range(x.shape[1]):
                 d = x[p, axis] - x[q, axis]
                 squared += d * d
-                rate += (v[p, axis] - v[q, axis]) * d if power else 0.0
-            length = math.sqrt(squared)
-            if power:
-                total += dashpot_power(c, rate / length if length > 0.0 else 0.0)
-            else:
-                total += spring_energy(k, rest, length)
+            total += spring_energy(k, rest, math.sqrt(squared))
     return total
 
 
 @numba.njit(cache=True, error_model="numpy")
-def grid_sum_serial(x, v, shape, offsets, values, power):
+def grid_sum_serial(x, shape, offsets, values):
     """One thread: `grid_sum_parallel`'s sums, in the same order."""
     sums = np.zeros((len(offsets), shape[0]))
     for m in range(len(offsets)):
         for plane in range(max(0, -offsets[m, 0]), shape[0] - max(0, offsets[m, 0])):
-            sums[m, plane] = _plane_sum(x, v, shape, offsets, values, m, plane, power)
+            sums[m, plane] = _plane_sum(x, shape, offsets, values, m, plane)
     return sums.sum()
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
-def grid_sum_parallel(x, v, shape, offsets, values, power):
-    """Σ over all springs (see `_plane_sum`), energy (J) or dashpot power (W), with
-    ``values`` (3, M) the stiffness, rest length and dashpot of each offset; the
+def grid_sum_parallel(x, shape, offsets, values):
+    """The energy (J) of all springs (see `_plane_sum`), with ``values`` (3, M) the
+    stiffness, rest length and dashpot of each offset; the
     threads take planes, and the sums are added in a fixed order."""
     sums = np.zeros((len(offsets), shape[0]))
     for m in range(len(offsets)):
         for plane in numba.prange(max(0, -offsets[m, 0]), shape[0] - max(0, offsets[m, 0])):
-            sums[m, plane] = _plane_sum(x, v, shape, offsets, values, m, plane, power)
+            sums[m, plane] = _plane_sum(x, shape, offsets, values, m, plane)
     return sums.sum()

@@ -8,15 +8,13 @@ from typing import TYPE_CHECKING
 
 import numba
 import numpy as np
-import scipy.sparse as sp
 
 from .. import equations
 from ..body import Body
-from .advance import accelerations, accelerations_parallel, compile_advance, divide_by_masses
+from ..kernel_results import Advanced, Jacobians, SpringSums
+from .advance import compile_advance
 from .contact import ground_clamp
 from .edges import (
-    dashpot_power_parallel,
-    dashpot_power_serial,
     elastic_energy_parallel,
     elastic_energy_serial,
     jacobian_blocks,
@@ -91,29 +89,27 @@ class NumbaKernel:
         self._pad = 0
         self._values_version = -1
         self._uniform = False
-        self._damped = ((-1, -1), True)  # (versions, whether any spring has a dashpot)
+        self._forces = np.zeros((0, 0))  # the spring forces of `advance` (scratch)
         self._order: np.ndarray | None = None
         self._classes_version = -1
         self._classes: tuple[np.ndarray | None, ...] = (None,)  # see `_edge_list`
 
     name = "numba"
     finite = staticmethod(finite)
-    damping_work = staticmethod(damping_work)
+    damping_work = staticmethod(damping_work)  # the ledger's sum, compiled (`Dynamics`)
     ground_clamp = staticmethod(ground_clamp)  # `interaction.Ground`'s clamp, if present
 
-    def add_spring_forces(
+    def spring_forces(
         self,
         body: Body,
         x: np.ndarray,
         v: np.ndarray,
         out: np.ndarray,
         springs: np.ndarray | None = None,
-    ) -> tuple[float, float]:
-        """Add the spring and dashpot forces (N) to ``out`` (N, d).
-
-        Returns the largest stretch |d|/l and the power (W) the dashpots take.
-        """
-        return self._spring_forces(body, x, v, out, springs, reduce=True)[:2]
+    ) -> SpringSums:
+        """Add the spring and dashpot forces (N) to ``out`` (N, d); the largest stretch
+        |d|/l and the power (W) the dashpots take come from the same loop."""
+        return SpringSums(*self._spring_forces(body, x, v, out, springs, reduce=True)[:2])
 
     def _spring_forces(
         self,
@@ -124,7 +120,7 @@ class NumbaKernel:
         springs: np.ndarray | None,
         reduce: bool,
     ) -> tuple[float, float, Pending]:
-        """`add_spring_forces`, and where the spring forces are (`Pending`): ``out`` with
+        """`spring_forces`, and where the spring forces are (`Pending`): ``out`` with
         ``reduce``; else ``out`` plus the threads' buffers of `edges.spring_forces_parallel`,
         or the gather's forces by coordinate. Without ``reduce`` ``out`` is scratch: the
         edge loops clear it, the gather leaves it."""
@@ -208,34 +204,18 @@ class NumbaKernel:
         self._threads = numba.get_num_threads()
         return self._threads > 1
 
-    def _grid_sum(self, body: Body, x: np.ndarray, v: np.ndarray, power: bool) -> float | None:
-        """The springs' energy (J), or with ``power`` their dashpot power (W), summed by offset
-        for a grid that keeps its springs per offset (`grid_sums`); None for other bodies."""
+    def _grid_energy(self, body: Body, x: np.ndarray) -> float | None:
+        """The springs' energy (J) summed by offset for a grid that keeps its springs per
+        offset (`grid_sums`); None for other bodies."""
         stencil = None if body.grid_springs is None else self.grid_stencil(body)
         if stencil is None:
             return None
         grid_sum = grid_sum_parallel if self._parallel(body) else grid_sum_serial
-        return grid_sum(x, v, stencil.shape, stencil.offsets, self._stencil_values, power)
-
-    def dashpot_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
-        """Power (W) the dashpots take out of the body at (x, v), always >= 0."""
-        if body.grid_springs is not None and body.grid_springs.damping == 0.0:
-            return 0.0
-        power = self._grid_sum(body, x, v, True)
-        if power is not None:
-            return power
-        a, b, damping = body.spring_a, body.spring_b, body.spring_values[2]
-        if self._damped[0] != (body.topology_version, body.parameters_version):
-            self._damped = ((body.topology_version, body.parameters_version), damping.any())
-        if not self._damped[1]:
-            return 0.0
-        if not self._parallel(body):
-            return dashpot_power_serial(x, v, a, b, damping)
-        return dashpot_power_parallel(x, v, a, b, damping, self._threads)
+        return grid_sum(x, stencil.shape, stencil.offsets, self._stencil_values)
 
     def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
         """Energy (J) stored in the springs (or in the given ones) at positions x."""
-        energy = None if springs is not None else self._grid_sum(body, x, x, False)
+        energy = None if springs is not None else self._grid_energy(body, x)
         if energy is not None:
             return energy
         arrays = (body.spring_a, body.spring_b, *body.spring_values[:2])
@@ -246,9 +226,7 @@ class NumbaKernel:
         return elastic_energy_parallel(x, *arrays, self._threads)
 
     @staticmethod
-    def jacobians(
-        body: Body, x: np.ndarray, pattern: JacobianPattern
-    ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    def jacobians(body: Body, x: np.ndarray, pattern: JacobianPattern) -> Jacobians:
         """∂F/∂x and ∂F/∂v of the springs on ``pattern``, as `kernels.spring_jacobians`,
         with the blocks computed spring by spring."""
         values = body.spring_values
@@ -256,29 +234,7 @@ class NumbaKernel:
         stiff = np.empty((body.n_springs, dim, dim))
         damp = np.empty((body.n_springs if values[2].any() else 0, dim, dim))
         jacobian_blocks(x, body.spring_a, body.spring_b, *values, stiff, damp)
-        return pattern.jacobians(stiff, damp if len(damp) else None)
-
-    @staticmethod
-    def to_acceleration(body: Body, forces: np.ndarray) -> np.ndarray:
-        """Turn forces (N, d) into accelerations a = F/m in place (0 for fixed); return them."""
-        divide_by_masses(forces, body.masses, body.fixed)
-        return forces
-
-    def acceleration(
-        self, body: Body, x: np.ndarray, v: np.ndarray, forces: np.ndarray, field: np.ndarray
-    ) -> tuple[np.ndarray, float, float]:
-        """a = (F + m·g)/m (N, d) in m/s², F the spring forces and g = ``field`` (d,), 0 for
-        fixed particles; with the largest stretch and the dashpot power (W). The spring
-        forces are summed in the loop that divides (as in `advance_with_springs`);
-        ``forces`` is scratch."""
-        stretch, power, (forces, partial) = self._spring_forces(
-            body, x, v, forces, None, reduce=False
-        )
-        threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
-        out = np.empty_like(x)
-        loop = accelerations_parallel if threads else accelerations
-        loop(forces, partial, field, body.masses, body.fixed, out)
-        return out, stretch, power
+        return Jacobians(*pattern.jacobians(stiff, damp if len(damp) else None))
 
     def advance(
         self,
@@ -286,39 +242,32 @@ class NumbaKernel:
         body: Body,
         x: np.ndarray,
         v: np.ndarray,
-        forces: np.ndarray,
         field: np.ndarray,
         dt: float,
         coefficients: tuple[float, ...],
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """``update(x, v, a, dt, *coefficients)`` with a = (F + m·g)/m (0 if fixed),
-        g = ``field`` (d,) in m/s², in one loop.
+        forces: np.ndarray | None = None,
+    ) -> Advanced:
+        """``update(x, v, a, dt, *coefficients)`` with a = (F + m·g)/m (0 if fixed), F the
+        spring forces plus ``forces`` (N, d) if given, g = ``field`` (d,) in m/s²: the
+        springs' loop, then one loop doing a and the update.
 
-        An update numba cannot compile warns once and runs on whole arrays.
+        The spring forces not yet added up (the threads' buffers, or the gather's forces
+        by coordinate) are added in the update's loop, not in a pass of their own; the
+        other ``forces`` are added there after the springs'. An update numba cannot
+        compile warns once and runs on whole arrays.
         """
-        no_partial = np.zeros((0, *x.shape))
-        return self._advance(update, body, x, v, forces, no_partial, field, dt, coefficients)
-
-    def advance_with_springs(
-        self,
-        update: Callable,
-        body: Body,
-        x: np.ndarray,
-        v: np.ndarray,
-        forces: np.ndarray,
-        field: np.ndarray,
-        dt: float,
-        coefficients: tuple[float, ...],
-    ) -> tuple[np.ndarray, np.ndarray, float, float]:
-        """The spring forces, then `advance`: (x_new, v_new, largest stretch, dashpot power W).
-        The threads' partial spring forces are added to F in the update's loop, not in a
-        pass of their own, and the gather's are read where it left them; ``forces`` is
-        scratch, its content not read."""
-        stretch, power, (forces, partial) = self._spring_forces(
-            body, x, v, forces, None, reduce=False
-        )
-        x_new, v_new = self._advance(update, body, x, v, forces, partial, field, dt, coefficients)
-        return x_new, v_new, stretch, power
+        if self._forces.shape != x.shape:
+            self._forces = np.empty_like(x)
+        if forces is None:
+            stretch, power, (total, partial) = self._spring_forces(
+                body, x, v, self._forces, None, reduce=False
+            )
+        else:
+            self._forces.fill(0.0)
+            stretch, power, _ = self._spring_forces(body, x, v, self._forces, None, reduce=True)
+            total, partial = self._forces, forces[np.newaxis]
+        x_new, v_new = self._advance(update, body, x, v, total, partial, field, dt, coefficients)
+        return Advanced(x_new, v_new, stretch, power)
 
     def _advance(
         self,
@@ -332,8 +281,8 @@ class NumbaKernel:
         dt: float,
         coefficients: tuple[float, ...],
     ) -> tuple[np.ndarray, np.ndarray]:
-        """`advance` with F = ``forces`` plus the threads' ``partial`` forces (see
-        `advance.compile_advance`)."""
+        """The update with F = ``forces`` plus the ``partial`` forces (see
+        `advance.compile_advance`): the new positions and velocities."""
         threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
         compiled = None if update in _FAILED else _ADVANCES.get((update, threads))
         if compiled is None and update not in _FAILED:

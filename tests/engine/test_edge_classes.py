@@ -37,7 +37,7 @@ def shuffled_body(seed: int = 0) -> msd.Body:
 
 def forces_by(kernel: spring_kernel.SpringKernel, body: msd.Body, springs=None) -> tuple:
     out = np.zeros_like(body.positions)
-    stretch, power = kernel.add_spring_forces(body, body.positions, body.velocities, out, springs)
+    stretch, power = kernel.spring_forces(body, body.positions, body.velocities, out, springs)
     return out, stretch, power
 
 

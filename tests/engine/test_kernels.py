@@ -3,13 +3,12 @@
 from __future__ import annotations
 
 import sys
-import warnings
 
 import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab import integrators, kernels, spring_kernel
+from msdlab import kernels, spring_kernel
 from msdlab.dynamics import Dynamics
 
 RTOL = 1e-12
@@ -66,19 +65,14 @@ def test_kernel_matches_spring_objects(
     assert springs.name == kernel
     forces, energy, power = per_spring(body)
     out = np.ones_like(x)  # the kernel adds to what is there
-    stretch, fused_power = springs.add_spring_forces(body, x, v, out, None)
+    stretch, fused_power = springs.spring_forces(body, x, v, out, None)
     assert_close(out - 1.0, forces, np.abs(forces).max())
     assert stretch == pytest.approx(max(s.length() / s.rest_length for s in body.springs), RTOL)
     assert fused_power == pytest.approx(power, rel=RTOL) and power > 0
-    assert springs.dashpot_power(body, x, v) == pytest.approx(power, rel=RTOL)
     assert springs.elastic_energy(body, x, None) == pytest.approx(energy, rel=RTOL)
     some = body.springs_touching(np.array([1, 5, 6]))
     by_objects = sum(body.springs[int(s)].energy() for s in some)
     assert springs.elastic_energy(body, x, some) == pytest.approx(by_objects, rel=RTOL)
-    accelerations = springs.to_acceleration(body, forces.copy())
-    assert np.all(accelerations[body.fixed] == 0.0)
-    free = ~body.fixed
-    assert_close(accelerations[free], forces[free] / body.masses[free, None], 1.0)
 
 
 def test_public_numpy_functions_match_spring_objects() -> None:
@@ -87,7 +81,8 @@ def test_public_numpy_functions_match_spring_objects() -> None:
     forces, energy, power = per_spring(body)
     assert_close(kernels.spring_forces(body, x, v)[0], forces, np.abs(forces).max())
     assert kernels.elastic_energy(body, x) == pytest.approx(energy, rel=RTOL)
-    assert kernels.dashpot_power(body, x, v) == pytest.approx(power, rel=RTOL)
+    dashpots = kernels.NumpyKernel.spring_forces(body, x, v, np.zeros_like(x)).power
+    assert dashpots == pytest.approx(power, rel=RTOL)
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -106,74 +101,6 @@ def test_accelerations_include_forces_and_subsets(dim: int) -> None:
     drag = Dynamics(body, [msd.Gravity(g), msd.ViscousDamping(0.4)])  # not a uniform field
     dragged = np.where(body.fixed[:, None], 0.0, expected - 0.4 * v / body.masses[:, None])
     assert_close(drag.acceleration(x, v), dragged, np.abs(expected).max())
-
-
-def fused_case(
-    dim: int, uniform: bool, threaded: bool, monkeypatch: pytest.MonkeyPatch, seed: int
-) -> msd.Body:
-    """A `deformed_body` for the fused kernel calls: with ``uniform`` spring values (the numba
-    kernel gathers them by offset), and with ``threaded`` every loop shared between threads."""
-    if threaded:
-        for least in ("SPRINGS", "GATHERED", "PARTICLES"):
-            monkeypatch.setattr(f"msdlab.compiled.kernel.PARALLEL_MIN_{least}", 0)
-    body = deformed_body(dim, seed=seed)
-    if uniform:
-        body.stiffness[:] = 30.0
-        body.spring_damping[:] = 0.3
-    return body
-
-
-@pytest.mark.parametrize("threaded", [False, True])
-@pytest.mark.parametrize(("dim", "uniform"), [(3, False), (3, True), (2, True)])
-def test_acceleration_is_forces_then_division(
-    threaded: bool, dim: int, uniform: bool, kernel: str, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """The kernel's a = (F + m·g)/m, bit for bit what adding the forces and dividing
-    gives (the numba kernel sums the spring forces in its dividing loop), with the
-    stretch and power of `add_spring_forces`."""
-    body = fused_case(dim, uniform, threaded, monkeypatch, seed=8)
-    x, v, field = body.positions, body.velocities, np.array([0.0, -9.81, 0.0][:dim])
-    springs = spring_kernel.make_kernel(kernel)
-    forces = np.zeros_like(x)
-    sums = springs.add_spring_forces(body, x, v, forces, None)
-    expected = springs.to_acceleration(body, forces + body.masses[:, None] * field)
-    scratch = np.full_like(x, 7.0)  # its content is not read
-    a, *fused_sums = springs.acceleration(body, x, v, scratch, field)
-    np.testing.assert_array_equal(a, expected)
-    assert tuple(fused_sums) == sums
-
-
-def object_update(x: float, v: float, a: float, dt: float) -> tuple[float, float]:
-    """An update numba cannot compile (it builds a Python object): it runs on arrays."""
-    note = {"why": object()}
-    del note
-    return x + dt * v, v + dt * a
-
-
-@pytest.mark.parametrize("threaded", [False, True])
-@pytest.mark.parametrize("update", [integrators.symplectic_euler_update, object_update])
-@pytest.mark.parametrize(("dim", "uniform"), [(3, False), (3, True), (2, True)])
-def test_advance_with_springs_is_forces_then_advance(
-    threaded: bool, update, dim: int, uniform: bool, kernel: str, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """The forces, the update and the stretch and power, bit for bit (the numba kernel adds
-    its threads' partial forces, or the grid gather's forces, in the update's loop instead
-    of a pass of their own). With ``uniform`` spring values the numba kernel gathers."""
-    body = fused_case(dim, uniform, threaded, monkeypatch, seed=6)
-    x, v, field = body.positions, body.velocities, np.array([0.0, -9.81, 0.0][:dim])
-    springs = spring_kernel.make_kernel(kernel)
-    if kernel == "numba":
-        assert (springs.grid_stencil(body) is not None) == uniform
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)  # numba cannot compile object_update
-        forces = np.zeros_like(x)
-        sums = springs.add_spring_forces(body, x, v, forces, None)
-        expected = springs.advance(update, body, x, v, forces, field, 1e-3, ())
-        scratch = np.full_like(x, 7.0)  # its content is not read
-        fused = springs.advance_with_springs(update, body, x, v, scratch, field, 1e-3, ())
-    np.testing.assert_array_equal(fused[0], expected[0])
-    np.testing.assert_array_equal(fused[1], expected[1])
-    assert fused[2:] == sums
 
 
 def test_kernel_choice(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -197,13 +124,16 @@ def test_under_a_debugger_the_step_runs_the_readable_equations(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """A tracer (what a debugger installs) picks the numpy kernel, whose step calls
-    `equations.spring_force` where a breakpoint stops; ``MSDLAB_KERNEL`` still wins."""
+    `equations.spring_force` and the integrator's equation (`Verlet.update`), where
+    breakpoints stop; ``MSDLAB_KERNEL`` still wins."""
     monkeypatch.delenv("MSDLAB_KERNEL")
     stopped = []
 
+    watched = (msd.equations.spring_force.__code__, msd.Verlet.update.__code__)
+
     def tracer(frame, event: str, argument: object):
-        if event == "call" and frame.f_code is msd.equations.spring_force.__code__:
-            stopped.append(frame.f_code.co_name)
+        if event == "call" and frame.f_code in watched:
+            stopped.append(frame.f_code.co_qualname)
 
     sys.settrace(tracer)
     try:
@@ -212,7 +142,7 @@ def test_under_a_debugger_the_step_runs_the_readable_equations(
     finally:
         sys.settrace(None)
     assert sim.dynamics.kernel == "numpy"
-    assert "spring_force" in stopped
+    assert {"spring_force", "Verlet.update"} <= set(stopped)
     monkeypatch.setenv("MSDLAB_KERNEL", "numba")
     sys.settrace(tracer)
     try:

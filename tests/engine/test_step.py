@@ -179,7 +179,7 @@ class InPlace(msd.Integrator):
     """Writes into the arrays `Dynamics.advance` returned."""
 
     def step(self, x, v, dt, dynamics):
-        x_new, v_new = dynamics.advance(msd.integrators.symplectic_euler_update, x, v, dt)
+        x_new, v_new = dynamics.advance(msd.SymplecticEuler.update, x, v, dt)
         v_new *= 0.99
         return x_new, v_new
 
@@ -188,7 +188,7 @@ class Fresh(msd.Integrator):
     """`InPlace` computing new arrays instead."""
 
     def step(self, x, v, dt, dynamics):
-        x_new, v_new = dynamics.advance(msd.integrators.symplectic_euler_update, x, v, dt)
+        x_new, v_new = dynamics.advance(msd.SymplecticEuler.update, x, v, dt)
         return x_new, v_new * 0.99
 
 

@@ -1,0 +1,235 @@
+"""Every spring kernel computes what the readable numpy kernel computes, method by method.
+
+The numpy kernel (`kernels.NumpyKernel`) is the reference. Each kernel named in
+`spring_kernel.KERNELS` runs each method of `spring_kernel.SpringKernel` on the same
+bodies (a cloth built from arrays, grids in 2-D and 3-D, a pinned body, a damped
+body) and must give the numpy kernel's results to rounding; its fused `advance`, if
+it has one, must give what the numpy kernel's forces, a = (F + m·g)/m and the
+update on whole arrays give. A new backend is added to `KERNELS` and gets all of it.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+import msdlab as msd
+from msdlab import equations, spring_kernel
+from msdlab.jacobian import JacobianPattern
+from msdlab.kernels import NumpyKernel
+
+RTOL = 1e-12
+REFERENCE = NumpyKernel()
+
+
+def cloth(n: int = 9, spacing: float = 0.05) -> msd.Body:
+    """An n×n cloth from arrays: stretch, shear and bend springs with dashpots, two corners
+    pinned, shaken and moving (3-D)."""
+    ij = np.stack(np.meshgrid(np.arange(n), np.arange(n), indexing="ij"), -1).reshape(-1, 2)
+    index = ij[:, 0] * n + ij[:, 1]
+    pairs, stiffness = [], []
+    for (di, dj), k in {(1, 0): 400.0, (0, 1): 400.0, (1, 1): 200.0, (1, -1): 200.0}.items():
+        for reach, scale in ((1, 1.0), (2, 0.1)) if dj >= 0 and di + dj == 1 else ((1, 1.0),):
+            inside = (ij[:, 0] + reach * di < n) & (ij[:, 1] + reach * dj >= 0)
+            inside &= ij[:, 1] + reach * dj < n
+            pairs.append(np.column_stack([index[inside], index[inside] + reach * (di * n + dj)]))
+            stiffness.append(np.full(inside.sum(), k * scale))  # bend springs reach 2 apart
+    positions = np.column_stack([ij * spacing, np.zeros(len(ij))])
+    fixed = (ij[:, 1] == n - 1) & ((ij[:, 0] == 0) | (ij[:, 0] == n - 1))
+    body = msd.Body.from_arrays(
+        positions, np.vstack(pairs), masses=0.01, fixed=fixed, stiffness=np.concatenate(stiffness)
+    )
+    body.spring_damping[:] = 0.02
+    return shaken(body, seed=1)
+
+
+def shaken(body: msd.Body, seed: int) -> msd.Body:
+    """``body`` with its free particles moved off rest and moving (fixed ones at rest)."""
+    rng = np.random.default_rng(seed)
+    body.positions[:] += rng.normal(scale=0.01, size=body.positions.shape)
+    body.velocities[:] = rng.normal(scale=0.3, size=body.positions.shape)
+    body.velocities[body.fixed] = 0.0
+    return body
+
+
+def grid(dim: int) -> msd.Body:
+    """A grid with one stiffness per offset and no dashpots (the numba kernel gathers it)."""
+    shape, neighbours = ((5, 4, 3), (1, 2, 3)) if dim == 3 else ((7, 5), (1, 2))
+    return shaken(msd.Body.grid(shape, spacing=0.1, stiffness=30.0, neighbours=neighbours), 2)
+
+
+def pinned(dim: int) -> msd.Body:
+    """A grid with uniform dashpots and a pinned row, its particles of uneven masses."""
+    shape, neighbours = ((4, 4, 3), (1, 2)) if dim == 3 else ((6, 5), (1, 2))
+    body = msd.Body.grid(shape, spacing=0.1, stiffness=50.0, neighbours=neighbours, damping=0.2)
+    body.fixed[: shape[-1]] = True
+    body.masses[:] = np.random.default_rng(3).uniform(0.5, 2.0, len(body))
+    return shaken(body, 3)
+
+
+def damped(dim: int) -> msd.Body:
+    """A grid whose springs each have their own stiffness and dashpot (some none)."""
+    body = grid(dim)
+    rng = np.random.default_rng(4)
+    body.stiffness[:] = rng.uniform(10.0, 50.0, body.n_springs)
+    body.spring_damping[:] = np.where(rng.random(body.n_springs) < 0.5, 0.3, 0.0)
+    body.fixed[[0, 3]] = True
+    body.velocities[[0, 3]] = 0.0
+    return body
+
+
+BODIES: dict[str, Callable[[], msd.Body]] = {
+    "cloth": cloth,
+    "grid 3-D": lambda: grid(3),
+    "grid 2-D": lambda: grid(2),
+    "pinned 3-D": lambda: pinned(3),
+    "pinned 2-D": lambda: pinned(2),
+    "damped 3-D": lambda: damped(3),
+    "damped 2-D": lambda: damped(2),
+}
+
+# How a kernel is made to use its threads on these small bodies (its own thresholds).
+THREADED: dict[str, tuple[str, ...]] = {
+    "numba": tuple(
+        f"msdlab.compiled.kernel.PARALLEL_MIN_{least}"
+        for least in ("SPRINGS", "GATHERED", "PARTICLES")
+    ),
+}
+
+
+@pytest.fixture(params=spring_kernel.KERNELS)
+def kernel(request: pytest.FixtureRequest) -> str:
+    """Each kernel of `spring_kernel.KERNELS` (this overrides the engine's two-kernel run)."""
+    return request.param
+
+
+@pytest.fixture(params=["one thread", "threads"])
+def backend(
+    request: pytest.FixtureRequest, kernel: str, monkeypatch: pytest.MonkeyPatch
+) -> spring_kernel.SpringKernel:
+    """The kernel under test, on one thread or made to share even small bodies out."""
+    if request.param == "threads":
+        if kernel not in THREADED:
+            pytest.skip(f"the {kernel} kernel has no threads")
+        for setting in THREADED[kernel]:
+            monkeypatch.setattr(setting, 0)
+    return spring_kernel.make_kernel(kernel)
+
+
+@pytest.fixture(params=list(BODIES))
+def body(request: pytest.FixtureRequest) -> msd.Body:
+    return BODIES[request.param]()
+
+
+def assert_close(actual: np.ndarray, expected: np.ndarray) -> None:
+    scale = float(np.abs(expected).max(initial=1.0))
+    np.testing.assert_allclose(actual, expected, rtol=RTOL, atol=RTOL * scale)
+
+
+def test_spring_forces(backend: spring_kernel.SpringKernel, body: msd.Body) -> None:
+    """The forces are added to what ``out`` holds; the largest stretch and the dashpot
+    power come by name; a subset of the springs gives its own forces."""
+    x, v = body.positions, body.velocities
+    out, expected = np.ones_like(x), np.zeros_like(x)
+    sums = backend.spring_forces(body, x, v, out)
+    reference = REFERENCE.spring_forces(body, x, v, expected)
+    assert_close(out - 1.0, expected)
+    assert sums.stretch == pytest.approx(reference.stretch, rel=RTOL)
+    assert sums.power == pytest.approx(reference.power, rel=RTOL, abs=1e-300)
+    assert (sums.power > 0.0) == bool(body.spring_damping.any())
+    some = body.springs_touching(np.array([1, 5, 6]))
+    out, expected = np.zeros_like(x), np.zeros_like(x)
+    subset = backend.spring_forces(body, x, v, out, some)
+    reference = REFERENCE.spring_forces(body, x, v, expected, some)
+    assert_close(out, expected)
+    assert subset == pytest.approx(reference, rel=RTOL, abs=1e-300)
+
+
+def test_elastic_energy(backend: spring_kernel.SpringKernel, body: msd.Body) -> None:
+    x = body.positions
+    assert backend.elastic_energy(body, x) == pytest.approx(REFERENCE.elastic_energy(body, x))
+    some = body.springs_touching(np.array([2, 7]))
+    expected = REFERENCE.elastic_energy(body, x, some)
+    assert backend.elastic_energy(body, x, some) == pytest.approx(expected, rel=RTOL)
+
+
+def test_jacobians(backend: spring_kernel.SpringKernel, body: msd.Body) -> None:
+    pattern = JacobianPattern(body)
+    got = backend.jacobians(body, body.positions, pattern)
+    expected = REFERENCE.jacobians(body, body.positions, pattern)
+    assert_close(got.position.toarray(), expected.position.toarray())
+    assert_close(got.velocity.toarray(), expected.velocity.toarray())
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_finite(backend: spring_kernel.SpringKernel, body: msd.Body, bad: float) -> None:
+    x, v = body.positions.copy(), body.velocities.copy()
+    assert backend.finite(x, v) and REFERENCE.finite(x, v)
+    v[len(v) // 2, -1] = bad
+    assert not backend.finite(x, v) and not REFERENCE.finite(x, v)
+
+
+def object_update(x: float, v: float, a: float, dt: float) -> tuple[float, float]:
+    """An update numba cannot compile (it builds a Python object): it runs on arrays."""
+    note = {"why": object()}
+    del note
+    return msd.SymplecticEuler.update(x, v, a, dt)
+
+
+UPDATES = {
+    "Verlet": (msd.Verlet.update, (0.01,)),
+    "SymplecticEuler": (msd.SymplecticEuler.update, ()),
+    "ExplicitEuler": (msd.ExplicitEuler.update, ()),
+    "not compiled": (object_update, ()),
+}
+
+
+@pytest.mark.parametrize("update", list(UPDATES))
+@pytest.mark.parametrize("others", [False, True])
+def test_fused_advance(
+    backend: spring_kernel.SpringKernel, body: msd.Body, update: str, others: bool
+) -> None:
+    """The fused `advance` is the forces, a = (F + m·g)/m and the update on arrays, with the
+    stretch and power of the pass; ``others`` adds forces beside the springs'."""
+    if not hasattr(backend, "advance"):
+        pytest.skip(f"the {backend.name} kernel has no fused advance")
+    function, coefficients = UPDATES[update]
+    x, v, dt = body.positions, body.velocities, 1e-3
+    field = np.array([0.0, -9.81, 0.0][: body.dim])
+    forces = np.random.default_rng(5).normal(size=x.shape) if others else None
+    total = np.zeros_like(x)
+    sums = REFERENCE.spring_forces(body, x, v, total)
+    total = total + (0.0 if forces is None else forces)
+    masses = body.masses[:, None]
+    a = equations.acceleration(total + masses * field, masses, ~body.fixed[:, None])
+    expected = function(x, v, a, dt, *coefficients)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # numba cannot compile object_update
+        step = backend.advance(function, body, x, v, field, dt, coefficients, forces)
+    assert_close(step.x, expected[0])
+    assert_close(step.v, expected[1])
+    assert step.stretch == pytest.approx(sums.stretch, rel=RTOL)
+    assert step.power == pytest.approx(sums.power, rel=RTOL, abs=1e-300)
+
+
+def test_the_fused_advance_is_its_own_forces_then_the_update_bit_for_bit(
+    backend: spring_kernel.SpringKernel, body: msd.Body
+) -> None:
+    """Fusing changes no bit: the kernel's own `spring_forces`, then a = (F + m·g)/m and
+    `Verlet.update` on whole arrays give the same new state."""
+    if not hasattr(backend, "advance"):
+        pytest.skip(f"the {backend.name} kernel has no fused advance")
+    x, v, dt = body.positions, body.velocities, 1e-3
+    field = np.array([0.0, -9.81, 0.0][: body.dim])
+    forces = np.zeros_like(x)
+    sums = backend.spring_forces(body, x, v, forces)
+    masses = body.masses[:, None]
+    a = equations.acceleration(forces + masses * field, masses, ~body.fixed[:, None])
+    expected = msd.Verlet.update(x, v, a, dt, 0.01)
+    step = backend.advance(msd.Verlet.update, body, x, v, field, dt, (0.01,))
+    np.testing.assert_array_equal(step.x, expected[0])
+    np.testing.assert_array_equal(step.v, expected[1])
+    assert (step.stretch, step.power) == sums
