@@ -38,7 +38,8 @@ class SpringKernel(Protocol):
     velocities (m/s), (N, d) float64 with d = 2 or 3. ``springs`` (indices) restricts
     a method to some springs. `advance` is optional: without it `Dynamics`
     computes a = F/m and runs the update on whole arrays. A kernel may also offer
-    a faster `equations.damping_work` for the ledger (the numba kernel does).
+    a faster `equations.damping_work` for the ledger and a ``ground_clamp`` for
+    `interaction.Ground` (the numba kernel does).
     """
 
     name: str
