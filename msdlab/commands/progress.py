@@ -15,10 +15,10 @@ from ..spring_kernel import compiling_first
 # The line before a first run on a machine compiles the engine (a cold `msdlab demo` less
 # a warm one, benchmarks/first_run.py, on a quiet machine; cached on disk after that).
 COMPILING = "compiling the engine once, about 10 s (later runs load it from the cache)"
-# What a wait for the first step usually is otherwise (the cached loops are loaded, and the
-# integrator's update loop is compiled once per process), and how long a first step may
-# take without it (loading the cached loops takes up to 1.5 s).
-STARTING = "starting: loading the engine and compiling this run's update (a few seconds)"
+# What a wait for the first step usually is otherwise (the cached loops are loaded, and a
+# user's integrator's update loop is compiled once per process), and how long a first step
+# may take without it (loading the cached loops takes up to 1.5 s).
+STARTING = "starting: loading the engine (a few seconds)"
 FIRST_STEP_WAIT = 2.0
 
 

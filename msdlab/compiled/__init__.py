@@ -10,7 +10,8 @@ then sums them per particle. `NumbaKernel` compiles the same functions
 - `advance`: an integrator's update function (for example
   `integrators.Verlet.update`) compiled into one loop over the particles that
   computes a = F/m (plus gravity's g) and the update together; it is compiled
-  once per process and update (`NumbaKernel.advance`). The spring forces not
+  once per machine for msdlab's integrators (cached on disk, `advance.loop_file`)
+  and once per process for a user's update. The spring forces not
   yet summed (the edge loop's threads' buffers, or the gather's forces by
   coordinate) are added in that loop too, not in a pass of their own;
 - `kernel`: `NumbaKernel`, which keeps what a body needs between calls and

@@ -1,0 +1,51 @@
+"""The integrators' update loops are compiled once per machine, not once per process."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+import msdlab as msd
+from msdlab.compiled import advance
+
+# A process steps a small cube once and reports, for its Verlet update loop, how many
+# signatures numba compiled and how many it loaded from its disk cache.
+STEP_ONCE = """
+import json
+import msdlab as msd
+from msdlab.compiled import kernel
+cube = msd.Body.grid((3, 3, 3), spacing=0.1, stiffness=500.0)
+msd.Simulation(cube, msd.Verlet(0.01), dt=1e-3, forces=[msd.Gravity((0, -9.81, 0))]).step()
+(loop,) = [f for (update, _), f in kernel._ADVANCES.items() if update is msd.Verlet.update]
+print(json.dumps({"misses": sum(loop.stats.cache_misses.values()),
+                  "hits": sum(loop.stats.cache_hits.values())}))
+"""
+
+
+def step_once(cache) -> dict[str, int]:
+    environment = {**os.environ, "NUMBA_CACHE_DIR": str(cache), "MSDLAB_KERNEL": "numba"}
+    done = subprocess.run(
+        [sys.executable, "-c", STEP_ONCE], env=environment, capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout.splitlines()[-1])
+
+
+def test_a_second_process_loads_the_verlet_loop_compiled(tmp_path, kernel):
+    if kernel != "numba":
+        pytest.skip("the numba kernel's loops")
+    first, second = step_once(tmp_path), step_once(tmp_path)
+    assert first == {"misses": 1, "hits": 0}
+    assert second == {"misses": 0, "hits": 1}
+
+
+def test_a_users_update_is_compiled_in_its_process_only():
+    def user_update(x, v, a, dt):
+        return x + dt * v, v + dt * a
+
+    assert advance.loop_file(user_update, threads=False) is None
+    assert advance.loop_file(msd.Verlet.update, threads=False) is not None
