@@ -69,8 +69,11 @@ def compile_advance(update: Callable, threads: bool) -> Callable:
     if path is not None:
         spec = importlib.util.spec_from_file_location(f"msdlab_loop_{path.stem}", path)
         module = sys.modules[spec.name] = importlib.util.module_from_spec(spec)  # numba's cache
-        spec.loader.exec_module(module)  # finds its loop's globals by the module's name
-        return module.advance
+        try:  # finds its loop's globals by the module's name
+            spec.loader.exec_module(module)
+            return module.advance
+        except (OSError, RuntimeError):  # numba found no folder to write its cache in
+            del sys.modules[spec.name]
     namespace = {"update": update}
     exec(LOOP.format(import_update="", update="update", threads=threads, cache=False), namespace)
     return namespace["advance"]
