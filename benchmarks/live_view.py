@@ -19,11 +19,13 @@ there, and the drag's energy drift: the change of the total the energy panel sho
 The ceiling: requestAnimationFrame callbacks a second of an empty page in the same
 browser, measured before each case; and the machine's load average (`os.getloadavg`).
 
-    python benchmarks/live_view.py [--seconds 8] [--cases mesh,cube10,cube20,grid10] [--nodelay]
+    python benchmarks/live_view.py [--seconds 8] [--cases mesh,cube10,cube20,grid10] [--plain]
 
-``--nodelay`` starts JupyterLab with the kernel websocket that sets TCP no-delay
-(`msdlab.viz.nodelay`). Headless Chromium with --disable-gpu draws on the CPU and paces
-requestAnimationFrame at the display's 60 Hz at most, so 60 a second is the ceiling here.
+JupyterLab runs as an installed msdlab sets it up: with the server extension
+`msdlab_jupyter`, whose kernel websockets send each message at once (TCP no-delay).
+``--plain`` starts it with the server's own websocket instead (Nagle's algorithm).
+Headless Chromium with --disable-gpu draws on the CPU and paces requestAnimationFrame
+at the display's 60 Hz at most, so 60 a second is the ceiling here.
 """
 
 from __future__ import annotations
@@ -44,7 +46,8 @@ import psutil
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from browser import jupyterlab_server, launch, run_notebook
 
-NODELAY = "msdlab.viz.nodelay.NoDelayConnection"  # the websocket with TCP no-delay
+# the server's own kernel websocket, named: the extension then leaves it in place
+PLAIN = "jupyter_server.services.kernels.connection.channels.ZMQChannelsWebsocketConnection"
 KERNEL = {"name": "python3", "display_name": "Python 3 (ipykernel)", "language": "python"}
 GRID = (
     "msd.Simulation(msd.Body.grid((10, 10, 10), spacing=0.1, stiffness=5000.0, "
@@ -208,11 +211,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=8.0)
     parser.add_argument("--cases", default=",".join(CASES))
-    parser.add_argument("--nodelay", action="store_true", help="TCP no-delay on the websocket")
+    parser.add_argument("--plain", action="store_true", help="the server's own websocket")
     args = parser.parse_args()
     from playwright.sync_api import sync_playwright
 
-    options = ["--ServerApp.kernel_websocket_connection_class=" + NODELAY] if args.nodelay else []
+    options = ["--ServerApp.kernel_websocket_connection_class=" + PLAIN] if args.plain else []
     with TemporaryDirectory() as folder, sync_playwright() as playwright:
         tmp = Path(folder)
         with jupyterlab_server(tmp, options=options) as (url, token):
