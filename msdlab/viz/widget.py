@@ -149,7 +149,7 @@ class LiveView(anywidget.AnyWidget):
         self._frames = 0
         self._moved = False  # the hand moved since the last frame
         self.send_rate = FRAME_RATE  # states sent a second: the page's frame rate
-        self.energy: dict = {}  # the energies last sent (`energies`)
+        self.energy: dict = {}  # the energies of the last state sent (`energies`)
         self.status = ""  # the status line last sent
         self.achieved = 1.0  # steps done over steps asked since the last energy update
         self.stopwatch = instruments.Stopwatch(lambda: self.sim.time)
@@ -208,17 +208,17 @@ class LiveView(anywidget.AnyWidget):
 
     def publish(self, energy: bool = True) -> None:
         """Send the state: one message, the positions (a float32 buffer) and, if
-        ``energy``, the energies and the status line (the energies cost a force
-        evaluation, the line a layout of the page: the thread sends them every
-        `ENERGY_EVERY` states)."""
+        ``energy``, the energies and the status line (a layout of the page: the thread
+        sends them every `ENERGY_EVERY` states). Every state sent is recorded for export
+        with its velocities and energies (a force evaluation)."""
         content: dict = {"type": "state"}
+        velocities = velocities_now(self.sim)
+        self.energy = energies(self.sim, self._taken, self._level, velocities)
+        self.recording.add(self.sim.time, self.sim.body.positions, velocities, self.energy)
         if energy:
-            velocities = velocities_now(self.sim)
-            self.energy = energies(self.sim, self._taken, self._level, velocities)
             content["energy"] = self.energy
             self.status = content["status"] = self.status_line()
             content["pace"] = self.achieved
-            self.recording.add(self.sim.time, self.sim.body.positions, velocities, self.energy)
         if any(self.tools.values()) or self.readings:  # once more, empty, when all go off
             self.readings = content["readings"] = self.measure() if any(self.tools.values()) else {}
         self.send(content, buffers=[self._positions()])
@@ -447,8 +447,8 @@ class LiveView(anywidget.AnyWidget):
 
     def export(self, path: str | Path) -> Path:
         """Write the run shown to ``path``, a .csv table or a .npz of NumPy arrays: time,
-        energies, positions and velocities of each state sent with its energies (every
-        `ENERGY_EVERY`-th while it runs, 15 a second at 60; each one paused)."""
+        energies, positions and velocities of every state sent (the latest
+        `export.RECORD_BYTES` of positions and velocities)."""
         return self.recording.write(path)
 
     def send_export(self, kind: str) -> None:
