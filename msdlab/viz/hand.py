@@ -8,7 +8,9 @@ work (exact to second order in the move per step, `interaction.constraints.lead`
 by several per cent of the work. Played back at the pace the hand made them, each step
 moves the particle by the hand's motion over that step's time, as a `Grab` moved along
 a path in a script. The playback lags the newest move by the longest delay seen in the
-drag (`LAG_LIMIT` at most).
+drag; more than `LAG_LIMIT` behind, it plays `CATCH_UP` times faster until it is back
+within it (a jump would put a long move into one step), and it never lags by more than
+`JUMP_LIMIT` (an engine slower than real time).
 """
 
 from __future__ import annotations
@@ -18,7 +20,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-LAG_LIMIT = 100.0  # ms the playback may lag the newest move; further behind, it jumps
+LAG_LIMIT = 100.0  # ms the playback may lag the newest move at the hand's pace
+CATCH_UP = 2.0  # times the hand's pace, further behind than that
+JUMP_LIMIT = 1000.0  # ms the playback lags at most: further behind, it jumps
 
 
 class HandPath:
@@ -48,10 +52,12 @@ class HandPath:
         return self.clock >= self.newest
 
     def advance(self, ms: float) -> np.ndarray:
-        """Move the clock on by ``ms`` (no further than the newest move, and no more than
-        `LAG_LIMIT` behind it) and return the target there, on the straight line between
-        the two moves around it."""
-        self.clock = min(max(self.clock + ms, self.newest - LAG_LIMIT), self.newest)
+        """Move the clock on by ``ms`` (`CATCH_UP` times that if it lags by more than
+        `LAG_LIMIT`; no further than the newest move) and return the target there, on the
+        straight line between the two moves around it."""
+        pace = CATCH_UP if self.newest - self.clock > LAG_LIMIT else 1.0
+        self.clock = max(self.clock + pace * ms, self.newest - JUMP_LIMIT)
+        self.clock = min(self.clock, self.newest)
         while len(self.points) > 1 and self.points[1][0] <= self.clock:
             self.points.popleft()
         (t0, x0), *later = self.points
