@@ -12,8 +12,10 @@ stops while a cell runs, and a thread also runs outside Jupyter (tests,
 scripts); the kernel sends comm messages from any thread. What the page asks
 (grab, move, release, step, reset, a slider, the stopwatch's buttons, an export)
 arrives on the kernel's main thread and is queued, to be done by the stepping thread
-between two steps. The instruments turned on (`instruments`) are read here and their
-readings ride in the states; the run shown is kept for export (`export.Recording`).
+between two steps; the hand's moves are played back to `Grab` one step at a time at the
+pace the hand made them (`hand.HandPath`). The instruments turned on (`instruments`)
+are read here and their readings ride in the states; every state sent is kept for
+export (`export.Recording`).
 """
 
 from __future__ import annotations
