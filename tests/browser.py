@@ -107,7 +107,9 @@ def jupyterlab_server(
     page_config.write_text(json.dumps({"disabledExtensions": no_news}))
     # the server extension msdlab_jupyter, enabled as an installed msdlab enables it (an
     # editable install, like this checkout's, does not install that file)
-    shutil.copytree(SERVER_CONFIG.parent, tmp_path / "config" / SERVER_CONFIG.parent.name)
+    shutil.copytree(
+        SERVER_CONFIG.parent, tmp_path / "config" / SERVER_CONFIG.parent.name, dirs_exist_ok=True
+    )
     log = (tmp_path / "jupyterlab.log").open("w")
     server = subprocess.Popen(
         [
