@@ -20,7 +20,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-LAG_LIMIT = 100.0  # ms the playback may lag the newest move at the hand's pace
+LAG_LIMIT = 250.0  # ms the playback may lag the newest move at the hand's pace
 CATCH_UP = 2.0  # times the hand's pace, further behind than that
 JUMP_LIMIT = 1000.0  # ms the playback lags at most: further behind, it jumps
 
