@@ -23,7 +23,7 @@ browser, measured before each case; and the machine's load average (`os.getloada
     python benchmarks/live_view.py [--seconds 6] [--cases mesh,cube10,cube20,grid10] [--plain]
 
 JupyterLab runs as an installed msdlab sets it up: with the server extension
-`msdlab_jupyter`, whose kernel websockets send each message at once (TCP no-delay).
+`msdlab.jupyter_extension`, whose kernel websockets send each message at once (TCP no-delay).
 ``--plain`` starts it with the server's own websocket instead (Nagle's algorithm).
 Headless Chromium with --disable-gpu draws on the CPU and paces requestAnimationFrame
 at the display's 60 Hz at most, so 60 a second is the ceiling here.

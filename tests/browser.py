@@ -19,10 +19,8 @@ from pathlib import Path
 
 import pytest
 
-# what the package installs in etc/jupyter: the server extension msdlab_jupyter enabled
-SERVER_CONFIG = (
-    Path(__file__).resolve().parents[1] / "jupyter-config/jupyter_server_config.d/msdlab.json"
-)
+# what the package installs in etc/jupyter/jupyter_server_config.d: its server extension on
+SERVER_CONFIG = Path(__file__).resolve().parents[1] / "msdlab/jupyter-config/msdlab.json"
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 # headless, offline: no first-run pages, no background requests, no updates
 LAUNCH_ARGS = [
@@ -105,11 +103,11 @@ def jupyterlab_server(
     page_config.parent.mkdir(parents=True, exist_ok=True)
     no_news = {"@jupyterlab/apputils-extension:announcements": True}  # no pop-up over the page
     page_config.write_text(json.dumps({"disabledExtensions": no_news}))
-    # the server extension msdlab_jupyter, enabled as an installed msdlab enables it (an
-    # editable install, like this checkout's, does not install that file)
-    shutil.copytree(
-        SERVER_CONFIG.parent, tmp_path / "config" / SERVER_CONFIG.parent.name, dirs_exist_ok=True
-    )
+    # msdlab's server extension, enabled as an installed msdlab enables it (an editable
+    # install, like this checkout's, does not install that file)
+    extensions = tmp_path / "config" / "jupyter_server_config.d"
+    extensions.mkdir(exist_ok=True)
+    shutil.copy(SERVER_CONFIG, extensions)
     log = (tmp_path / "jupyterlab.log").open("w")
     server = subprocess.Popen(
         [

@@ -4,15 +4,13 @@ send each message at once (TCP no-delay).
 The live view sends a small message per state, 60 a second. By default the server's
 websocket (tornado) holds a small message until the browser has acknowledged the one
 before (Nagle's algorithm), and the browser delays that acknowledgement, so the states
-arrive in pairs and unevenly. The package installs
-``etc/jupyter/jupyter_server_config.d/msdlab.json``, which enables this extension in
-every Jupyter server of the environment (``jupyter lab``, ``jupyter notebook``); it
-swaps the kernel websocket connection for `NoDelayConnection` unless the server's
-configuration names one (``--ServerApp.kernel_websocket_connection_class``). An
-editable install (``pip install -e``) installs no such file: copy the repository's
-``jupyter-config`` folder into ``<sys.prefix>/etc/jupyter`` once. A package of its
-own, outside ``msdlab``: the server imports it at start, and it imports nothing of the
-engine.
+arrive in pairs and unevenly. The package installs ``msdlab/jupyter-config/msdlab.json``
+as ``<sys.prefix>/etc/jupyter/jupyter_server_config.d/msdlab.json``, which enables this
+extension in every Jupyter server of the environment (``jupyter lab``, ``jupyter
+notebook``); it swaps the kernel websocket connection for `NoDelayConnection` unless the
+server's configuration names one (``--ServerApp.kernel_websocket_connection_class``).
+An editable install (``pip install -e``) installs no such file: copy it there once.
+The module imports nothing of the engine.
 """
 
 from __future__ import annotations
@@ -36,7 +34,7 @@ class NoDelayConnection(ZMQChannelsWebsocketConnection):
 
 def _jupyter_server_extension_points() -> list[dict[str, str]]:
     """The extension's entry point, as Jupyter server looks it up."""
-    return [{"module": "msdlab_jupyter"}]
+    return [{"module": "msdlab.jupyter_extension"}]
 
 
 def _load_jupyter_server_extension(server: Any) -> None:
