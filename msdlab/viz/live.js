@@ -473,7 +473,8 @@ function isAt(x, p, target, d) {
 }
 
 /** A body view: canvas, camera, mouse and the drawing loop. `source` hands it
- * positions (`latest()`) and takes the user's grabs (`grab/move/release`). */
+ * positions (`latest()`) and takes the user's grabs (`grab/move/release`, each grab and
+ * move with the time of the event, ms). */
 export function mountView(el, scene, arrays, source) {
   const root = element("div", { className: "msdlab-live" }, el);
   root.style.cssText = "font: 12px sans-serif; max-width: 100%";
@@ -564,7 +565,7 @@ function pointer(view, painter, source) {
   /** The hand at `target` (world) now: drawn at the next frame, sent to the engine. */
   const hold = (particle, target, event) => {
     const time = Math.min(event.timeStamp, performance.now()); // when the event was made
-    view.hand = { particle, target, released: null };
+    view.hand = { particle, target, time, released: null };
     stats.moved = time;
     stats.pending = [time, particle, target];
   };
@@ -583,7 +584,7 @@ function pointer(view, painter, source) {
     view.held = nearest;
     depth = painter.depth[nearest];
     hold(nearest, camera.unproject(px, py, depth), event);
-    source.grab(nearest, view.hand.target);
+    source.grab(nearest, view.hand.target, view.hand.time);
   });
   const take = (event) => {
     active = event.pointerId;
@@ -594,7 +595,7 @@ function pointer(view, painter, source) {
     const [px, py] = at(event);
     if (view.held !== null) {
       hold(view.held, camera.unproject(px, py, depth), event);
-      source.move(view.hand.target);
+      source.move(view.hand.target, view.hand.time);
     } else if (turning) {
       camera.azimuth = turning[2] - (px - turning[0]) * 0.01;
       const elevation = turning[3] + (py - turning[1]) * 0.01;
@@ -678,8 +679,9 @@ function render({ model, el }) {
       if (states.length) show(states.shift());
       return positions;
     },
-    grab: (particle, target) => send({ type: "grab", particle, target }),
-    move: (target) => send({ type: "move", target }),
+    // with the time of the hand's move (ms): the kernel plays the moves back at their pace
+    grab: (particle, target, time) => send({ type: "grab", particle, target, time }),
+    move: (target, time) => send({ type: "move", target, time }),
     release: () => send({ type: "release" }),
     stepping: () => model.get("running") && !model.get("error"),
     readings: () => tools.shown(),

@@ -12,8 +12,10 @@ stops while a cell runs, and a thread also runs outside Jupyter (tests,
 scripts); the kernel sends comm messages from any thread. What the page asks
 (grab, move, release, step, reset, a slider, the stopwatch's buttons, an export)
 arrives on the kernel's main thread and is queued, to be done by the stepping thread
-between two steps. The instruments turned on (`instruments`) are read here and their
-readings ride in the states; the run shown is kept for export (`export.Recording`).
+between two steps; the hand's moves are played back to `Grab` one step at a time at the
+pace the hand made them (`hand.HandPath`). The instruments turned on (`instruments`)
+are read here and their readings ride in the states; every state sent is kept for
+export (`export.Recording`).
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ from ..simulation import Simulation
 from ..units import SI
 from . import frontend, instruments, settings
 from .export import Recording
+from .hand import HandPath
 from .upright import UPS, resolve_up
 from .view import LIVE_STRAIN_LIMIT, spheres_of
 
@@ -46,6 +49,7 @@ ENERGY_EVERY = 4  # states sent per energy update (15 a second)
 BUDGET = 0.75  # of the time between two states sent, spent stepping at most
 KEEPS_PACE = 0.97  # a pace below this share of the one asked is shown in the status line
 PACE_OVER = 10.0  # steps asked, at least, over which the pace kept is measured
+PHASE = 0.5  # of a step owed at the start: the steps of a frame are not on a knife's edge
 # requests done at the next state sent, not at once: a mouse moves 60 times a second,
 # and a state sent for each move beside the paced ones would be more than the page can
 # show (the page draws the held particle at the hand itself)
@@ -148,8 +152,10 @@ class LiveView(anywidget.AnyWidget):
         self._values: dict[str, float] = {}
         self._frames = 0
         self._moved = False  # the hand moved since the last frame
+        self.hand: HandPath | None = None  # the held particle's path, played back
+        self._letting_go = False  # the hand let go; the playback finishes its path first
         self.send_rate = FRAME_RATE  # states sent a second: the page's frame rate
-        self.energy: dict = {}  # the energies last sent (`energies`)
+        self.energy: dict = {}  # the energies of the last state sent (`energies`)
         self.status = ""  # the status line last sent
         self.achieved = 1.0  # steps done over steps asked since the last energy update
         self.stopwatch = instruments.Stopwatch(lambda: self.sim.time)
@@ -163,6 +169,7 @@ class LiveView(anywidget.AnyWidget):
         """Show ``sim`` from now on (at the start, and after a rebuild)."""
         self.sim = sim
         self.grab = Grab()
+        self.hand, self._letting_go = None, False
         sim.constraints.append(self.grab)
         self._start = settings.start_of(sim)
         self._initial = (sim.body.positions.copy(), sim.body.velocities.copy())
@@ -170,7 +177,7 @@ class LiveView(anywidget.AnyWidget):
         up = resolve_up(self._look[1], sim, sim.body.dim)
         self._up = UPS.index(up)
         self._level = ground_level(sim, self._up)
-        self._owed, self._clock = 0.0, time.perf_counter()
+        self._owed, self._clock = PHASE, time.perf_counter()
         self._asked = self._done = 0.0
         view, _, energy_unit = self._look
         live = settings.live_settings(sim)
@@ -208,17 +215,17 @@ class LiveView(anywidget.AnyWidget):
 
     def publish(self, energy: bool = True) -> None:
         """Send the state: one message, the positions (a float32 buffer) and, if
-        ``energy``, the energies and the status line (the energies cost a force
-        evaluation, the line a layout of the page: the thread sends them every
-        `ENERGY_EVERY` states)."""
+        ``energy``, the energies and the status line (a layout of the page: the thread
+        sends them every `ENERGY_EVERY` states). Every state sent is recorded for export
+        with its velocities and energies (a force evaluation)."""
         content: dict = {"type": "state"}
+        velocities = velocities_now(self.sim)
+        self.energy = energies(self.sim, self._taken, self._level, velocities)
+        self.recording.add(self.sim.time, self.sim.body.positions, velocities, self.energy)
         if energy:
-            velocities = velocities_now(self.sim)
-            self.energy = energies(self.sim, self._taken, self._level, velocities)
             content["energy"] = self.energy
             self.status = content["status"] = self.status_line()
             content["pace"] = self.achieved
-            self.recording.add(self.sim.time, self.sim.body.positions, velocities, self.energy)
         if any(self.tools.values()) or self.readings:  # once more, empty, when all go off
             self.readings = content["readings"] = self.measure() if any(self.tools.values()) else {}
         self.send(content, buffers=[self._positions()])
@@ -250,6 +257,7 @@ class LiveView(anywidget.AnyWidget):
         done, start = 0, time.perf_counter()
         try:
             while self._owed >= 1.0 and time.perf_counter() - start < budget:
+                self.follow_hand()
                 self.sim.step()
                 self.trace.record(self.sim)
                 self._owed -= 1.0
@@ -261,6 +269,23 @@ class LiveView(anywidget.AnyWidget):
         self._done += done
         return done
 
+    def follow_hand(self) -> None:
+        """Before a step: give `Grab` the hand's target at the step's time (`HandPath`,
+        the wall-clock time of a step at the pace; paused, the newest); let go once the
+        playback reached the move the hand let go at."""
+        if self.hand is None:
+            return
+        if self._letting_go and self.hand.caught_up:
+            self.let_go()
+            return
+        pace = self.steps_per_second * self.speed if self.running else 0.0
+        self.grab.move(self.hand.advance(1000.0 / pace if pace > 0 else np.inf))
+
+    def let_go(self) -> None:
+        """The hand lets go of the held particle (it keeps the velocity of the last step)."""
+        self.grab.release()
+        self.hand, self._letting_go = None, False
+
     def do_pending(self) -> None:
         """Do what the page asked since the last call (grabs, slider moves, ...)."""
         while True:
@@ -270,9 +295,10 @@ class LiveView(anywidget.AnyWidget):
                 return
             command()
 
-    def frame(self) -> None:
-        """One round of the stepping thread: the page's requests, steps, a frame sent."""
-        now = time.perf_counter()
+    def frame(self, now: float | None = None) -> None:
+        """One round of the stepping thread: the page's requests, steps, a frame sent.
+        ``now``: the time (s, `time.perf_counter`) the frame stands for, by default now."""
+        now = time.perf_counter() if now is None else now
         elapsed, self._clock = now - self._clock, now
         self._moved = False
         self.do_pending()
@@ -283,11 +309,14 @@ class LiveView(anywidget.AnyWidget):
 
     # ------------------------------------------------------------------ the page's requests
     def _on_message(self, _widget: object, content: dict, buffers: list) -> None:
-        """A request from the page, queued for the stepping thread (or done now if none)."""
+        """A request from the page, queued for the stepping thread (or done now if none).
+        A grab or move carries the time the hand was there (ms, the page's clock); one
+        without it is timed by its arrival."""
+        stamp = float(content.get("time", 1000.0 * time.perf_counter()))
         handlers = {
-            "grab": lambda: self._hold(content["particle"], content["target"]),
-            "move": lambda: self._hold(self.grab.particle, content["target"]),
-            "release": lambda: self.grab.release(),
+            "grab": lambda: self._take(content["particle"], content["target"], stamp),
+            "move": lambda: self._move(content["target"], stamp),
+            "release": self._release,
             "step": self.step_once,
             "reset": self.reset,
             "set": lambda: self.set(content["name"], content["value"]),
@@ -303,16 +332,26 @@ class LiveView(anywidget.AnyWidget):
             if content["type"] not in PACED:
                 self._wake.set()  # a frame now: a grab, a step, a slider need not wait
 
-    def _hold(self, particle: int | None, target: list[float]) -> None:
-        """The hand at ``target`` holding ``particle`` (none: the move of a hand let go)."""
-        if particle is None:
-            return
-        if particle != self.grab.particle:
-            self.grab.hold(self.sim.body, particle, target)
-            self.pick(particle)
-        else:
-            self.grab.move(target)
+    def _take(self, particle: int, target: list[float], stamp: float) -> None:
+        """The hand takes ``particle`` at ``target`` at time ``stamp`` (ms)."""
+        self.grab.hold(self.sim.body, particle, target)
+        self.hand, self._letting_go = HandPath(stamp, target), False
+        self.pick(particle)
         self._moved = True
+
+    def _move(self, target: list[float], stamp: float) -> None:
+        """The hand at ``target`` at time ``stamp`` (ms) (nothing if it holds nothing)."""
+        if self.hand is not None and not self._letting_go:
+            self.hand.add(stamp, target)
+            self._moved = True
+
+    def _release(self) -> None:
+        """Let go now if the playback has reached the hand (or the view is paused), else
+        once it has (`follow_hand`)."""
+        if self.hand is None or self.hand.caught_up or not self.running:
+            self.let_go()
+        else:
+            self._letting_go = True
 
     def match_frames(self, rate: float) -> None:
         """Send as many states a second as the page draws frames (``rate``, 1/s)."""
@@ -326,7 +365,7 @@ class LiveView(anywidget.AnyWidget):
 
     def reset(self) -> None:
         """Back to the positions and velocities at the start; the clock and ledger too."""
-        self.grab.release()
+        self.let_go()
         x, v = self._initial
         self.sim.body.positions[...] = x
         self.sim.body.velocities[...] = v
@@ -447,8 +486,8 @@ class LiveView(anywidget.AnyWidget):
 
     def export(self, path: str | Path) -> Path:
         """Write the run shown to ``path``, a .csv table or a .npz of NumPy arrays: time,
-        energies, positions and velocities of each state sent with its energies (every
-        `ENERGY_EVERY`-th while it runs, 15 a second at 60; each one paused)."""
+        energies, positions and velocities of every state sent (the latest
+        `export.RECORD_BYTES` of positions and velocities)."""
         return self.recording.write(path)
 
     def send_export(self, kind: str) -> None:
@@ -480,7 +519,10 @@ class LiveView(anywidget.AnyWidget):
         beat = time.perf_counter()
         while not self._stop.is_set():
             self._wake.clear()
-            self.frame()
+            now = time.perf_counter()
+            # a frame on the beat stands for the beat's time, not the wake-up's: at a pace
+            # of one step a state, each frame then steps once, none twice and none never
+            self.frame(min(now, beat))
             now = time.perf_counter()
             while beat <= now:  # the beats a slow frame overran are skipped, not caught up
                 beat += 1.0 / self.send_rate

@@ -180,6 +180,20 @@ def test_an_export_reads_back_with_numpy(tmp_path):
         view.export(tmp_path / "run.xlsx")
 
 
+def test_every_state_the_page_is_sent_is_exported(tmp_path, monkeypatch):
+    view = LiveView(spring_mass())  # its first state is sent at once
+    sent = []
+    monkeypatch.setattr(view, "send", lambda content, buffers: sent.append(buffers[0]))
+    for _ in range(12):  # a frame every 1/60 s, as the stepping thread sends them
+        view._clock -= 1 / 60
+        view.frame()
+    npz = np.load(view.export(tmp_path / "run.npz"))
+    shown = [np.frombuffer(state, np.float32).reshape(2, 2) for state in sent]
+    assert len(npz["time"]) == 1 + len(shown) and np.all(np.diff(npz["time"]) > 0)
+    np.testing.assert_array_equal(npz["positions"][1:].astype(np.float32), shown)
+    assert npz["total"] == pytest.approx(npz["total"][0], abs=1e-4)  # a ledger for each
+
+
 def test_reset_starts_the_recording_and_the_stopwatch_over():
     view = LiveView(spring_mass())
     view.stopwatch.start()

@@ -189,7 +189,8 @@ def test_every_state_is_shown_and_a_hands_circle_is_booked(page_with_widget):
     assert 1000 * pictures / now >= 8.0, f"{1000 * pictures / now:.1f} new pictures a second"
     # the energy panel's total (in the body and taken out) moves by the hand's work only
     assert -driven > 50.0  # the hand put energy in (px²/frame², unit masses)
-    # 1 % at the page's pace; a starved kernel (10 % seen at load 15) steps less often, so the
-    # hand moves further in a step, and the booking's error grows with the step's move
+    # the kernel plays the hand's moves back at the pace the hand made them, however they
+    # arrive: within 1 % on a quiet machine; the bound leaves room for CI's load
     drift = f"the total moved {total:.4g} for the hand's work {-driven:.4g}"
-    assert abs(total) <= 0.2 * -driven, drift  # before: -89 %, the hand's stops unbooked
+    print(drift)
+    assert abs(total) <= 0.03 * -driven, drift  # before: 3.5 to 8 %, the moves in bursts

@@ -1,0 +1,46 @@
+"""A Jupyter server extension, enabled when msdlab is installed: the kernels' websockets
+send each message at once (TCP no-delay).
+
+The live view sends a small message per state, 60 a second. By default the server's
+websocket (tornado) holds a small message until the browser has acknowledged the one
+before (Nagle's algorithm), and the browser delays that acknowledgement, so the states
+arrive in pairs and unevenly. The package installs ``msdlab/jupyter-config/msdlab.json``
+as ``<sys.prefix>/etc/jupyter/jupyter_server_config.d/msdlab.json``, which enables this
+extension in every Jupyter server of the environment (``jupyter lab``, ``jupyter
+notebook``); it swaps the kernel websocket connection for `NoDelayConnection` unless the
+server's configuration names one (``--ServerApp.kernel_websocket_connection_class``).
+An editable install (``pip install -e``) installs no such file: copy it there once.
+The module imports nothing of the engine.
+"""
+
+from __future__ import annotations
+
+import asyncio
+from typing import Any
+
+from jupyter_server.services.kernels.connection.channels import ZMQChannelsWebsocketConnection
+
+SETTING = "kernel_websocket_connection_class"
+
+
+class NoDelayConnection(ZMQChannelsWebsocketConnection):
+    """The default kernel websocket connection, with no-delay set on its socket."""
+
+    def connect(self) -> asyncio.Future[None] | None:
+        """Set no-delay on the open websocket, then connect it to the kernel."""
+        self.websocket_handler.set_nodelay(True)
+        return super().connect()
+
+
+def _jupyter_server_extension_points() -> list[dict[str, str]]:
+    """The extension's entry point, as Jupyter server looks it up."""
+    return [{"module": "msdlab.jupyter_extension"}]
+
+
+def _load_jupyter_server_extension(server: Any) -> None:
+    """Use `NoDelayConnection` for the kernels' websockets, unless the configuration
+    names a class."""
+    if SETTING in server.config.get("ServerApp", {}):
+        return
+    server.web_app.settings[SETTING] = NoDelayConnection
+    server.log.info("msdlab: kernel websockets send each message at once (TCP no-delay)")
