@@ -181,6 +181,10 @@ def test_a_finger_drags_a_particle_with_pointer_events(widget_page):
     assert grab["type"] == "grab" and grab["particle"] == 1
     assert [m["type"] for m in moves] == ["move"] * len(moves) and len(moves) == 5
     assert kernel.view.grab.particle == 1
+    for _ in range(60):  # a second at most: the moves are played back at the finger's pace
+        if kernel.view.hand.caught_up:
+            break
+        kernel.frames()
     screen_now = page.evaluate(
         """(x) => { const out = new Float32Array(2), depth = new Float32Array(1);
         window.msdlabViews[0].camera.project(Float32Array.from(x), 1, out, depth);
