@@ -95,8 +95,8 @@ class Dynamics:
                 field += g
         masses, free, a = self.body.masses, ~self.body.fixed, np.empty_like(x)
         for q in range(x.shape[1]):  # by coordinate: numpy is fastest on whole columns
-            force = total[:, q] + masses * field[q] if field[q] else total[:, q]
-            a[:, q] = equations.acceleration(force, masses, free)
+            along_q = total[:, q] + masses * field[q] if field[q] else total[:, q]
+            a[:, q] = equations.acceleration(along_q, masses, free)
         return a
 
     def advance(
