@@ -174,8 +174,9 @@ class Simulation:
                 )
             arrays.append(array.copy() if np.may_share_memory(array, x) else array)
         x_new, v_new = arrays
-        pinned = np.flatnonzero(self.body.fixed)  # indices: a mask costs 68 µs on 16 384 rows
-        if len(pinned):
+        fixed = self.body.fixed
+        if np.count_nonzero(fixed):  # faster than fixed.any() on a few rows
+            pinned = np.flatnonzero(fixed)  # indices: a mask costs 68 µs on 16 384 rows
             x_new[pinned] = x[pinned]
             v_new[pinned] = 0.0
         return x_new, v_new
