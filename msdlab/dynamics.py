@@ -16,6 +16,14 @@ from .jacobian import JacobianPattern
 from .spring_kernel import SpringKernel, Update, make_kernel
 
 
+def keep_acceleration(
+    x: np.ndarray, v: np.ndarray, a: np.ndarray, dt: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The update that returns the acceleration a (m/s²) in place of the new positions:
+    through a kernel's fused advance, a = F/m alone in one compiled loop."""
+    return a, v
+
+
 class SpringPass(NamedTuple):
     """The dashpot power (W) a pass over all springs summed with their forces, and the
     state (x, v) it read, referred to weakly."""
@@ -84,7 +92,10 @@ class Dynamics:
     def acceleration(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Acceleration of each particle (N, d) in m/s², a = (F + m·g)/m: F the spring,
         dashpot and other forces, g the uniform fields (gravity, `Force.uniform_acceleration`);
-        zero for fixed particles."""
+        zero for fixed particles. A kernel with a fused `SpringKernel.advance` computes it
+        in its compiled loop (`keep_acceleration`)."""
+        if getattr(self.springs, "advance", None) is not None:
+            return self.advance(keep_acceleration, x, v, 0.0)[0]
         total, field = np.zeros_like(x), np.zeros(x.shape[1])
         self._spring_pass(x, v, total)
         for force in self.forces:
