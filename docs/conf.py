@@ -46,22 +46,9 @@ default_role = "py:obj"  # `name` links to the API where it can, plain code othe
 myst_enable_extensions = ["dollarmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3
 
-# The notebooks are committed with their text outputs (notebooks/build.py); the site shows
-# them as they are instead of running them again (`pytest` runs them with nbval).
+# docs/notebooks/ holds the notebooks run with their text outputs (notebooks/build.py); the
+# site shows them as they are instead of running them again (`pytest` runs them with nbval).
 nb_execution_mode = "off"
-NOTEBOOKS = DOCS / "notebooks"
-
-
-def copy_notebooks() -> None:
-    """notebooks/*.ipynb into docs/notebooks/ (Sphinx reads only its own source folder)."""
-    NOTEBOOKS.mkdir(exist_ok=True)
-    for notebook in sorted((ROOT / "notebooks").glob("*.ipynb")):
-        target = NOTEBOOKS / notebook.name
-        if not target.exists() or target.read_bytes() != notebook.read_bytes():
-            shutil.copyfile(notebook, target)
-
-
-copy_notebooks()
 
 # MathJax 2 from Debian's libjs-mathjax (.ci/run installs it), the few files a page uses
 # copied beside the site, so that pages load nothing from the network. Without it the

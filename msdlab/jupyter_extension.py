@@ -1,16 +1,22 @@
 """A Jupyter server extension, enabled when msdlab is installed: the kernels' websockets
-send each message at once (TCP no-delay).
+send each message at once (TCP no-delay), and the course's notebooks are saved as the
+course keeps them.
 
 The live view sends a small message per state, 60 a second. By default the server's
 websocket (tornado) holds a small message until the browser has acknowledged the one
 before (Nagle's algorithm), and the browser delays that acknowledgement, so the states
-arrive in pairs and unevenly. The package installs ``msdlab/jupyter-config/msdlab.json``
-as ``<sys.prefix>/etc/jupyter/jupyter_server_config.d/msdlab.json``, which enables this
-extension in every Jupyter server of the environment (``jupyter lab``, ``jupyter
-notebook``); it swaps the kernel websocket connection for `NoDelayConnection` unless the
-server's configuration names one (``--ServerApp.kernel_websocket_connection_class``).
-An editable install (``pip install -e``) installs no such file: copy it there once.
-The module imports nothing of the engine.
+arrive in pairs and unevenly. The extension swaps the kernel websocket connection for
+`NoDelayConnection` unless the server's configuration names one
+(``--ServerApp.kernel_websocket_connection_class``).
+
+A course notebook marked to be kept without outputs (`msdlab.course.notebook_file`) is
+saved without them (`save_as_kept`), so running one in a checkout of the course leaves
+git's copy unchanged.
+
+The package installs ``msdlab/jupyter-config/msdlab.json`` as
+``<sys.prefix>/etc/jupyter/jupyter_server_config.d/msdlab.json`` (editable installs
+too), which enables the extension in every Jupyter server of the environment
+(``jupyter lab``, ``jupyter notebook``). The module imports nothing of the engine.
 """
 
 from __future__ import annotations
@@ -19,6 +25,8 @@ import asyncio
 from typing import Any
 
 from jupyter_server.services.kernels.connection.channels import ZMQChannelsWebsocketConnection
+
+from .course.notebook_file import as_kept, is_marked
 
 SETTING = "kernel_websocket_connection_class"
 
@@ -37,9 +45,16 @@ def _jupyter_server_extension_points() -> list[dict[str, str]]:
     return [{"module": "msdlab.jupyter_extension"}]
 
 
+def save_as_kept(model: dict[str, Any], **_: Any) -> None:
+    """Jupyter's pre-save hook: a marked course notebook is written without its outputs."""
+    if model.get("type") == "notebook" and is_marked(model.get("content") or {}):
+        as_kept(model["content"])
+
+
 def _load_jupyter_server_extension(server: Any) -> None:
-    """Use `NoDelayConnection` for the kernels' websockets, unless the configuration
-    names a class."""
+    """Save course notebooks as kept (`save_as_kept`); use `NoDelayConnection` for the
+    kernels' websockets, unless the configuration names a class."""
+    server.contents_manager.register_pre_save_hook(save_as_kept)
     if SETTING in server.config.get("ServerApp", {}):
         return
     server.web_app.settings[SETTING] = NoDelayConnection

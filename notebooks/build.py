@@ -1,12 +1,17 @@
-"""Build the notebooks from their sources: ``notebooks/src/NAME.py`` -> ``notebooks/NAME.ipynb``.
+"""Build the notebooks from their sources: ``notebooks/src/NAME.py`` -> two notebooks.
 
 A source is a Python file in the percent format: ``# %%`` starts a code cell,
-``# %% [markdown]`` a Markdown cell whose lines are comments (``# text``).
-Each notebook is run against the reference solutions (nbclient, a kernel of
-this Python, working folder ``notebooks/``) and saved with its text outputs,
-which nbval compares in the cells marked ``# NBVAL_CHECK_OUTPUT``. Pictures and
-animations are left out of the saved files so that they stay small and diff
-cleanly: run a notebook to see them.
+``# %% [markdown]`` a Markdown cell whose lines are comments (``# text``). Each
+source makes
+
+- ``notebooks/NAME.ipynb``, the notebook people open: no outputs, marked so that
+  Jupyter saves it without them (`msdlab.course.notebook_file`), so running it in a
+  checkout leaves git's copy as it is;
+- ``docs/notebooks/NAME.ipynb``, the same notebook run against the reference
+  solutions (nbclient, a kernel of this Python, working folder ``notebooks/``) with its
+  text outputs: the documentation site shows it, and nbval compares the cells marked
+  ``# NBVAL_CHECK_OUTPUT`` with it. Pictures and animations are left out so that the
+  files stay small and diff cleanly: run a notebook to see them.
 
     python notebooks/build.py              # build and run every notebook
     python notebooks/build.py task2 tour   # only those whose name contains one of the words
@@ -25,14 +30,13 @@ from pathlib import Path
 import nbformat
 from nbformat import NotebookNode
 
+from msdlab.course.notebook_file import MARK, METADATA
+
 HERE = Path(__file__).resolve().parent
 SOURCES = HERE / "src"
 ROOT = HERE.parent
+RUN = ROOT / "docs" / "notebooks"  # the notebooks run, with their text outputs
 MARKER = re.compile(r"# %%(?P<markdown> \[markdown\])?\s*$")
-METADATA = {
-    "kernelspec": {"display_name": "Python 3", "language": "python", "name": "python3"},
-    "language_info": {"name": "python"},
-}
 TEXT_ONLY = {"text/plain"}  # output data kept in the saved notebooks
 
 
@@ -114,33 +118,44 @@ def keep_text(notebook: NotebookNode) -> None:
         cell.outputs = kept
 
 
+def kept(source: Path) -> str:
+    """The text of ``notebooks/NAME.ipynb`` for ``source``: not run, marked to save no outputs."""
+    notebook = skeleton(source)
+    notebook.metadata.update(nbformat.from_dict(MARK))
+    return nbformat.writes(notebook) + "\n"
+
+
 def build(source: Path) -> Path:
-    """Make, run and save the notebook of ``source``; return its path."""
+    """Write the notebook of ``source`` to open, run it and save it with its text outputs
+    for the docs; return the path of the run one."""
+    (HERE / f"{source.stem}.ipynb").write_text(kept(source), encoding="utf-8")
     notebook = skeleton(source)
     execute(notebook)
     keep_text(notebook)
-    path = HERE / f"{source.stem}.ipynb"
+    RUN.mkdir(exist_ok=True)
+    path = RUN / f"{source.stem}.ipynb"
     nbformat.write(notebook, path)
     return path
 
 
 def stale() -> list[str]:
-    """Names of the notebooks that are missing, orphaned or not what their source makes.
-
-    Compares the cells (type, id, source); outputs come from running the notebook.
-    """
+    """Paths (from the repository) of the notebooks that are missing, orphaned or not what
+    their source makes."""
     sources = {path.stem: path for path in SOURCES.glob("*.py")}
-    saved = {path.stem: path for path in HERE.glob("*.ipynb")}
-    names = []
-    for name in sorted(sources.keys() | saved.keys()):
-        if name not in sources or name not in saved:
-            names.append(name)
-            continue
-        wanted = skeleton(sources[name]).cells
-        found = nbformat.read(saved[name], as_version=4).cells
-        if _shape(wanted) != _shape(found):
-            names.append(name)
-    return names
+    saved = {path for folder in (HERE, RUN) for path in folder.glob("*.ipynb")}
+    wanted = {folder / f"{name}.ipynb" for folder in (HERE, RUN) for name in sources}
+    wrong = saved ^ wanted
+    wrong.update(path for path in saved & wanted if not _current(path, sources[path.stem]))
+    return sorted(str(path.relative_to(ROOT)) for path in wrong)
+
+
+def _current(path: Path, source: Path) -> bool:
+    """Whether the notebook at ``path`` is what ``source`` makes: the one to open exactly
+    (`kept`); the run one with the same cells (type, id, source), its outputs coming from
+    running it."""
+    if path.parent == HERE:
+        return path.read_text(encoding="utf-8") == kept(source)
+    return _shape(skeleton(source).cells) == _shape(nbformat.read(path, as_version=4).cells)
 
 
 def _shape(cells: list[NotebookNode]) -> list[tuple[str, str, str]]:
@@ -155,18 +170,20 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = parser.parse_args(argv)
     if args.check:
-        names = stale()
-        for name in names:
-            print(f"notebooks/{name}.ipynb is not what notebooks/src/{name}.py makes")
-        if names:
+        paths = stale()
+        for path in paths:
+            print(f"{path} is not what notebooks/src/{Path(path).stem}.py makes")
+        if paths:
             print("run: python notebooks/build.py")
-        return 1 if names else 0
+        return 1 if paths else 0
     os.environ["MSDLAB_IMPL"] = "solutions"  # the saved outputs are those of the reference
     sources = sorted(SOURCES.glob("*.py"))
     chosen = [s for s in sources if not args.words or any(w in s.stem for w in args.words)]
-    for orphan in set(HERE.glob("*.ipynb")) - {HERE / f"{s.stem}.ipynb" for s in sources}:
-        print(f"{orphan.relative_to(ROOT)} has no source: removed")
-        orphan.unlink()
+    names = {source.stem for source in sources}
+    for orphan in [*HERE.glob("*.ipynb"), *RUN.glob("*.ipynb")]:
+        if orphan.stem not in names:
+            print(f"{orphan.relative_to(ROOT)} has no source: removed")
+            orphan.unlink()
     for source in chosen:
         print(f"building {build(source).relative_to(ROOT)}", flush=True)
     return 0

@@ -19,8 +19,6 @@ from pathlib import Path
 
 import pytest
 
-# what the package installs in etc/jupyter/jupyter_server_config.d: its server extension on
-SERVER_CONFIG = Path(__file__).resolve().parents[1] / "msdlab/jupyter-config/msdlab.json"
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 # headless, offline: no first-run pages, no background requests, no updates
 LAUNCH_ARGS = [
@@ -103,11 +101,6 @@ def jupyterlab_server(
     page_config.parent.mkdir(parents=True, exist_ok=True)
     no_news = {"@jupyterlab/apputils-extension:announcements": True}  # no pop-up over the page
     page_config.write_text(json.dumps({"disabledExtensions": no_news}))
-    # msdlab's server extension, enabled as an installed msdlab enables it (an editable
-    # install, like this checkout's, does not install that file)
-    extensions = tmp_path / "config" / "jupyter_server_config.d"
-    extensions.mkdir(exist_ok=True)
-    shutil.copy(SERVER_CONFIG, extensions)
     log = (tmp_path / "jupyterlab.log").open("w")
     server = subprocess.Popen(
         [

@@ -11,6 +11,7 @@ is `msdlab.instructor`, which the student bundle does not contain.)
   energies, engine-made variants of typical mistakes); no answers.
 - `runner`: run the checks in a fresh pytest process (``msdlab check``, the notebooks).
 - `notebook`: the notebooks' helper for trying and checking a task.
+- `notebook_file`: a course notebook as the repository keeps it, without outputs.
 - `report`: the machine-readable result of a check run, and its text table.
 - `call_limit`: the time limit on each call into a task file (``msdlab check --call-timeout``).
 - `manifest`: what the checks of each task are worth, hidden ones included.

@@ -1,7 +1,7 @@
 """The student release: the engine, the templates, the notebooks and the public checks.
 
-`build` copies what ships (see `release_rules`) into a new folder, strips the
-notebooks' outputs (they were made with the solutions), writes the students'
+`build` copies what ships (see `release_rules`) into a new folder, the notebooks
+without outputs and unmarked (their outputs are saved), writes the students'
 README, ``.gitignore``, pyproject and the points manifest (what the hidden
 checks, which do not ship, are worth), and refuses to finish if any line of a solution block
 turns up anywhere in the bundle.
@@ -16,7 +16,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from ..course import TASKS, manifest, own_numbers
+from ..course import TASKS, manifest, notebook_file, own_numbers
 from ..course.runner import CHECKS
 from .release_rules import shipped_files, solution_leaks, solution_lines
 
@@ -122,7 +122,7 @@ def build(out: Path, root: Path, force: bool = False, student: str | None = None
         target = out / source.relative_to(root)
         target.parent.mkdir(parents=True, exist_ok=True)
         if source.suffix == ".ipynb":
-            _write_stripped(source, target)
+            _write_for_students(source, target)
         else:
             shutil.copyfile(source, target)
         written.append(target)
@@ -192,11 +192,10 @@ def _write_points(checks: Path, path: Path) -> None:
         raise ReleaseError(f"the checks in {checks} could not be collected:\n{done.stdout[-2000:]}")
 
 
-def _write_stripped(source: Path, target: Path) -> None:
-    """Copy a notebook without outputs or execution counts (they came from the solutions)."""
+def _write_for_students(source: Path, target: Path) -> None:
+    """Copy a notebook without outputs or execution counts (a run in the checkout shows the
+    solutions'), unmarked: the students' Jupyter saves their outputs (`notebook_file`)."""
     notebook = json.loads(source.read_text(encoding="utf-8"))
-    for cell in notebook["cells"]:
-        if cell["cell_type"] == "code":
-            cell["outputs"] = []
-            cell["execution_count"] = None
+    notebook_file.as_kept(notebook)
+    notebook_file.unmarked(notebook)
     target.write_text(json.dumps(notebook, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")

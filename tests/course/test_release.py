@@ -37,14 +37,17 @@ def test_bundle_has_engine_templates_public_checks_and_no_answers(bundle):
     assert solution_leaks(shipped, solution_lines(PROJECT_ROOT / "solutions")) == []
 
 
-def test_notebooks_ship_without_outputs(bundle):
+def test_notebooks_ship_without_outputs_and_save_the_students(bundle):
+    """No outputs of the solutions; unmarked, so the students' Jupyter saves their outputs."""
     notebooks = sorted((bundle / "notebooks").glob("*.ipynb"))
     if not (PROJECT_ROOT / "notebooks").is_dir():
         pytest.skip("the course has no notebooks yet")
     assert notebooks
     for path in notebooks:
-        cells = json.loads(path.read_text())["cells"]
-        assert all(c.get("outputs", []) == [] for c in cells if c["cell_type"] == "code"), path
+        notebook = json.loads(path.read_text())
+        code = [c for c in notebook["cells"] if c["cell_type"] == "code"]
+        assert all(c.get("outputs", []) == [] for c in code), path
+        assert "msdlab" not in notebook["metadata"], path
 
 
 def test_a_solution_line_anywhere_stops_the_release(tmp_path):

@@ -7,10 +7,12 @@ from __future__ import annotations
 
 import csv
 import shutil
+import subprocess
 import zipfile
 from pathlib import Path
 
 import pytest
+from browser import CHROMIUM, jupyterlab_server, launch, run_notebook, wait_until
 
 from msdlab.course import PROJECT_ROOT
 from msdlab.instructor import sandbox
@@ -112,3 +114,34 @@ def test_one_student_regraded_from_inside_the_clone_keeps_the_class(home, graded
     totals = [int(after[name]["total"]) for name in ("alice", "bob", "carol", "dave", "erin")]
     assert "5 of 5 submissions graded." in summary
     assert f"| total | {after['(max points)']['total']} | {sum(totals) / 5:.1f} |" in summary
+
+
+def test_a_notebook_run_and_saved_in_the_clone_leaves_git_clean(home):
+    """The instructor opens a task's notebook in the clone with JupyterLab, runs it, saves
+    it: the page shows the outputs, and git shows no change."""
+    pytest.importorskip("playwright", reason="needs playwright (pip install -e '.[test]')")
+    if CHROMIUM is None:
+        pytest.skip("needs Chromium for the page (apt-get install chromium)")
+    from playwright.sync_api import sync_playwright
+
+    course, jupyter = home / "msdlab", home / "jupyter"
+    jupyter.mkdir(exist_ok=True)
+    path = course / "notebooks" / "task2.ipynb"
+    with (
+        jupyterlab_server(jupyter, root=course) as (url, token),
+        sync_playwright() as playwright,
+    ):
+        browser = launch(playwright)
+        page = browser.new_page(viewport={"width": 1400, "height": 1200})
+        page.set_default_timeout(120_000)
+        run_notebook(page, url, token, "notebooks/task2.ipynb")
+        shown = page.locator(".jp-OutputArea-output").filter(has_text="total:")
+        shown.first.wait_for(timeout=300_000)  # the check cell, the last, has run
+        before = path.stat().st_mtime_ns
+        page.evaluate("() => window.jupyterapp.commands.execute('docmanager:save')")
+        wait_until(lambda: path.stat().st_mtime_ns != before, 60, "JupyterLab saving")
+        browser.close()
+    status = subprocess.run(
+        ["git", "status", "--porcelain"], cwd=course, capture_output=True, text=True, check=True
+    )
+    assert status.stdout == "", status.stdout

@@ -1,5 +1,6 @@
-"""The committed notebooks are what ``notebooks/build.py`` makes from ``notebooks/src``, and
-they hold the outputs that nbval compares."""
+"""The committed notebooks are what ``notebooks/build.py`` makes from ``notebooks/src``: the
+ones people open without outputs, the run ones (docs/notebooks) with the outputs that nbval
+compares."""
 
 import importlib.util
 from pathlib import Path
@@ -8,7 +9,8 @@ import nbformat
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
+NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))  # to open
+RUN = sorted((ROOT / "docs" / "notebooks").glob("*.ipynb"))  # run, with their outputs
 
 
 def load_build():
@@ -27,12 +29,24 @@ def test_committed_notebooks_are_built_from_their_sources():
 
 
 def test_every_task_and_scene_has_a_notebook():
-    names = {path.stem for path in NOTEBOOKS}
     wanted = {"00_tour", "stability", "scene_trampoline", "scene_cloth", "scene_gallery"}
-    assert wanted | {f"task{n}" for n in range(1, 6)} <= names
+    wanted |= {f"task{n}" for n in range(1, 6)}
+    assert wanted <= {path.stem for path in NOTEBOOKS}
+    assert {path.stem for path in RUN} == {path.stem for path in NOTEBOOKS}
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)
+def test_the_notebooks_people_open_hold_no_outputs_and_say_so(path):
+    """So that running one in a checkout, Jupyter saving it as kept, leaves git's copy."""
+    notebook = nbformat.read(path, as_version=4)
+    assert notebook.metadata["msdlab"] == {"save_outputs": False}
+    for cell in notebook.cells:
+        assert cell.metadata == {}
+        if cell.cell_type == "code":
+            assert cell.outputs == [] and cell.execution_count is None, cell.source
+
+
+@pytest.mark.parametrize("path", RUN, ids=lambda path: path.stem)
 def test_checked_cells_hold_their_outputs(path):
     """A checked cell saved without outputs would compare nothing: a silent pass."""
     notebook = nbformat.read(path, as_version=4)
@@ -45,7 +59,7 @@ def test_checked_cells_hold_their_outputs(path):
         assert all(output.output_type != "error" for output in cell.outputs), cell.source
 
 
-@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)
+@pytest.mark.parametrize("path", RUN, ids=lambda path: path.stem)
 def test_saved_outputs_are_text_and_say_nothing_of_this_machine(path):
     text = path.read_text(encoding="utf-8")
     assert "image/png" not in text and "text/html" not in text

@@ -1,4 +1,5 @@
-"""pytest runs the notebooks in this folder with nbval, in this Python.
+"""pytest runs the notebooks in this folder (built with their outputs by notebooks/build.py)
+with nbval, in this Python.
 
 Lax mode: a notebook passes if no cell raises, and the cells marked
 ``# NBVAL_CHECK_OUTPUT`` print what the saved notebook shows. The options are
