@@ -18,7 +18,7 @@ LAYERS = [
     ("analysis · interaction", "measured stable dt, convergence · ground, walls, grab"),
     ("msdlab", "the package: re-exports the two layers below (import msdlab as msd)"),
     ("scenes · course", "ready simulations · task loading, checks' feedback, pytest plugin"),
-    ("viz", "pictures, animations, the live view"),
+    ("viz · jupyter_extension", "pictures, animations, the live view · Jupyter server side"),
     ("instructor", "templates, release, grading, sandbox, Gradescope, validate"),
     ("commands · cli", "msdlab demo, scenes, run, check, grade, ..."),
 ]

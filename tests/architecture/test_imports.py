@@ -9,7 +9,8 @@ The layers, lowest first; a module may import its own layer and the layers below
 1. ``msdlab.analysis`` and ``msdlab.interaction``, built on the core
 2. the package ``msdlab`` itself (its ``__init__`` re-exports 0 and 1)
 3. ``msdlab.scenes`` and ``msdlab.course``
-4. ``msdlab.viz``
+4. ``msdlab.viz`` and ``msdlab.jupyter_extension`` (the Jupyter server's side of the live
+   view and of the course's notebooks)
 5. ``msdlab.instructor``
 6. ``msdlab.commands``
 7. ``msdlab.cli``, the process settings it makes (``msdlab.process``) and ``msdlab.__main__``
@@ -32,6 +33,7 @@ LAYERS = {
     "scenes": 3,
     "course": 3,
     "viz": 4,
+    "jupyter_extension": 4,
     "instructor": 5,
     "commands": 6,
     "cli": 7,
