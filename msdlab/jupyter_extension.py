@@ -10,8 +10,8 @@ arrive in pairs and unevenly. The extension swaps the kernel websocket connectio
 (``--ServerApp.kernel_websocket_connection_class``).
 
 A course notebook marked to be kept without outputs (`msdlab.course.notebook_file`) is
-saved without them (`save_as_kept`), so running one in a checkout of the course leaves
-git's copy unchanged.
+saved without them under its own name (`save_as_kept`), so running one in a checkout of
+the course leaves git's copy unchanged; a copy saved under another name keeps its outputs.
 
 The package installs ``msdlab/jupyter-config/msdlab.json`` as
 ``<sys.prefix>/etc/jupyter/jupyter_server_config.d/msdlab.json`` (editable installs
@@ -22,11 +22,12 @@ too), which enables the extension in every Jupyter server of the environment
 from __future__ import annotations
 
 import asyncio
+from pathlib import PurePosixPath
 from typing import Any
 
 from jupyter_server.services.kernels.connection.channels import ZMQChannelsWebsocketConnection
 
-from .course.notebook_file import as_kept, is_marked
+from .course.notebook_file import as_kept, marked_name, unmarked
 
 SETTING = "kernel_websocket_connection_class"
 
@@ -45,10 +46,18 @@ def _jupyter_server_extension_points() -> list[dict[str, str]]:
     return [{"module": "msdlab.jupyter_extension"}]
 
 
-def save_as_kept(model: dict[str, Any], **_: Any) -> None:
-    """Jupyter's pre-save hook: a marked course notebook is written without its outputs."""
-    if model.get("type") == "notebook" and is_marked(model.get("content") or {}):
-        as_kept(model["content"])
+def save_as_kept(model: dict[str, Any], path: str = "", **_: Any) -> None:
+    """Jupyter's pre-save hook: a course notebook saved as the file it is marked for is
+    written without its outputs; saved as another file (``path``, from the server's root),
+    it loses the mark and keeps them."""
+    notebook = model.get("content") or {}
+    name = marked_name(notebook) if model.get("type") == "notebook" else None
+    if name is None:
+        return
+    if name == PurePosixPath(path).name:
+        as_kept(notebook, name)
+    else:
+        unmarked(notebook)
 
 
 def _load_jupyter_server_extension(server: Any) -> None:

@@ -30,7 +30,7 @@ from pathlib import Path
 import nbformat
 from nbformat import NotebookNode
 
-from msdlab.course.notebook_file import MARK, METADATA
+from msdlab.course.notebook_file import METADATA, mark
 
 HERE = Path(__file__).resolve().parent
 SOURCES = HERE / "src"
@@ -121,7 +121,7 @@ def keep_text(notebook: NotebookNode) -> None:
 def kept(source: Path) -> str:
     """The text of ``notebooks/NAME.ipynb`` for ``source``: not run, marked to save no outputs."""
     notebook = skeleton(source)
-    notebook.metadata.update(nbformat.from_dict(MARK))
+    notebook.metadata.update(nbformat.from_dict(mark(f"{source.stem}.ipynb")))
     return nbformat.writes(notebook) + "\n"
 
 

@@ -1,10 +1,12 @@
 """A course notebook as the course's repository keeps it: cells without outputs.
 
-``notebooks/build.py`` writes each notebook in this form, marked in its metadata
-(``"msdlab": {"save_outputs": false}``). msdlab's Jupyter server extension writes a
-marked notebook in the same form whenever Jupyter saves it (`as_kept`), so running
-it in a checkout leaves the file as git has it. The student release drops the mark
-(`unmarked`): there a notebook keeps its outputs, as in any Jupyter.
+``notebooks/build.py`` writes each notebook in this form, marked in its metadata with
+its own file name (``"msdlab": {"save_outputs": false, "file": "task2.ipynb"}``).
+msdlab's Jupyter server extension writes a marked notebook in the same form whenever
+Jupyter saves it under that name (`as_kept`), so running it in a checkout leaves the file
+as git has it; saved under another name (a copy to keep one's outputs), it drops the mark.
+The student release drops the mark too (`unmarked`): there a notebook keeps its outputs,
+as in any Jupyter.
 """
 
 from __future__ import annotations
@@ -16,18 +18,24 @@ METADATA: dict[str, Any] = {
     "kernelspec": {"display_name": "Python 3", "language": "python", "name": "python3"},
     "language_info": {"name": "python"},
 }
-MARK: dict[str, Any] = {"msdlab": {"save_outputs": False}}
 
 
-def is_marked(notebook: dict[str, Any]) -> bool:
-    """Whether ``notebook`` (as JSON) is kept without outputs."""
-    return notebook.get("metadata", {}).get("msdlab", {}).get("save_outputs") is False
+def mark(name: str) -> dict[str, Any]:
+    """The metadata marking a notebook to be kept without outputs as the file ``name``."""
+    return {"msdlab": {"save_outputs": False, "file": name}}
 
 
-def as_kept(notebook: dict[str, Any]) -> None:
-    """Reduce ``notebook`` (as JSON, in place) to its kept form: the cells' sources and ids,
-    no outputs, execution counts or cell metadata, and build.py's metadata with the mark."""
-    notebook["metadata"] = {**METADATA, **MARK}
+def marked_name(notebook: dict[str, Any]) -> str | None:
+    """The file name ``notebook`` (as JSON) is marked to be kept as; None if unmarked."""
+    found = notebook.get("metadata", {}).get("msdlab", {})
+    return found.get("file") if found.get("save_outputs") is False else None
+
+
+def as_kept(notebook: dict[str, Any], name: str) -> None:
+    """Reduce ``notebook`` (as JSON, in place) to its kept form as the file ``name``: the
+    cells' sources and ids, no outputs, execution counts or cell metadata, and build.py's
+    metadata with the mark."""
+    notebook["metadata"] = {**METADATA, **mark(name)}
     for cell in notebook["cells"]:
         cell["metadata"] = {}
         if cell["cell_type"] == "code":

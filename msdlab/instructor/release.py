@@ -196,6 +196,6 @@ def _write_for_students(source: Path, target: Path) -> None:
     """Copy a notebook without outputs or execution counts (a run in the checkout shows the
     solutions'), unmarked: the students' Jupyter saves their outputs (`notebook_file`)."""
     notebook = json.loads(source.read_text(encoding="utf-8"))
-    notebook_file.as_kept(notebook)
+    notebook_file.as_kept(notebook, source.name)
     notebook_file.unmarked(notebook)
     target.write_text(json.dumps(notebook, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")

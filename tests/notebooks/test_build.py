@@ -39,7 +39,7 @@ def test_every_task_and_scene_has_a_notebook():
 def test_the_notebooks_people_open_hold_no_outputs_and_say_so(path):
     """So that running one in a checkout, Jupyter saving it as kept, leaves git's copy."""
     notebook = nbformat.read(path, as_version=4)
-    assert notebook.metadata["msdlab"] == {"save_outputs": False}
+    assert notebook.metadata["msdlab"] == {"save_outputs": False, "file": path.name}
     for cell in notebook.cells:
         assert cell.metadata == {}
         if cell.cell_type == "code":

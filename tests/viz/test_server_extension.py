@@ -111,6 +111,22 @@ def test_an_edit_of_a_course_notebook_is_saved(tmp_path):
     assert saved["cells"][0]["source"] == ["# My notes"]
 
 
+def test_a_course_notebook_saved_under_another_name_keeps_its_outputs(tmp_path):
+    """Save As: the copy is the user's own notebook, no longer git's, and keeps what it shows;
+    saved again, it still does."""
+    tracked = json.loads((ROOT / "notebooks" / "task2.ipynb").read_text())
+    ran = after_a_run(
+        tracked, json.loads((ROOT / "docs" / "notebooks" / "task2.ipynb").read_text())
+    )
+    outputs = [cell.get("outputs") for cell in ran["cells"]]
+    (tmp_path / "mine").mkdir()
+    saved = json.loads(save(tmp_path, "mine/task2 with outputs.ipynb", ran))
+    assert [cell.get("outputs") for cell in saved["cells"]] == outputs
+    assert "msdlab" not in saved["metadata"]
+    again = json.loads(save(tmp_path, "mine/task2 with outputs.ipynb", saved))
+    assert [cell.get("outputs") for cell in again["cells"]] == outputs
+
+
 def test_other_notebooks_keep_their_outputs(tmp_path):
     run = json.loads((ROOT / "docs" / "notebooks" / "task2.ipynb").read_text())
     assert "msdlab" not in run["metadata"]
