@@ -104,11 +104,10 @@ class Dynamics:
                 force.add_to(self.body, x, v, total)
             else:
                 field += g
-        masses, free, a = self.body.masses, ~self.body.fixed, np.empty_like(x)
-        for q in range(x.shape[1]):  # by coordinate: numpy is fastest on whole columns
-            along_q = total[:, q] + masses * field[q] if field[q] else total[:, q]
-            a[:, q] = equations.acceleration(along_q, masses, free)
-        return a
+        masses = self.body.masses[:, None]
+        if field.any():
+            total += masses * field
+        return equations.acceleration(total, masses, ~self.body.fixed[:, None])
 
     def advance(
         self, update: Update, x: np.ndarray, v: np.ndarray, dt: float, *coefficients: float
