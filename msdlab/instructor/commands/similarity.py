@@ -21,6 +21,7 @@ from .. import intake
 
 TEMPLATES = PROJECT_ROOT / "assignments"
 THRESHOLD = 0.5  # similarity from which a pair is flagged, by default
+PRINTED = 10  # pairs printed, most similar first (the page and the CSV have them all)
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -81,7 +82,7 @@ def write_report(
     threshold: float = THRESHOLD,
 ) -> None:
     """Compare the submissions in ``folders`` (id -> folder); write out/similarity.html and
-    out/similarity.csv and print the flagged pairs."""
+    out/similarity.csv and print the most similar pairs."""
     require_copydetect()
     if not 0.0 < threshold <= 1.0:
         raise ValueError(f"--threshold is a similarity between 0 and 1, got {threshold}")
@@ -89,13 +90,34 @@ def write_report(
         raise FileNotFoundError(f"no template folder at {template}; give --template DIR")
     from .. import similarity, similarity_report
 
-    pairs = similarity.compare(folders, template)
+    texts, left_out = {}, []
+    for student, folder in folders.items():
+        texts[student], problems = similarity.task_texts(folder)
+        left_out += [f"{student}: {problem}" for problem in problems]
+    pairs = similarity.compare(texts, template)
     out.mkdir(parents=True, exist_ok=True)
     similarity.write_csv(pairs, out / "similarity.csv", threshold)
-    similarity_report.write_html(pairs, out / "similarity.html", len(folders), threshold)
-    flagged = [pair for pair in pairs if pair.flagged(threshold)]
-    print(f"{len(flagged)} of {len(pairs)} pairs of task files flagged (similarity >= {threshold})")
-    for pair in flagged:
-        first, second = pair.students
-        print(f"  {pair.task_file}  {first} and {second}  similarity {pair.similarity:.2f}")
+    similarity_report.write_html(pairs, out / "similarity.html", len(folders), threshold, left_out)
+    print(ranked_list(pairs, threshold))
+    for line in left_out[:PRINTED]:
+        print(f"  not compared: {line}")
+    if len(left_out) > PRINTED:
+        print(f"  ... {len(left_out) - PRINTED} more files not compared (the page lists them)")
     print(f"report written to {out / 'similarity.html'} and {out / 'similarity.csv'}")
+
+
+def ranked_list(pairs: list, threshold: float) -> str:
+    """The lines to print: how many pairs are flagged, and the `PRINTED` most similar."""
+    flagged = sum(pair.flagged(threshold) for pair in pairs)
+    lines = [
+        f"{flagged} of {len(pairs)} pairs of students flagged (similarity >= {threshold}, "
+        "over all task files or in one)"
+    ]
+    top = [pair for pair in pairs[:PRINTED] if max(pair.matched) > 0]
+    width = max((len(" and ".join(p.students)) for p in top), default=0)
+    for rank, pair in enumerate(top, 1):
+        files = ", ".join(f"{f.task_file[:-3]} {f.similarity:.2f}" for f in pair.files)
+        mark = "flagged" if pair.flagged(threshold) else "       "
+        lines.append(f"{rank:>3}. {' and '.join(pair.students):<{width}}  "
+                     f"{pair.similarity:.2f}  {mark}  ({files})")  # fmt: skip
+    return "\n".join(lines)

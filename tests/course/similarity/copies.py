@@ -9,7 +9,12 @@ imports, goes before the first answer):
 - ``renamed``: ``original`` with every local variable of the answers renamed;
 - ``reordered``: ``original`` with the functions of each file in reverse order;
 - ``honest_loops``: the alternatives of ``tests/course/alternatives`` (loops);
-- ``honest_masks``: ``tests/course/similarity/honest`` (tasks 2 and 4; the others unanswered).
+- ``honest_masks``: ``tests/course/similarity/honest`` (vectorised: masks, padding, einsum,
+  a quaternion, closed forms);
+- ``honest_plain``: ``tests/course/similarity/plain`` (plain Python and helpers: np.diff,
+  a sparse incidence matrix, a bisecting search, base-3 offsets, velocity form).
+
+The three honest students wrote each task independently of the reference and of each other.
 """
 
 from __future__ import annotations
@@ -24,7 +29,7 @@ from msdlab.course import PROJECT_ROOT, TASKS
 HERE = Path(__file__).parent
 TEMPLATES = PROJECT_ROOT / "assignments"
 COPIES = ("renamed", "reordered")
-HONEST = ("original", "honest_loops", "honest_masks")
+HONEST = ("original", "honest_loops", "honest_masks", "honest_plain")
 RENAMES = {  # how the copier renamed the locals of the answers
     "a": "acc", "axis": "dim", "first": "lower", "second": "upper", "d": "diff",
     "length": "dist", "direction": "unit", "f": "force", "steps": "choices",
@@ -41,6 +46,7 @@ def write_class(folder: Path) -> dict[str, Path]:
         "original": {t: strip_markers(PROJECT_ROOT / "solutions" / f"task{t}.py") for t in TASKS},
         "honest_loops": {t: answered(t, HERE.parent / "alternatives") for t in TASKS},
         "honest_masks": {t: answered(t, HERE / "honest") for t in TASKS},
+        "honest_plain": {t: answered(t, HERE / "plain") for t in TASKS},
     }
     students["renamed"] = {t: renamed(s) for t, s in students["original"].items()}
     students["reordered"] = {t: reordered(s) for t, s in students["original"].items()}
