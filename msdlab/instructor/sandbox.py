@@ -246,12 +246,13 @@ class SandboxProcess:
                 str(self.scratch / "scratch"),
                 str(self.scratch / "lib"),
             )
-        child = f"{library}/msdlab/instructor/{CHILD.name}"
+        package = f"{library}/msdlab"  # the guard resolves the link to where it really is
+        child = f"{package}/instructor/{CHILD.name}"
         config = {
             "folder": folder,
             "scratch": scratch,
             "sys_path": [library, *sites],
-            "read_roots": [folder, library, sys.prefix, sys.base_prefix, *sites],
+            "read_roots": [folder, library, package, sys.prefix, sys.base_prefix, *sites],
             "memory_bytes": self.memory_bytes,
             "cpu_seconds": int(max(600.0, 100 * self.timeout)),  # a whole set of checks
             "in_fd": to_child,

@@ -29,12 +29,14 @@ def main(config: dict[str, Any]) -> None:
 
     import numpy  # noqa: F401  trusted libraries load before the guard
     import scipy.linalg
-    import scipy.sparse  # noqa: F401
+    import scipy.sparse
+    import scipy.sparse.linalg  # noqa: F401  what the engine imports only when used
 
     import msdlab  # noqa: F401
     from msdlab.course import delegation
     from msdlab.instructor import wire
 
+    _load_engine()
     delegation.install()  # before the submission is imported: see msdlab.course.delegation
 
     _install_guard(config["read_roots"], config["scratch"])
@@ -53,6 +55,44 @@ def _die_with_parent() -> None:
         ctypes.CDLL(None).prctl(1, int(signal.SIGKILL))  # PR_SET_PDEATHSIG
     if os.getppid() != parent:  # the grader died before we asked
         os._exit(1)
+
+
+NOT_ENGINE = frozenset({
+    "instructor", "course", "viz", "scenes", "commands", "compiled", "cli", "__main__",
+    "jupyter_extension",
+})  # fmt: skip
+"""The parts of msdlab a submission's calls do not need: the grader's and the course's
+tools, the pictures, and the numba kernel (the sandbox runs the numpy kernel)."""
+
+
+def _load_engine() -> None:
+    """Import every module of the engine now, before the guard and the submission: its calls
+    never need a file read once the submission's code has run (``msdlab`` imports its
+    names on first use, the guard refuses files outside its roots, and the submission
+    may have changed how its process imports)."""
+    import importlib
+
+    for name in engine_modules():
+        importlib.import_module(name)
+
+
+def engine_modules() -> list[str]:
+    """The names of the engine's modules: msdlab's, but for the parts in `NOT_ENGINE`."""
+    import pkgutil
+
+    import msdlab
+
+    names, folders = [], [(list(msdlab.__path__), "msdlab.")]
+    while folders:
+        path, prefix = folders.pop()
+        for module in pkgutil.iter_modules(path, prefix):
+            if module.name.removeprefix("msdlab.").split(".")[0] in NOT_ENGINE:
+                continue
+            names.append(module.name)
+            if module.ispkg:
+                inside = [os.path.join(folder, module.name.rsplit(".", 1)[-1]) for folder in path]
+                folders.append((inside, module.name + "."))
+    return sorted(names)
 
 
 MAX_PROCESSES = 32  # of the sandbox's user: threads and helpers, not a fork bomb

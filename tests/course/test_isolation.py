@@ -20,7 +20,7 @@ import pytest
 
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
-from msdlab.instructor import sandbox
+from msdlab.instructor import sandbox, sandbox_child
 
 CHECKS = PROJECT_ROOT / "tests" / "tasks"
 MARKER = "msdlab-hostile-helper"
@@ -219,3 +219,24 @@ def test_the_weaker_isolation_is_named_in_every_row_and_the_summary(tmp_path, ca
     rows = {row["id"]: row for row in csv.DictReader(out.open())}
     assert "weaker isolation 'process'" in rows["nobody"]["notes"]
     assert "isolation: process" in capsys.readouterr().out
+
+
+def test_the_engine_is_loaded_before_the_submission_runs(tmp_path):
+    """Nothing a submission's calls need is read once its code has run: the process sandbox's
+    guard refuses files outside its roots, and the submission may have changed how its
+    process imports."""
+    (tmp_path / "task1.py").write_text(
+        "import sys\n"
+        "LOADED = sorted(name for name in sys.modules if name.startswith('msdlab'))\n"
+        "def loaded():\n"
+        "    return LOADED\n"
+    )
+    remote = sandbox.RemoteImplementation(tmp_path, isolation="process", timeout=60.0)
+    try:
+        loaded = set(remote.task(1).loaded())
+    finally:
+        remote.close()
+    engine = set(sandbox_child.engine_modules())
+    assert {"msdlab.simulation", "msdlab.analysis", "msdlab.interaction.contact"} <= engine
+    assert not {name for name in engine if name.startswith("msdlab.instructor")}
+    assert engine - loaded == set()
