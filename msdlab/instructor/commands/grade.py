@@ -14,7 +14,9 @@ the CSV (id,task,change,reason) are applied after every run. Rows of earlier
 runs in the CSV are kept, a submission graded again gets its row replaced,
 and --resume skips those already graded with the same checks. --feedback DIR
 writes DIR/students/ID.md (to hand out), DIR/instructor/ID.md (everything)
-and DIR/summary.md (over every row of the CSV). Exit status 0 if every
+and DIR/summary.md (over every row of the CSV). Every run writes the class at a
+glance beside the CSV (GRADES.class.html: points per task, each check's failure rate,
+the usual causes, a check x student map, hand-in times not verified). Exit status 0 if every
 submission was graded, 1 if some could not be (their notes say why), 2 if the
 grader itself failed (its sandbox could not start, or an error of its own, named
 in the notes: no student feedback file is written for those submissions; fix it
@@ -36,7 +38,16 @@ from tqdm.auto import tqdm
 
 from ...analysis.cluster import parse_cluster
 from ...course import PROJECT_ROOT, TASKS, own_numbers
-from .. import feedback, final_points, gradebook, grading, intake, sandbox, term_options
+from .. import (
+    class_report,
+    feedback,
+    final_points,
+    gradebook,
+    grading,
+    intake,
+    sandbox,
+    term_options,
+)
 from ..cluster_grading import grade_all_on_cluster
 from . import similarity
 
@@ -193,8 +204,12 @@ def run(args: argparse.Namespace) -> int:
             grades = grading.grade_all(graded, checks, jobs=jobs, progress=progress, **options)
         explained = save()
         grades = unusable + grades
+        rows = class_report.rows_of(book, grades)
+        page = class_report.beside(args.out)
+        class_report.write_html(rows, book.maximum, page)
         if args.feedback is not None:
-            write_feedback(args.feedback, grades, entries, book)
+            section = class_report.summary_section(rows, os.path.relpath(page, args.feedback))
+            write_feedback(args.feedback, grades, entries, book, section)
             final_points.refresh_feedback(
                 args.feedback, book.rows, explained, book.maximum.get("total", "")
             )
@@ -210,6 +225,7 @@ def run(args: argparse.Namespace) -> int:
     print(
         f"grades written to {args.out}" + (f" ({kept} rows of earlier runs kept)" if kept else "")
     )
+    print(f"class report written to {class_report.beside(args.out)}")
     failed = [grade for grade in grades if grade.grader_failed]
     if failed:
         print(grader_failure(failed), file=sys.stderr)
@@ -238,9 +254,10 @@ def write_feedback(
     grades: list[grading.Grade],
     entries: dict[str, intake.Entry],
     book: gradebook.Gradebook,
+    class_section: str = "",
 ) -> None:
     """DIR/students/ID.md (none where the grader failed), DIR/instructor/ID.md, and
-    DIR/summary.md over every row of ``book``."""
+    DIR/summary.md over every row of ``book``, ``class_section`` at its end."""
     for kind in ("students", "instructor"):
         (folder / kind).mkdir(parents=True, exist_ok=True)
     for grade in (shown(g, entries[g.submission]) for g in grades):
@@ -254,7 +271,7 @@ def write_feedback(
         (folder / "instructor" / f"{stem}.md").write_text(
             feedback.for_instructor(grade, source), encoding="utf-8"
         )
-    summary = feedback.class_summary(book, grades)
+    summary = feedback.class_summary(book, grades) + class_section
     (folder / "summary.md").write_text(summary, encoding="utf-8")
 
 

@@ -1,0 +1,366 @@
+"""The class at a glance after grading: one offline HTML page and a section of summary.md.
+
+The page (`write_html`, no network: its style inline, its pictures PNG data URIs) shows
+the points per task (a histogram each and their numbers), each check's failure rate over
+the students graded with it, the usual causes the failing checks named ("Usual cause: ..."
+in their messages) and how many students each, a check × student map, the students whose
+hand-in time could not be verified and those not graded. `summary_section` gives the same
+findings as Markdown.
+
+It reads `ClassRow`s, one per row of the gradebook (`rows_of`): a row's per-check results
+come from this run's reports where the student was graded in it (with the causes), else
+from the gradebook's per-check columns (``--detail``), else they are not known.
+"""
+
+from __future__ import annotations
+
+import base64
+import collections
+import html
+import io
+import re
+import statistics
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from ..course import TASKS
+from .gradebook import Gradebook, check_column
+from .grading import Grade
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+TRUSTED_SOURCES = ("Gradescope's submission time",)
+"""Hand-in times the student's own machine did not set (see `handin.NAMES`)."""
+UNKNOWN_TIME = "hand-in time unknown"
+CAUSE = re.compile(r"Usual cause: ([^\n]*?)\.?\s*(?:\n|$)")
+LISTED = 10
+"""Students named per usual cause (the count covers all of them)."""
+PASSED, FAILED, NOT_RUN = 0, 1, 2  # a cell of the check × student map
+
+
+@dataclass(frozen=True)
+class CheckOutcome:
+    """One check's result for one student; ``cause`` the usual cause it named when failing."""
+
+    task: int
+    name: str
+    passed: bool
+    cause: str | None = None
+
+    @property
+    def column(self) -> str:
+        return check_column(self.task, self.name)
+
+
+@dataclass(frozen=True)
+class ClassRow:
+    """One student's row: points by task, total, check results (empty: not known), and why
+    their hand-in time could not be verified (None: it could, or no due date needs it)."""
+
+    id: str
+    graded: bool
+    points: dict[int, float]
+    total: float
+    checks: tuple[CheckOutcome, ...]
+    unverified: str | None
+    notes: str = ""
+
+
+def rows_of(book: Gradebook, grades: Sequence[Grade]) -> list[ClassRow]:
+    """Every row of ``book`` as a `ClassRow`, its checks from ``grades`` (this run's) where
+    the student was graded in it, else from the book's per-check columns."""
+    reports = {g.submission: g.report for g in grades if g.report is not None}
+    rows = []
+    for identifier in sorted(book.rows):
+        row = book.rows[identifier]
+        if identifier in reports:
+            checks = tuple(
+                CheckOutcome(c.task, c.name, c.passed, None if c.passed else cause_of(c.message))
+                for c in reports[identifier].checks
+            )
+        else:
+            checks = _from_columns(row, book)
+        rows.append(
+            ClassRow(
+                identifier,
+                bool(row.get("fingerprint")),
+                {t: float(row.get(f"task{t}") or 0) for t in TASKS},
+                float(row.get("total") or 0),
+                checks,
+                unverified(row),
+                row.get("notes", ""),
+            )
+        )
+    return rows
+
+
+def _from_columns(row: dict[str, str], book: Gradebook) -> tuple[CheckOutcome, ...]:
+    outcomes = []
+    for column in (c for c in book.detail_columns if row.get(c)):
+        task, name = column.split(" ", 1)
+        passed = float(row[column]) >= float(book.maximum[column])
+        outcomes.append(CheckOutcome(int(task.removeprefix("task")), name, passed))
+    return tuple(outcomes)
+
+
+def cause_of(message: str) -> str | None:
+    """The usual cause a failing check's message names, or None."""
+    found = CAUSE.search(message or "")
+    return found.group(1).strip() if found else None
+
+
+def unverified(row: dict[str, str]) -> str | None:
+    """Why a row's hand-in time could not be verified: not known, or (where a due date
+    applies) read from a clock the student's machine set."""
+    late = row.get("late", "")
+    if late.startswith(UNKNOWN_TIME) or UNKNOWN_TIME in row.get("notes", ""):
+        return "hand-in time unknown"
+    source = row.get("handed_in_from", "")
+    if row.get("due") and source and source not in TRUSTED_SOURCES:
+        return f"hand-in time from the {source}, which the student's machine set"
+    return None
+
+
+@dataclass(frozen=True)
+class CheckRate:
+    """How many of the students graded with a check failed it."""
+
+    column: str
+    failed: int
+    graded: int
+
+    @property
+    def rate(self) -> float:
+        return self.failed / self.graded if self.graded else 0.0
+
+
+def failure_rates(rows: Sequence[ClassRow]) -> list[CheckRate]:
+    """Each check's failure rate over the graded rows that have its result, worst first."""
+    failed, having = collections.Counter(), collections.Counter()
+    for row in (r for r in rows if r.graded):
+        for check in row.checks:
+            having[check.column] += 1
+            failed[check.column] += not check.passed
+    rates = [CheckRate(column, failed[column], having[column]) for column in having]
+    return sorted(rates, key=lambda r: (-r.rate, -r.failed, r.column))
+
+
+def usual_causes(rows: Sequence[ClassRow]) -> list[tuple[str, list[str]]]:
+    """Each usual cause the failing checks named and the students who had it, most first."""
+    students = collections.defaultdict(set)
+    for row in (r for r in rows if r.graded):
+        for check in row.checks:
+            if check.cause:
+                students[check.cause].add(row.id)
+    return sorted(((c, sorted(s)) for c, s in students.items()), key=lambda i: (-len(i[1]), i[0]))
+
+
+def unverified_groups(rows: Sequence[ClassRow]) -> list[tuple[str, list[str]]]:
+    """The students whose hand-in time could not be verified, by reason, most first."""
+    students = collections.defaultdict(list)
+    for row in (r for r in rows if r.unverified):
+        students[row.unverified].append(row.id)
+    return sorted(students.items(), key=lambda item: (-len(item[1]), item[0]))
+
+
+def task_statistics(rows: Sequence[ClassRow]) -> list[tuple[str, list[float]]]:
+    """The points of every graded row per task, then the totals: [(column, points), ...]."""
+    graded = [r for r in rows if r.graded]
+    columns = [(f"task{t}", [r.points[t] for r in graded]) for t in TASKS]
+    return [*columns, ("total", [r.total for r in graded])]
+
+
+def summary_section(rows: Sequence[ClassRow], page: str) -> str:
+    """The class report's findings as a Markdown section of summary.md."""
+    lines = ["", "## The class at a glance", "", f"Pictures and every check: `{page}`.", ""]
+    causes = usual_causes(rows)
+    if causes:
+        lines += ["Usual causes the failing checks named:", ""]
+        lines += [f"- {cause}: {len(ids)} ({_named(ids)})" for cause, ids in causes]
+        lines.append("")
+    doubtful = unverified_groups(rows)
+    count = sum(len(ids) for _, ids in doubtful)
+    lines.append(f"Hand-in time not verified: {count}" + (":" if doubtful else "."))
+    lines += [f"- {reason}: {len(ids)} ({_named(ids)})" for reason, ids in doubtful]
+    missing = [r for r in rows if not r.graded]
+    if missing:
+        lines += ["", f"Not graded: {len(missing)}:"]
+        lines += [f"- {r.id}: {r.notes or 'no reason recorded'}" for r in missing]
+    return "\n".join(lines) + "\n"
+
+
+def _named(ids: list[str]) -> str:
+    more = f", and {len(ids) - LISTED} more" if len(ids) > LISTED else ""
+    return ", ".join(ids[:LISTED]) + more
+
+
+def beside(grades_file: Path) -> Path:
+    """Where the class report of a grades file goes: grades.csv -> grades.class.html."""
+    return grades_file.with_name(f"{grades_file.stem}.class.html")
+
+
+def write_html(rows: Sequence[ClassRow], maximum: dict[str, str], path: Path) -> None:
+    """The class report, one offline HTML file, to ``path``; ``maximum`` is the gradebook's
+    row of the points each column is worth."""
+    graded = [r for r in rows if r.graded]
+    columns = task_statistics(rows)
+    body = [
+        "<h1>The class at a glance</h1>",
+        f"<p>{len(graded)} of {len(rows)} students graded. It reports; it changes no points.</p>",
+        "<h2>Points per task</h2>",
+        _picture(histograms(columns, maximum), "points per task") if graded else "",
+        _statistics_table(columns, maximum) if graded else "",
+        "<h2>Checks failed most often</h2>",
+        _rates_table(failure_rates(rows)),
+        "<h2>Usual causes</h2>",
+        _causes_table(usual_causes(rows)),
+        "<h2>Checks × students</h2>",
+        _heatmap_part(rows),
+        "<h2>Hand-in time not verified</h2>",
+        _list(
+            [f"{why}: {len(ids)} ({', '.join(ids)})" for why, ids in unverified_groups(rows)],
+            "none",
+        ),
+        "<h2>Not graded</h2>",
+        _list([f"{r.id}: {r.notes or 'no reason recorded'}" for r in rows if not r.graded], "none"),
+    ]
+    page = (
+        '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+        f"<title>The class at a glance</title><style>{STYLE}</style></head><body>\n"
+        + "\n".join(part for part in body if part)
+        + "\n</body></html>\n"
+    )
+    path.write_text(page, encoding="utf-8")
+
+
+STYLE = """
+body { font-family: system-ui, sans-serif; margin: 1.5em; color: #222; max-width: 75em; }
+table { border-collapse: collapse; margin: 1em 0; }
+th, td { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; vertical-align: top; }
+td.number { text-align: right; font-variant-numeric: tabular-nums; }
+img { max-width: 100%; height: auto; }
+.bar { display: inline-block; height: 0.8em; background: #d9534f; }
+"""
+
+
+def _statistics_table(columns: list[tuple[str, list[float]]], maximum: dict[str, str]) -> str:
+    head = "<tr><th></th><th>worth</th><th>mean</th><th>median</th><th>min</th><th>max</th></tr>"
+    rows = [
+        f"<tr><th>{name}</th>"
+        + "".join(
+            f'<td class="number">{value}</td>'
+            for value in (
+                maximum.get(name, ""),
+                f"{statistics.mean(points):.1f}",
+                f"{statistics.median(points):g}",
+                f"{min(points):g}",
+                f"{max(points):g}",
+            )
+        )
+        + "</tr>"
+        for name, points in columns
+    ]
+    return f"<table>{head}{''.join(rows)}</table>"
+
+
+def _rates_table(rates: list[CheckRate]) -> str:
+    if not rates:
+        return "<p>No check results are known (grade with --detail to keep them).</p>"
+    passed = sum(not r.failed for r in rates)
+    rates = [r for r in rates if r.failed]
+    rest = f"<p>{passed} checks passed by every student graded with them.</p>" if passed else ""
+    head = "<tr><th>check</th><th>failed by</th><th>of</th><th>rate</th></tr>"
+    rows = [
+        f"<tr><td>{html.escape(r.column)}</td><td class='number'>{r.failed}</td>"
+        f"<td class='number'>{r.graded}</td><td><span class='bar' style='width: "
+        f"{r.rate * 8:.2f}em'></span> {r.rate:.0%}</td></tr>"
+        for r in rates
+    ]
+    return (f"<table>{head}{''.join(rows)}</table>" if rows else "") + rest
+
+
+def _causes_table(causes: list[tuple[str, list[str]]]) -> str:
+    if not causes:
+        return "<p>No failing check named a usual cause.</p>"
+    head = "<tr><th>usual cause</th><th>students</th><th>who</th></tr>"
+    rows = [
+        f"<tr><td>{html.escape(cause)}</td><td class='number'>{len(ids)}</td>"
+        f"<td>{html.escape(_named(ids))}</td></tr>"
+        for cause, ids in causes
+    ]
+    return f"<table>{head}{''.join(rows)}</table>"
+
+
+def _list(lines: list[str], empty: str) -> str:
+    if not lines:
+        return f"<p>{empty}</p>"
+    return "<ul>" + "".join(f"<li>{html.escape(line)}</li>" for line in lines) + "</ul>"
+
+
+def _heatmap_part(rows: Sequence[ClassRow]) -> str:
+    known = [r for r in rows if r.graded and r.checks]
+    if not known:
+        return "<p>No check results are known (grade with --detail to keep them).</p>"
+    return _picture(heatmap(known), "checks by students: green passed, red failed, grey not run")
+
+
+def _picture(figure: Figure, text: str) -> str:
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=100)
+    encoded = base64.b64encode(buffer.getvalue()).decode("ascii")
+    return f'<p><img alt="{html.escape(text)}" src="data:image/png;base64,{encoded}"></p>'
+
+
+def histograms(columns: list[tuple[str, list[float]]], maximum: dict[str, str]) -> Figure:
+    """One histogram of points per task and one of the totals (matplotlib, no display)."""
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(12, 6), layout="constrained")
+    axes = figure.subplots(2, (len(columns) + 1) // 2).ravel()
+    for ax, (name, points) in zip(axes, columns):
+        top = float(maximum.get(name) or max(points) or 1)
+        width = max(1.0, top / 20)  # at most 20 bars, each at least one point wide
+        edges = [i * width - width / 2 for i in range(int(top / width) + 2)]
+        ax.hist(points, bins=edges, color="#4a7fb5", edgecolor="white")
+        ax.set(title=f"{name} (worth {top:g})", xlabel="points", ylabel="students")
+        ax.set_xlim(-width, top + width)
+        ax.yaxis.get_major_locator().set_params(integer=True)
+    for ax in axes[len(columns) :]:
+        ax.set_visible(False)
+    return figure
+
+
+def heatmap(rows: Sequence[ClassRow]) -> Figure:
+    """Checks (rows, by task) × students (columns, lowest total first): passed, failed,
+    not run."""
+    from matplotlib.colors import ListedColormap
+    from matplotlib.figure import Figure
+
+    columns = sorted({c.column for r in rows for c in r.checks}, key=_check_order)
+    students = sorted(rows, key=lambda r: (r.total, r.id))
+    where = {column: i for i, column in enumerate(columns)}
+    cells = [[NOT_RUN] * len(students) for _ in columns]
+    for j, row in enumerate(students):
+        for check in row.checks:
+            cells[where[check.column]][j] = PASSED if check.passed else FAILED
+    width = min(4 + 0.25 * len(students), 30)
+    figure = Figure(figsize=(width, 1.5 + 0.18 * len(columns)), layout="constrained")
+    ax = figure.subplots()
+    colours = ListedColormap(["#5cb85c", "#d9534f", "#dddddd"])
+    ax.imshow(cells, cmap=colours, vmin=0, vmax=2, aspect="auto", interpolation="nearest")
+    ax.set_yticks(range(len(columns)), columns, fontsize=7)
+    if len(students) <= 60:
+        ax.set_xticks(range(len(students)), [r.id for r in students], rotation=90, fontsize=7)
+    else:
+        ax.set_xticks([])
+        ax.set_xlabel(f"{len(students)} students, lowest total on the left")
+    ax.set_title("checks × students: green passed, red failed, grey not run")
+    return figure
+
+
+def _check_order(column: str) -> tuple[int, str]:
+    task, name = column.split(" ", 1)
+    return int(task.removeprefix("task")), name
