@@ -166,10 +166,14 @@ def unverified_groups(rows: Sequence[ClassRow]) -> list[tuple[str, list[str]]]:
     return sorted(students.items(), key=lambda item: (-len(item[1]), item[0]))
 
 
-def task_statistics(rows: Sequence[ClassRow]) -> list[tuple[str, list[float]]]:
-    """The points of every graded row per task, then the totals: [(column, points), ...]."""
+def task_statistics(
+    rows: Sequence[ClassRow], maximum: dict[str, str]
+) -> list[tuple[str, list[float]]]:
+    """The points of every graded row per task the checks grade (worth more than 0 in
+    ``maximum``, the gradebook's row of what each column is worth), then the totals."""
     graded = [r for r in rows if r.graded]
-    columns = [(f"task{t}", [r.points[t] for r in graded]) for t in TASKS]
+    tasks = [t for t in TASKS if float(maximum.get(f"task{t}") or 0) > 0]
+    columns = [(f"task{t}", [r.points[t] for r in graded]) for t in tasks]
     return [*columns, ("total", [r.total for r in graded])]
 
 
@@ -206,7 +210,7 @@ def write_html(rows: Sequence[ClassRow], maximum: dict[str, str], path: Path) ->
     """The class report, one offline HTML file, to ``path``; ``maximum`` is the gradebook's
     row of the points each column is worth."""
     graded = [r for r in rows if r.graded]
-    columns = task_statistics(rows)
+    columns = task_statistics(rows, maximum)
     body = [
         "<h1>The class at a glance</h1>",
         f"<p>{len(graded)} of {len(rows)} students graded. It reports; it changes no points.</p>",
@@ -327,6 +331,7 @@ def histograms(columns: list[tuple[str, list[float]]], maximum: dict[str, str]) 
         ax.hist(points, bins=edges, color="#4a7fb5", edgecolor="white")
         ax.set(title=f"{name} (worth {top:g})", xlabel="points", ylabel="students")
         ax.set_xlim(-width, top + width)
+        ax.xaxis.get_major_locator().set_params(integer=True)
         ax.yaxis.get_major_locator().set_params(integer=True)
     for ax in axes[len(columns) :]:
         ax.set_visible(False)
@@ -346,7 +351,7 @@ def heatmap(rows: Sequence[ClassRow]) -> Figure:
     for j, row in enumerate(students):
         for check in row.checks:
             cells[where[check.column]][j] = PASSED if check.passed else FAILED
-    width = min(4 + 0.25 * len(students), 30)
+    width = min(6 + 0.22 * len(students), 30)  # inches: the check names, then the students
     figure = Figure(figsize=(width, 1.5 + 0.18 * len(columns)), layout="constrained")
     ax = figure.subplots()
     colours = ListedColormap(["#5cb85c", "#d9534f", "#dddddd"])
@@ -357,7 +362,7 @@ def heatmap(rows: Sequence[ClassRow]) -> Figure:
     else:
         ax.set_xticks([])
         ax.set_xlabel(f"{len(students)} students, lowest total on the left")
-    ax.set_title("checks × students: green passed, red failed, grey not run")
+    ax.set_title("green passed, red failed, grey not run", fontsize=9)
     return figure
 
 
