@@ -40,7 +40,10 @@ def run(args: argparse.Namespace) -> int:
     scene = get_scene("jelly-cube")
     sim = scene.build(size=args.size)
     limit = max_stable_dt(sim.body, sim.integrator)
-    print(f"jelly cube: {sim.body}, {sim.integrator!r}, dt = {sim.dt:g} (stable below {limit:.3g})")
+    print(
+        f"jelly cube: {sim.body}, {sim.integrator!r}, dt = {sim.dt:g} {scene.unit} (the "
+        f"engine predicts this integrator stable below dt = {limit:.3g} {scene.unit})"
+    )
     with step_bar(args.steps, "jelly cube") as bar:
         trajectory = sim.run(
             steps=args.steps,
@@ -48,6 +51,7 @@ def run(args: argparse.Namespace) -> int:
             callback=lambda s: bar(s.step_count),
         )
     print(trajectory.energies.table(rows=8))
+    print(legend(trajectory.energies.dissipated, scene.unit, scene.energy_unit))
     args.out.mkdir(parents=True, exist_ok=True)
     animation = save_animation(
         trajectory,
@@ -76,3 +80,36 @@ def run(args: argparse.Namespace) -> int:
         "`msdlab run trampoline --experiments`, `msdlab run cloth --save cloth.gif`."
     )
     return 0
+
+
+COLUMNS = {
+    "time": "time simulated so far",
+    "kinetic": "½ m v², summed over the particles",
+    "elastic": "½ k (|x_i - x_j| - l)², summed over the springs",
+    "potential": "-m g·x, the gravitational energy (0 at the floor y = 0)",
+    "total": "kinetic + elastic + potential: the energy in the body",
+    "drift": "the integrator's own error, total + all taken out - total at the start (ideally 0)",
+}
+TAKEN_OUT = {
+    "dashpot": "the springs' dashpots",
+    "integrator": "the integrator's damping λ",
+    "ground": "the floor (contact and friction)",
+    "viscous": "drag on every particle",
+    "drag": "the hand dragging a particle",
+    "walls": "the walls",
+    "driven": "a driven particle",
+}
+
+
+def legend(taken_out: dict, time_unit: str, energy_unit: str) -> str:
+    """What the ledger's columns are, with their units: the energies in the body, what each
+    mechanism in ``taken_out`` took out so far, and the drift."""
+    rows = [(name, COLUMNS[name]) for name in ("time", "kinetic", "elastic", "potential", "total")]
+    rows += [
+        (name, f"taken out so far by {TAKEN_OUT.get(name, name)}") for name in sorted(taken_out)
+    ]
+    rows.append(("drift", COLUMNS["drift"]))
+    width = max(len(name) for name, _ in rows)
+    lines = [f"time in {time_unit}, energies in {energy_unit} (unit masses):"]
+    lines += [f"  {name:<{width}}  {meaning}" for name, meaning in rows]
+    return "\n".join(lines)

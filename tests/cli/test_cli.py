@@ -120,6 +120,13 @@ def test_demo_writes_animation_and_plot(tmp_path, capsys):
     assert main(args) == 0
     out = capsys.readouterr().out
     assert "kinetic" in out
+    assert re.search(r"dt = 0.4 template units \(the engine predicts this integrator stable "
+                     r"below dt = [\d.]+ template units\)", out)  # fmt: skip
+    header = next(line for line in out.splitlines() if line.split()[:2] == ["time", "kinetic"])
+    legend = out[out.index("time in template units, energies in template units") :]
+    for column in header.split():  # every column of the ledger is explained below it
+        assert re.search(rf"^  {column} +\S", legend, re.M), column
+    assert "taken out so far by the integrator's damping λ" in legend
     for name in ("demo.gif", "demo_energy.png"):
         assert (tmp_path / name).stat().st_size > 1000
         assert str((tmp_path / name).resolve()) in out
