@@ -16,7 +16,8 @@ import math
 import numpy as np
 
 N = 20  # particles per edge (the original also ran N = 30)
-SPACING = 2.0 / N  # grid spacing h
+EDGE = 2.0  # edge length of the grid's cube: x and z in [-1, 1)
+SPACING = EDGE / N  # grid spacing h
 ORIGIN = (-1.0, 1.5, -1.0)  # position of particle (0, 0, 0)
 DT = 0.1  # time step
 GRAVITY = (0.0, -0.001, 0.0)  # the template's acceleration a
@@ -33,15 +34,15 @@ SCHEMES = (
 
 # --------------------------------------------------------------------------- given code
 def initial_grid(n: int = N) -> np.ndarray:
-    """Positions (n, n, n, 3) of the template's grid, ``coord / n * 2 - 1 + (0, 2.5, 0)``.
+    """Positions (n, n, n, 3) of the template's grid: ``ORIGIN + (EDGE / n)·(i, j, k)``.
 
-    Particle (i, j, k) sits at (-1, 1.5, -1) + (2/n)·(i, j, k): x and z in
-    [-1, 1), y in [1.5, 3.5).
+    Particle (i, j, k) sits at ORIGIN + (EDGE/n)·(i, j, k): x and z in [-1, 1),
+    y in [1.5, 1.5 + EDGE).
     """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise ValueError(f"n is the number of particles per edge, an integer >= 1; got {n!r}")
     coord = np.stack(np.meshgrid(*3 * [np.arange(n)], indexing="ij"), axis=-1)
-    return coord / n * 2.0 - 1.0 + np.array([0.0, 2.5, 0.0])
+    return np.asarray(ORIGIN, dtype=float) + (EDGE / n) * coord
 
 
 def msd_kernel(
@@ -146,10 +147,10 @@ def steps_to_floor(y0: float = ORIGIN[1], dt: float = DT, g: float = GRAVITY[1])
     """After how many template steps a particle at rest at height ``y0`` first reaches the floor.
 
     That is the first step n whose new height (before the clamp) is <= 0: the
-    step in which the floor clamp first acts on it. For the bottom layer of the
-    template (y0 = 1.5) this is close to 547. Needs y0 > 0, g < 0 and dt > 0:
-    raise ValueError otherwise (a particle that starts on or below the floor, or
-    does not fall, has no first contact to count).
+    step in which the floor clamp first acts on it. For the bottom layer of
+    your template (y0 = ORIGIN[1] = 1.5) this is close to 547.
+    Needs y0 > 0, g < 0 and dt > 0: raise ValueError otherwise (a particle that
+    starts on or below the floor, or does not fall, has no first contact to count).
     """
     raise NotImplementedError(
         "Task 1: return the first step after which the particle is at or below the floor y = 0."

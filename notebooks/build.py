@@ -1,8 +1,7 @@
 """Build the notebooks from their sources: ``notebooks/src/NAME.py`` -> two notebooks.
 
-A source is a Python file in the percent format: ``# %%`` starts a code cell,
-``# %% [markdown]`` a Markdown cell whose lines are comments (``# text``). Each
-source makes
+A source is a Python file in the percent format (`msdlab.course.notebook_source`),
+the numbers a student reads written as markers ``{{ name }}``. Each source makes
 
 - ``notebooks/NAME.ipynb``, the notebook people open: no outputs, marked so that
   Jupyter saves it without them (`msdlab.course.notebook_file`), so running it in a
@@ -21,61 +20,27 @@ source makes
 from __future__ import annotations
 
 import argparse
-import hashlib
 import os
-import re
 import sys
 from pathlib import Path
 
 import nbformat
 from nbformat import NotebookNode
 
+from msdlab.course import notebook_source
 from msdlab.course.notebook_file import METADATA, mark
 
 HERE = Path(__file__).resolve().parent
 SOURCES = HERE / "src"
 ROOT = HERE.parent
 RUN = ROOT / "docs" / "notebooks"  # the notebooks run, with their text outputs
-MARKER = re.compile(r"# %%(?P<markdown> \[markdown\])?\s*$")
 TEXT_ONLY = {"text/plain"}  # output data kept in the saved notebooks
 
 
-def cells(text: str) -> list[NotebookNode]:
-    """The cells of a percent-format source, with ids made from their content."""
-    chunks: list[tuple[bool, list[str]]] = []
-    for number, line in enumerate(text.splitlines(), 1):
-        marker = MARKER.match(line)
-        if marker:
-            chunks.append((bool(marker["markdown"]), []))
-        elif chunks:
-            chunks[-1][1].append(line)
-        elif line.strip():
-            raise ValueError(f"line {number}: text before the first '# %%' cell marker")
-    made, seen = [], set()
-    for markdown, lines in chunks:
-        source = "\n".join(_markdown(lines) if markdown else lines).strip("\n")
-        if not source.strip():
-            continue
-        digest = hashlib.sha1(source.encode()).hexdigest()[:8]
-        cell_id = digest if digest not in seen else f"{digest}-{len(made)}"
-        seen.add(cell_id)
-        new = nbformat.v4.new_markdown_cell if markdown else nbformat.v4.new_code_cell
-        made.append(new(source, id=cell_id))
-    return made
-
-
-def _markdown(lines: list[str]) -> list[str]:
-    """Comment lines ``# text`` -> ``text``."""
-    for line in lines:
-        if line.strip() and not line.startswith("#"):
-            raise ValueError(f"a Markdown cell holds a line that is not a comment: {line!r}")
-    return [line[2:] if line.startswith("# ") else line[1:] for line in lines]
-
-
 def skeleton(source: Path) -> NotebookNode:
-    """The notebook of ``source``, not yet run."""
+    """The notebook of ``source`` with the course's numbers, not yet run."""
     notebook = nbformat.v4.new_notebook(metadata=METADATA)
-    notebook.cells = cells(source.read_text(encoding="utf-8"))
+    notebook.cells = [nbformat.from_dict(cell) for cell in notebook_source.notebook_cells(source)]
     return notebook
 
 

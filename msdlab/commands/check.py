@@ -16,7 +16,7 @@ import shutil
 import tempfile
 from pathlib import Path
 
-from ..course import TASKS, manifest
+from ..course import TASKS, manifest, own_numbers
 from ..course.loader import ENV_IMPL
 from ..course.report import CheckReport
 from ..course.runner import (
@@ -94,6 +94,9 @@ def run(args: argparse.Namespace) -> int:
     print(f"msdlab check: {scope} on {folder}")
     if spec == "solutions":
         print(f"  (the reference answers, not your task files: asked by --impl or ${ENV_IMPL})")
+    own = own_numbers.announced(folder)
+    if own is not None:
+        print(f"  with {own}")
     with tempfile.TemporaryDirectory(prefix="msdlab-check-") as scratch:
         points = Path(scratch) / manifest.FILE_NAME
         try:

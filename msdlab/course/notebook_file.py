@@ -13,10 +13,20 @@ from __future__ import annotations
 
 from typing import Any
 
-# The notebook metadata build.py writes: any Python 3 kernel, no versions of this machine.
+# The notebook metadata build.py writes: the kernel ``python3`` that ipykernel installs in
+# every environment with JupyterLab, named as ipykernel names it, so that JupyterLab opens a
+# notebook on it without asking and does not rename it when it saves; the language as the
+# kernel describes it, but for the version of this machine's Python.
 METADATA: dict[str, Any] = {
-    "kernelspec": {"display_name": "Python 3", "language": "python", "name": "python3"},
-    "language_info": {"name": "python"},
+    "kernelspec": {"display_name": "Python 3 (ipykernel)", "language": "python", "name": "python3"},
+    "language_info": {
+        "codemirror_mode": {"name": "ipython", "version": 3},
+        "file_extension": ".py",
+        "mimetype": "text/x-python",
+        "name": "python",
+        "nbconvert_exporter": "python",
+        "pygments_lexer": "ipython3",
+    },
 }
 
 

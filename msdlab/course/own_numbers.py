@@ -10,6 +10,11 @@ the student's ``msdlab check`` and the grader agree without sharing a file:
   template's acceleration g (``GRAVITY[1]``, -0.001);
 - task 4: the grid size n of the cost measurement (6 by default).
 
+The numbers a student reads (the task files' docstrings, the notebooks' text) are written
+as markers ``{{ name }}`` in the solutions and the notebooks' sources and filled in from
+the same `Numbers` (`filled`, `shown`): the defaults in the course's checkout, the
+student's own in their release.
+
 Off by default: the switch is ``"own_numbers": true`` in the course's settings file
 ``course.json`` (at the course root), read by ``msdlab release`` and ``msdlab grade``.
 A release for one student writes their id into ``assignments/student.json``; the checks
@@ -21,6 +26,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,6 +36,9 @@ STUDENT_FILE = "student.json"
 HEIGHTS = tuple(round(1.2 + 0.1 * i, 1) for i in range(9))  # y0: 1.2 ... 2.0
 ACCELERATIONS = (-0.0008, -0.0009, -0.001, -0.0011, -0.0012)  # g
 COST_SIZES = (5, 6, 7, 8)  # n of task 4's step_cost check
+DT = 0.1  # task 1: the template's time step, the same for everyone
+MARKER = re.compile(r"\{\{ *(\w+) *\}\}")
+"""A number to fill in, ``{{ name }}``: one of `shown`'s names."""
 
 
 @dataclass(frozen=True)
@@ -58,6 +67,11 @@ def numbers(student: str | None) -> Numbers:
     )
 
 
+def course_of(checks: Path) -> Path:
+    """The course folder whose settings apply to the checks in ``checks`` (``tests/tasks``)."""
+    return Path(checks).resolve().parent.parent
+
+
 def enabled(course: Path) -> bool:
     """Whether the course at ``course`` gives each student their own numbers (its settings)."""
     path = Path(course) / SETTINGS_FILE
@@ -73,9 +87,34 @@ def enabled(course: Path) -> bool:
     return switch
 
 
+def shown(own: Numbers) -> dict[str, str]:
+    """The numbers a student reads, by marker name: ``y0`` (the bottom layer's height),
+    ``g`` (the template's acceleration), ``parabola_step`` (the step in which the exact
+    free fall y0 + ½ g t² reaches the floor, t = n·DT: close to the template's answer)."""
+    return {
+        "y0": repr(own.bottom),
+        "g": repr(own.gravity),
+        "parabola_step": str(math.floor(math.sqrt(2.0 * own.bottom / -own.gravity) / DT)),
+    }
+
+
+def filled(text: str, own: Numbers, where: str = "the text") -> str:
+    """``text`` with every marker ``{{ name }}`` replaced by ``own``'s number of that name."""
+    numbers = shown(own)
+    unknown = sorted({name for name in MARKER.findall(text) if name not in numbers})
+    if unknown:
+        raise ValueError(
+            f"{where}: no number named {', '.join(unknown)} to fill in; the markers "
+            f"{{{{ name }}}} take one of {', '.join(numbers)}"
+        )
+    return MARKER.sub(lambda match: numbers[match[1]], text)
+
+
 def personalised(task: int, source: str, own: Numbers) -> str:
-    """The template (or solution) text of ``task`` with ``own`` numbers in its constants."""
-    if task != 1 or own == DEFAULT:
+    """The template (or solution) text of ``task`` with ``own`` numbers in its constants
+    and in its markers (`filled`)."""
+    source = filled(source, own, f"task{task}.py")
+    if task != 1:
         return source
     replaced = {
         "ORIGIN": f"(-1.0, {own.bottom!r}, -1.0)",
@@ -107,3 +146,17 @@ def student_of(folder: Path) -> str | None:
     if not isinstance(student, str) or not student.strip():
         raise ValueError(f'{path} should hold {{"id": "your roster id"}}; ask for a new release')
     return student
+
+
+def announced(folder: Path) -> str | None:
+    """The line that tells a student the checks of the task files in ``folder`` use their own
+    numbers (from its ``student.json``), and which; None where they use the course's."""
+    student = student_of(folder)
+    if student is None:
+        return None
+    own = numbers(student)
+    return (
+        f"your own numbers (student {student}): task 1 y0 = ORIGIN[1] = {own.bottom!r} and "
+        f"g = GRAVITY[1] = {own.gravity!r}; task 4's step_cost is checked on a "
+        f"{own.cost_size}×{own.cost_size}×{own.cost_size} grid"
+    )

@@ -13,7 +13,9 @@ The template keeps everything outside the blocks (signature, type hints,
 docstring, given code) and replaces each block by
 ``raise NotImplementedError("Task 1: count the particles of an n × n × n grid.")``.
 The ``# TODO:`` comment (it may go on over further ``#`` lines) is required: it
-is what the student reads when a check calls the unfinished function.
+is what the student reads when a check calls the unfinished function. The numbers a
+student reads are markers ``{{ name }}`` filled in from the course's or the student's
+own numbers (`own_numbers.filled`).
 """
 
 from __future__ import annotations
@@ -23,6 +25,8 @@ import re
 import textwrap
 from dataclasses import dataclass
 from pathlib import Path
+
+from ..course import own_numbers
 
 BEGIN = "### BEGIN SOLUTION"
 END = "### END SOLUTION"
@@ -84,10 +88,15 @@ def solution_files(solutions: Path) -> list[Path]:
     return sorted(files, key=task_number)
 
 
-def render(solutions: Path) -> dict[str, str]:
-    """The template text of every task file of ``solutions``, by file name."""
+def render(solutions: Path, own: own_numbers.Numbers = own_numbers.DEFAULT) -> dict[str, str]:
+    """The template text of every task file of ``solutions``, by file name, with the
+    numbers ``own`` (the course's defaults unless a student's own, `own_numbers`)."""
     return {
-        path.name: make_template(path.read_text(encoding="utf-8"), task_number(path), str(path))
+        path.name: own_numbers.personalised(
+            task_number(path),
+            make_template(path.read_text(encoding="utf-8"), task_number(path), str(path)),
+            own,
+        )
         for path in solution_files(solutions)
     }
 

@@ -5,7 +5,7 @@
 #
 # The template is a crude particle system: a cube of $N \times N \times N$
 # particles ($N = 20$) lifted above the floor $y = 0$ falls under a constant
-# acceleration $\mathbf{a} = (0, -0.001, 0)$ with a time step $\Delta t = 0.1$.
+# acceleration $\mathbf{a} = (0, {{ g }}, 0)$ with a time step $\Delta t = 0.1$.
 # The original ran one GPU thread per particle; `task1.py` holds the same code
 # in numpy (`initial_grid`, `msd_kernel`, `run_template`) and the questions,
 # which you answer as short functions. `msdlab check 1` grades them.
@@ -32,7 +32,7 @@ print(f"task files: {course.label}")
 # %% [markdown]
 # ## The template
 #
-# Particle $(i, j, k)$ starts at $(-1, 1.5, -1) + h\,(i, j, k)$ with spacing
+# Particle $(i, j, k)$ starts at $(-1, {{ y0 }}, -1) + h\,(i, j, k)$ with spacing
 # $h = 2/N$; three position buffers (old, current, new) rotate after every
 # step, and old = current at the start, so the grid starts at rest. This is
 # the kernel every particle runs:
@@ -48,22 +48,23 @@ for axis, name in enumerate("xyz"):
     print(f"{name} from {grid[..., axis].min():.2f} to {grid[..., axis].max():.2f}")
 
 # %% [markdown]
-# Run the template for 850 steps and follow the mean height of the bottom and
-# the top layer of particles:
+# Run the template until every particle has landed and follow the mean height of
+# the bottom and the top layer of particles:
 
 # %%
 old, current = grid.copy(), grid.copy()
 new = np.empty_like(grid)
 layers, first_clamped = [], None
-for step in range(1, 851):
+while current[..., 1].max() > task1.FLOOR and len(layers) < 5000:
     task1.msd_kernel(old, current, new)
     old, current, new = current, new, old
     layers.append((current[:, 0, :, 1].mean(), current[:, -1, :, 1].mean()))
     if first_clamped is None and current[..., 1].min() <= task1.FLOOR:
-        first_clamped = step
+        first_clamped = len(layers)
+landed = len(layers)  # the steps until the top layer is on the floor too
 
 fig, ax = plt.subplots(figsize=(7, 3.5))
-ax.plot(np.arange(1, 851), layers, label=["bottom layer", "top layer"])
+ax.plot(np.arange(1, landed + 1), layers, label=["bottom layer", "top layer"])
 ax.axhline(task1.FLOOR, color="k", lw=0.8)
 ax.set(xlabel="step", ylabel="height y", title="The template's grid falls and lands")
 ax.legend()
@@ -107,15 +108,17 @@ with course.attempt():
 # **Where is a particle after $n$ steps?** From rest, the template moves it by
 # $g\,\Delta t^2$ in the first step, $2g\,\Delta t^2$ in the second, ...
 # `height_after(n)` is compared with a single particle run by the template
-# (floor left out: it starts at y = 1.5 and is still above it at n = 500):
+# (floor left out: it starts at $y_0 = {{ y0 }}$, and the last $n$, the last hundred
+# steps before the bottom layer lands, keeps it above the floor):
 
 # %%
 # NBVAL_CHECK_OUTPUT
+counts = (1, 2, 10, 100, 100 * (first_clamped // 100))
 with course.attempt():
-    yours = [task1.height_after(steps) for steps in (1, 2, 10, 100, 500)]
+    yours = [task1.height_after(steps) for steps in counts]
     print(f"{'steps':>5} {'yours':>10} {'template':>10}")
-    for steps, height in zip((1, 2, 10, 100, 500), yours):
-        template = task1.run_template(steps, n=1)[0, 0, 0, 1]  # one particle, at y = 1.5
+    for steps, height in zip(counts, yours):
+        template = task1.run_template(steps, n=1)[0, 0, 0, 1]  # one particle, at y0
         print(f"{steps:>5} {height:>10.6f} {template:>10.6f}")
 
 # %% [markdown]
@@ -140,8 +143,9 @@ with course.attempt():
 body = msd.Body.from_arrays(grid.reshape(-1, 3))
 forces = [msd.Gravity(task1.GRAVITY), msd.Ground(task1.FLOOR)]
 sim = msd.Simulation(body, msd.Verlet(), task1.DT, forces)
-run = sim.run(steps=850, record_every=25)
-print("engine = template after 850 steps:", np.allclose(body.positions, current.reshape(-1, 3)))
+run = sim.run(steps=landed, record_every=25)
+same = np.allclose(body.positions, current.reshape(-1, 3))
+print(f"engine = template after {landed} steps:", same)
 print(f"highest particle now at y = {body.positions[:, 1].max():.2f}")
 
 # %% [markdown]

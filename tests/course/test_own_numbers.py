@@ -6,17 +6,19 @@ the default, the checks and the release are those of the template."""
 from __future__ import annotations
 
 import json
+import re
 import shutil
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 from modules import module_at
 
 from msdlab.course import PROJECT_ROOT, oracles, own_numbers
 from msdlab.course.report import CheckReport
-from msdlab.instructor import grading, release
+from msdlab.instructor import grading, release, templates
 
 CHECKS = PROJECT_ROOT / "tests" / "tasks"
 TEMPLATE_1 = (PROJECT_ROOT / "assignments" / "task1.py").read_text(encoding="utf-8")
@@ -65,14 +67,96 @@ def test_the_defaults_are_the_templates_numbers():
 
 def test_own_template_changes_only_its_numbers():
     alice = own_numbers.numbers("alice")
-    own = own_numbers.personalised(1, TEMPLATE_1, alice)
+    own = templates.render(PROJECT_ROOT / "solutions", alice)["task1.py"]
     changed = [(a, b) for a, b in zip(TEMPLATE_1.splitlines(), own.splitlines()) if a != b]
+    shown = own_numbers.shown(alice)
     assert changed == [
         ("ORIGIN = (-1.0, 1.5, -1.0)  # position of particle (0, 0, 0)",
          f"ORIGIN = (-1.0, {alice.bottom}, -1.0)  # position of particle (0, 0, 0)"),
         ("GRAVITY = (0.0, -0.001, 0.0)  # the template's acceleration a",
          f"GRAVITY = (0.0, {alice.gravity}, 0.0)  # the template's acceleration a"),
+        ("    y in [1.5, 1.5 + EDGE).", f"    y in [{alice.bottom}, {alice.bottom} + EDGE)."),
+        ("    your template (y0 = ORIGIN[1] = 1.5) this is close to 547.",
+         f"    your template (y0 = ORIGIN[1] = {alice.bottom}) this is close to "
+         f"{shown['parabola_step']}."),
     ]  # fmt: skip
+
+
+@pytest.mark.parametrize("student", ["alice", "carol", "dave"])
+def test_the_given_code_runs_on_the_students_own_numbers(student, tmp_path):
+    """The template's given code computes from its constants: the student's own grid starts
+    at their y0, and their running template reaches the floor in the step the check asks
+    for, close to the step the docstring names."""
+    own = own_numbers.numbers(student)
+    text = templates.render(PROJECT_ROOT / "solutions", own)["task1.py"]
+    (tmp_path / "task1.py").write_text(text, encoding="utf-8")
+    template = module_at(tmp_path / "task1.py", f"own_task1_{student}")
+    grid = template.initial_grid(4)
+    assert grid[:, 0, :, 1].min() == pytest.approx(own.bottom, abs=1e-12)
+    old, current, new = grid.copy(), grid.copy(), np.empty_like(grid)
+    step = 0
+    while current[..., 1].min() > template.FLOOR:
+        template.msd_kernel(old, current, new)
+        old, current, new = current, new, old
+        step += 1
+    expected = oracles.template_run(
+        oracles.template_positions((3, 2, 3), 0.1, (-1.0, own.bottom, -1.0)), 1000,
+        acceleration=(0.0, own.gravity, 0.0),
+    )  # fmt: skip
+    assert step == int(np.flatnonzero(expected[:, :, 0, :, 1].min(axis=(1, 2)) <= 0.0)[0])
+    assert abs(step - int(own_numbers.shown(own)["parabola_step"])) <= 2
+
+
+def test_a_student_reads_no_number_of_the_defaults_where_theirs_differ(tmp_path):
+    """The release of a student whose numbers both differ from the defaults: their
+    task1.py and task1 notebook show their numbers, none of the defaults', and no marker."""
+    student = next(s for s in ("alice", "bob", "carol", "dave", "erin") if different(s))
+    own = own_numbers.numbers(student)
+    (tmp_path / "course").mkdir()
+    course = shutil.copytree(PROJECT_ROOT, tmp_path / "course", dirs_exist_ok=True,
+                             ignore=shutil.ignore_patterns(".venv", ".git", "_build"))  # fmt: skip
+    (course / own_numbers.SETTINGS_FILE).write_text('{"own_numbers": true}')
+    out = tmp_path / "release"
+    release.build(out, course, student=student)
+    task1 = (out / "assignments" / "task1.py").read_text(encoding="utf-8")
+    notebook = "\n".join(
+        cell["source"]
+        for cell in json.loads((out / "notebooks" / "task1.ipynb").read_text())["cells"]
+    )
+    default = own_numbers.shown(own_numbers.DEFAULT)
+    for text in (task1, notebook):
+        assert "{{" not in text and number_in(str(own.bottom), text)
+        assert not number_in(default["y0"], text) and not number_in(default["g"], text)
+    assert not number_in(default["parabola_step"], task1)
+    assert number_in(own_numbers.shown(own)["parabola_step"], task1)
+    assert f"(0, {own.gravity}, 0)" in notebook
+
+
+def number_in(number: str, text: str) -> list[str]:
+    """The lines of ``text`` where ``number`` stands as a number of its own."""
+    pattern = re.compile(rf"(?<![\d.]){re.escape(number)}(?![\d])")
+    return [line for line in text.splitlines() if pattern.search(line)]
+
+
+def different(student: str) -> bool:
+    own, default = own_numbers.numbers(student), own_numbers.DEFAULT
+    return own.bottom != default.bottom and own.gravity != default.gravity
+
+
+def test_an_unknown_marker_is_refused_with_the_names_it_takes():
+    with pytest.raises(ValueError, match=r"task1\.py: no number named y1 .* y0, g"):
+        own_numbers.filled("y = {{ y1 }}", own_numbers.DEFAULT, "task1.py")
+
+
+def test_msdlab_check_says_the_numbers_are_the_students_own(tmp_path):
+    assert own_numbers.announced(tmp_path) is None
+    own_numbers.write_student(tmp_path, "alice")
+    alice = own_numbers.numbers("alice")
+    line = own_numbers.announced(tmp_path)
+    assert "your own numbers (student alice)" in line
+    assert (
+        f"y0 = ORIGIN[1] = {alice.bottom}" in line and f"g = GRAVITY[1] = {alice.gravity}" in line
+    )
 
 
 def test_each_passes_against_their_own_numbers_and_fails_against_the_others(tmp_path):
@@ -109,7 +193,7 @@ def test_the_settings_switch_is_checked(tmp_path):
 
 def test_a_release_for_one_student_holds_their_numbers(tmp_path):
     assignments = shutil.copytree(PROJECT_ROOT / "assignments", tmp_path / "assignments")
-    release._personalise(assignments, "carol")
+    release._personalise(assignments, PROJECT_ROOT / "solutions", "carol")
     carol = own_numbers.numbers("carol")
     assert f"ORIGIN = (-1.0, {carol.bottom}, -1.0)" in (assignments / "task1.py").read_text()
     assert own_numbers.student_of(assignments) == "carol"

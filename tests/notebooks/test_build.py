@@ -8,6 +8,8 @@ from pathlib import Path
 import nbformat
 import pytest
 
+from msdlab.course import notebook_source
+
 ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))  # to open
 RUN = sorted((ROOT / "docs" / "notebooks").glob("*.ipynb"))  # run, with their outputs
@@ -71,17 +73,17 @@ def test_saved_outputs_are_text_and_say_nothing_of_this_machine(path):
 
 def test_percent_format_makes_markdown_and_code_cells():
     source = "# %% [markdown]\n# # Title\n#\n# Some $x$.\n\n# %%\nx = 1\n\n\n# %%\nprint(x)\n"
-    cells = build.cells(source)
-    assert [c.cell_type for c in cells] == ["markdown", "code", "code"]
-    assert cells[0].source == "# Title\n\nSome $x$."
-    assert cells[1].source == "x = 1"
-    assert len({c.id for c in cells}) == 3
+    cells = notebook_source.cells(source)
+    assert [c["cell_type"] for c in cells] == ["markdown", "code", "code"]
+    assert cells[0]["source"] == "# Title\n\nSome $x$."
+    assert cells[1]["source"] == "x = 1"
+    assert len({c["id"] for c in cells}) == 3
 
 
 def test_cell_ids_follow_the_content_not_the_position():
-    first = build.cells("# %%\na = 1\n# %%\nb = 2\n")
-    inserted = build.cells("# %%\nz = 0\n# %%\na = 1\n# %%\nb = 2\n")
-    assert [c.id for c in first] == [c.id for c in inserted[1:]]
+    first = notebook_source.cells("# %%\na = 1\n# %%\nb = 2\n")
+    inserted = notebook_source.cells("# %%\nz = 0\n# %%\na = 1\n# %%\nb = 2\n")
+    assert [c["id"] for c in first] == [c["id"] for c in inserted[1:]]
 
 
 @pytest.mark.parametrize(
@@ -89,7 +91,7 @@ def test_cell_ids_follow_the_content_not_the_position():
 )
 def test_malformed_sources_are_refused(source):
     with pytest.raises(ValueError):
-        build.cells(source)
+        notebook_source.cells(source)
 
 
 def test_saved_outputs_keep_the_text_joined_and_drop_pictures():
