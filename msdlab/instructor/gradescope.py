@@ -17,6 +17,12 @@ the zip (default ``process``: a separate process with resource limits and the
 audit hook, which needs no privileges and no namespaces the container may lack).
 The root of the tree (``/autograder``) is the environment variable
 ``MSDLAB_AUTOGRADER_ROOT``, so the script can be tried on a copy of the tree.
+
+Own numbers: where the course gives each student their own numbers, the zip carries its
+``course.json``, and each submission is graded against the numbers of its student, whose
+roster id is read from Gradescope's ``submission_metadata.json`` (the user's field the
+setting ``roster_id`` names: ``sid``, the student id of Gradescope's roster, or
+``email``).
 """
 
 from __future__ import annotations
@@ -29,12 +35,14 @@ from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from ..course import TASKS
+from ..course import TASKS, own_numbers
 from ..course.report import CheckResult
 from . import grading
 
 CONFIG = "msdlab-autograder.json"
 HIDDEN_VISIBILITIES = ("after_published", "hidden")
+ROSTER_IDS = ("sid", "email")  # the fields of a Gradescope user that can be the roster id
+METADATA = "submission_metadata.json"
 ROOT_VARIABLE = "MSDLAB_AUTOGRADER_ROOT"
 GRADE_EXTRA = "grade"  # the extra of pyproject.toml that running the checks needs
 
@@ -66,6 +74,7 @@ class Settings:
     timeout: float = 600.0
     call_timeout: float = 60.0
     memory_mb: int = 2048
+    roster_id: str = "sid"
 
     def __post_init__(self) -> None:
         if self.hidden_visibility not in HIDDEN_VISIBILITIES:
@@ -73,22 +82,31 @@ class Settings:
                 f"hidden checks' visibility is one of {', '.join(HIDDEN_VISIBILITIES)}, "
                 f"got {self.hidden_visibility!r}"
             )
+        if self.roster_id not in ROSTER_IDS:
+            raise ValueError(
+                f"the roster id is one of the Gradescope user's fields {', '.join(ROSTER_IDS)}, "
+                f"got {self.roster_id!r}"
+            )
         if self.timeout <= 0 or self.call_timeout <= 0 or self.memory_mb < 256:
             raise ValueError("timeout and call_timeout > 0 s and memory_mb >= 256 MB")
 
 
 def build(out: Path, project: Path, checks: Path, settings: Settings) -> list[str]:
     """Write the autograder zip ``out`` for the msdlab at ``project`` and the checks in
-    ``checks``; return the names it holds."""
+    ``checks`` (with the settings of their course, `own_numbers.course_of`); return the
+    names it holds."""
     if out.suffix != ".zip":
         raise ValueError(f"the autograder is a .zip file, got {out}")
     if not list(checks.glob("test_*.py")):
         raise FileNotFoundError(f"no checks (test_*.py) in {checks}; give --checks DIR")
+    course = own_numbers.course_of(checks)
     out.parent.mkdir(parents=True, exist_ok=True)
     with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as archive:
         _add(archive, "setup.sh", SETUP)
         _add(archive, "run_autograder", RUN_AUTOGRADER)
         _add(archive, CONFIG, json.dumps(asdict(settings), indent=2) + "\n")
+        if own_numbers.enabled(course):
+            archive.write(course / own_numbers.SETTINGS_FILE, own_numbers.SETTINGS_FILE)
         for name in ("pyproject.toml", "README.md"):
             archive.write(project / name, f"msdlab/{name}")
         for path in _files(project / "msdlab"):
@@ -149,14 +167,25 @@ def run_autograder(root: Path) -> dict[str, object]:
     source = root / "source"
     settings = Settings(**json.loads((source / CONFIG).read_text(encoding="utf-8")))
     folder = submission_folder(root / "submission")
-    grade = grading.grade(
-        grading.Submission("submission", folder),
-        source / "checks",
-        timeout=settings.timeout,
-        call_timeout=settings.call_timeout,
-        memory_mb=settings.memory_mb,
-        isolation=settings.isolation,
-    )
+    own = own_numbers.enabled(source)
+    student = roster_id(root / METADATA, settings.roster_id) if own else "submission"
+    if student is None:
+        problem = (
+            f"the autograder found no {settings.roster_id} of yours in Gradescope's submission "
+            "metadata, and each student's work is checked against their own numbers: ask "
+            "your instructor to check the Gradescope roster"
+        )
+        grade = grading.Grade("submission", None, [problem])
+    else:
+        grade = grading.grade(
+            grading.Submission(student, folder),
+            source / "checks",
+            timeout=settings.timeout,
+            call_timeout=settings.call_timeout,
+            memory_mb=settings.memory_mb,
+            isolation=settings.isolation,
+            own_numbers=own,
+        )
     content = results(grade, settings.hidden_visibility)
     target = root / "results" / "results.json"
     target.parent.mkdir(parents=True, exist_ok=True)
@@ -164,6 +193,17 @@ def run_autograder(root: Path) -> dict[str, object]:
     partial.write_text(json.dumps(content, indent=2) + "\n", encoding="utf-8")
     partial.replace(target)
     return content
+
+
+def roster_id(metadata: Path, field: str) -> str | None:
+    """The ``field`` (`ROSTER_IDS`) of the submitting student in Gradescope's submission
+    metadata; None where the file, the student or the field is missing."""
+    try:
+        users = json.loads(metadata.read_text(encoding="utf-8")).get("users") or []
+        found = str(users[0].get(field) or "").strip()
+    except (OSError, ValueError, AttributeError, IndexError):
+        return None
+    return found or None
 
 
 def main(argv: Sequence[str] | None = None) -> int:

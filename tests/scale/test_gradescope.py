@@ -16,8 +16,8 @@ from pathlib import Path
 import pytest
 
 from msdlab.cli import main
-from msdlab.course import PROJECT_ROOT
-from msdlab.instructor.gradescope import ROOT_VARIABLE
+from msdlab.course import PROJECT_ROOT, own_numbers
+from msdlab.instructor.gradescope import METADATA, ROOT_VARIABLE
 
 HOSTILE = """
 import os, sys
@@ -28,11 +28,10 @@ finally:
 """
 
 
-@pytest.fixture(scope="module")
-def autograder(tmp_path_factory: pytest.TempPathFactory, task1_checks: Path) -> Path:
-    """The zip built by the command and unpacked where Gradescope puts it."""
+def unpacked(tmp_path_factory: pytest.TempPathFactory, checks: Path) -> Path:
+    """The zip built by the command for ``checks`` and unpacked where Gradescope puts it."""
     out = tmp_path_factory.mktemp("build") / "autograder.zip"
-    options = ["--checks", str(task1_checks), "--call-timeout", "10"]
+    options = ["--checks", str(checks), "--call-timeout", "10"]
     assert main(["gradescope", str(out), *options]) == 0
     root = tmp_path_factory.mktemp("autograder")
     with zipfile.ZipFile(out) as archive:
@@ -47,10 +46,33 @@ def autograder(tmp_path_factory: pytest.TempPathFactory, task1_checks: Path) -> 
     return root
 
 
-def run_autograder(root: Path, files: dict[str, str], subfolder: str = "") -> dict:
-    """Put ``files`` in the submission folder, run the script as Gradescope would, read results."""
+@pytest.fixture(scope="module")
+def autograder(tmp_path_factory: pytest.TempPathFactory, task1_checks: Path) -> Path:
+    """The zip of task 1's checks, unpacked where Gradescope puts it."""
+    return unpacked(tmp_path_factory, task1_checks)
+
+
+@pytest.fixture(scope="module")
+def own_autograder(tmp_path_factory: pytest.TempPathFactory, task1_checks: Path) -> Path:
+    """The same for a course that gives each student their own numbers (its course.json)."""
+    course = tmp_path_factory.mktemp("course")
+    (course / own_numbers.SETTINGS_FILE).write_text('{"own_numbers": true}')
+    checks = shutil.copytree(task1_checks, course / "tests" / "tasks")
+    root = unpacked(tmp_path_factory, checks)
+    assert own_numbers.enabled(root / "source")
+    return root
+
+
+def run_autograder(
+    root: Path, files: dict[str, str], subfolder: str = "", metadata: dict | None = None
+) -> dict:
+    """Put ``files`` in the submission folder (and Gradescope's ``metadata`` beside it), run
+    the script as Gradescope would, read results."""
     shutil.rmtree(root / "submission", ignore_errors=True)
     shutil.rmtree(root / "results", ignore_errors=True)
+    (root / METADATA).unlink(missing_ok=True)
+    if metadata is not None:
+        (root / METADATA).write_text(json.dumps(metadata))
     folder = root / "submission" / subfolder
     folder.mkdir(parents=True)
     for name, text in files.items():
@@ -102,3 +124,37 @@ def test_the_hidden_checks_can_stay_hidden(tmp_path: Path, task1_checks: Path) -
     with zipfile.ZipFile(out) as archive:
         assert json.loads(archive.read("msdlab-autograder.json"))["hidden_visibility"] == "hidden"
     assert main(["gradescope", str(tmp_path / "autograder.tar"), *options]) == 2
+
+
+def own_task1(student: str) -> dict[str, str]:
+    """The reference answer of task 1 in ``student``'s own release."""
+    own = own_numbers.numbers(student)
+    solution = (PROJECT_ROOT / "solutions" / "task1.py").read_text()
+    return {"task1.py": own_numbers.personalised(1, solution, own)}
+
+
+def gradescope_user(sid: str) -> dict:
+    return {"users": [{"name": "A Student", "email": f"{sid}@example.org", "sid": sid}]}
+
+
+def test_with_own_numbers_each_student_is_graded_against_their_own(own_autograder) -> None:
+    """The zip carries course.json: correct alice gets full marks, with the id from
+    Gradescope's roster; her answers under carol's id miss the floor step."""
+    results = run_autograder(own_autograder, own_task1("alice"), metadata=gradescope_user("alice"))
+    possible = sum(test["max_score"] for test in results["tests"])
+    assert possible > 0 and results["score"] == possible, results["output"]
+    handed = run_autograder(own_autograder, own_task1("alice"), metadata=gradescope_user("carol"))
+    failed = [test["name"] for test in handed["tests"] if test["status"] == "failed"]
+    assert failed == ["Task 1: steps_to_floor_as_template"], handed["output"]
+
+
+def test_with_own_numbers_and_no_roster_id_the_student_is_told_why(own_autograder) -> None:
+    results = run_autograder(own_autograder, own_task1("alice"), metadata={"users": [{}]})
+    assert results["score"] == 0
+    assert "no sid of yours in Gradescope's submission metadata" in results["output"]
+
+
+def test_the_zip_is_not_written_into_the_course_folder(task1_checks: Path) -> None:
+    inside = PROJECT_ROOT / "autograder-test.zip"
+    assert main(["gradescope", str(inside), "--checks", str(task1_checks)]) == 2
+    assert not inside.exists()

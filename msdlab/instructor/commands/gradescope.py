@@ -9,6 +9,10 @@ per-task totals go back to Gradescope. Hidden checks are shown to students
 after the grades are published (or never, with --hidden-visibility hidden).
 The container Gradescope starts for each submission is the isolation
 boundary; the sandbox inside it runs at --isolation (default: process).
+Where the course gives each student their own numbers (its course.json), the zip
+carries that setting and grades each student against the numbers of their
+roster id, taken from Gradescope's roster (--roster-id: the student id, sid, or
+the email). The zip is written outside the course folder, as a release is.
 """
 
 from __future__ import annotations
@@ -16,8 +20,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ...course import PROJECT_ROOT
-from ..gradescope import HIDDEN_VISIBILITIES, Settings, build
+from ...course import PROJECT_ROOT, own_numbers
+from ..gradescope import HIDDEN_VISIBILITIES, ROSTER_IDS, Settings, build
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -54,6 +58,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         "--memory", type=int, default=2048, help="memory limit per submission, MB (%(default)s)"
     )
+    parser.add_argument(
+        "--roster-id",
+        choices=ROSTER_IDS,
+        default="sid",
+        help="with own numbers: the field of Gradescope's roster that holds the id each "
+        "student's release was built with (default: %(default)s, the student id)",
+    )
     parser.set_defaults(run=run)
 
 
@@ -64,9 +75,20 @@ def run(args: argparse.Namespace) -> int:
         timeout=args.timeout,
         call_timeout=args.call_timeout,
         memory_mb=args.memory,
+        roster_id=args.roster_id,
     )
+    out, course = args.out.resolve(), own_numbers.course_of(args.checks)
+    for folder in (PROJECT_ROOT, course):
+        if folder in out.parents and (folder / "solutions").is_dir():
+            raise ValueError(
+                f"write the autograder outside the course folder {folder}, e.g. "
+                f"{folder.parent / args.out.name}"
+            )
     names = build(args.out, PROJECT_ROOT, args.checks, settings)
     checks = sum(1 for name in names if name.startswith("checks/test_"))
     print(f"Gradescope autograder: {len(names)} files ({checks} check files) in {args.out}")
     print("upload it as the assignment's autograder (Configure Autograder > Zip file upload)")
+    if own_numbers.SETTINGS_FILE in names:
+        print(f"with own numbers: each student is graded against the numbers of their "
+              f"{args.roster_id} in Gradescope's roster")  # fmt: skip
     return 0
