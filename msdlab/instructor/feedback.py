@@ -76,11 +76,14 @@ def for_student(grade: Grade) -> str:
     return "\n".join(lines) + "\n"
 
 
-def for_instructor(grade: Grade, source: str = "") -> str:
-    """The Markdown feedback with everything: notes, every check and every message."""
+def for_instructor(grade: Grade, source: str = "", hint: str | None = None) -> str:
+    """The Markdown feedback with everything: notes, every check and every message, and a
+    ``hint`` for the instructor only (whose own numbers the submission holds)."""
     lines = [f"# {grade.submission}", ""]
     if source:
         lines += [f"Handed in: `{source}`", ""]
+    if hint:
+        lines += [f"For you only: {hint}", ""]
     if grade.report is None:
         lines += ["Not graded:", *[f"- {note}" for note in grade.notes]]
         return "\n".join(lines) + "\n"

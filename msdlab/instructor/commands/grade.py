@@ -40,6 +40,7 @@ from ...analysis.cluster import parse_cluster
 from ...course import PROJECT_ROOT, TASKS, own_numbers
 from .. import (
     class_report,
+    copied_numbers,
     feedback,
     final_points,
     gradebook,
@@ -187,13 +188,14 @@ def run(args: argparse.Namespace) -> int:
                        f"{result}  ({grade.seconds:.1f} s)", file=sys.stderr)  # fmt: skip
 
         started = time.monotonic()
+        own = own_numbers.enabled(own_numbers.course_of(checks))
         options = dict(
             timeout=args.timeout,
             call_timeout=args.call_timeout,
             memory_mb=args.memory,
             isolation=args.isolation,
             allow_delegation=_tasks(args.allow_delegation),
-            own_numbers=own_numbers.enabled(checks.parent.parent),  # the course's settings
+            own_numbers=own,
         )
         graded = [grading.Submission(e.id, e.folder) for e in todo]
         if not graded:
@@ -207,9 +209,12 @@ def run(args: argparse.Namespace) -> int:
         rows = class_report.rows_of(book, grades)
         page = class_report.beside(args.out)
         class_report.write_html(rows, book.maximum, page)
+        hints = copied_hints(grades, entries, set(book.rows)) if own else {}
+        for student, hint in hints.items():
+            print(f"{student}: {hint}", file=sys.stderr)
         if args.feedback is not None:
             section = class_report.summary_section(rows, os.path.relpath(page, args.feedback))
-            write_feedback(args.feedback, grades, entries, book, section)
+            write_feedback(args.feedback, grades, entries, book, section, hints)
             final_points.refresh_feedback(
                 args.feedback, book.rows, explained, book.maximum.get("total", "")
             )
@@ -249,15 +254,34 @@ def shown(grade: grading.Grade, entry: intake.Entry) -> grading.Grade:
     return dataclasses.replace(grade, notes=[*entry.notes, *grade.notes])
 
 
+def copied_hints(
+    grades: list[grading.Grade], entries: dict[str, intake.Entry], roster: set[str]
+) -> dict[str, str]:
+    """For the instructor: the submissions whose task 1 constants are not their author's
+    own numbers, and whose they are (`copied_numbers`), among ``roster`` and this run's."""
+    everyone = roster | set(entries)
+    found = {
+        grade.submission: copied_numbers.hint(
+            grade.submission, entries[grade.submission].folder, everyone
+        )
+        for grade in grades
+        if grade.graded
+    }
+    return {student: hint for student, hint in found.items() if hint is not None}
+
+
 def write_feedback(
     folder: Path,
     grades: list[grading.Grade],
     entries: dict[str, intake.Entry],
     book: gradebook.Gradebook,
     class_section: str = "",
+    hints: dict[str, str] | None = None,
 ) -> None:
-    """DIR/students/ID.md (none where the grader failed), DIR/instructor/ID.md, and
-    DIR/summary.md over every row of ``book``, ``class_section`` at its end."""
+    """DIR/students/ID.md (none where the grader failed), DIR/instructor/ID.md (with the
+    ``hints`` for the instructor only), and DIR/summary.md over every row of ``book``,
+    ``class_section`` at its end."""
+    hints = hints or {}
     for kind in ("students", "instructor"):
         (folder / kind).mkdir(parents=True, exist_ok=True)
     for grade in (shown(g, entries[g.submission]) for g in grades):
@@ -269,7 +293,8 @@ def write_feedback(
             student.write_text(feedback.for_student(grade), encoding="utf-8")
         source = intake.escaped(str(entries[grade.submission].source))
         (folder / "instructor" / f"{stem}.md").write_text(
-            feedback.for_instructor(grade, source), encoding="utf-8"
+            feedback.for_instructor(grade, source, hints.get(grade.submission)),
+            encoding="utf-8",
         )
     summary = feedback.class_summary(book, grades) + class_section
     (folder / "summary.md").write_text(summary, encoding="utf-8")
