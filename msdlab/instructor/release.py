@@ -16,8 +16,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-from ..course import TASKS, manifest, notebook_file, own_numbers
+from ..course import manifest, notebook_file, notebook_source, own_numbers
 from ..course.runner import CHECKS
+from . import release_docs, templates
 from .release_rules import shipped_files, solution_leaks, solution_lines
 
 STUDENT_README = """\
@@ -29,19 +30,28 @@ cube, in five staged tasks.
 
 ## Quick start
 
+In a terminal, in this folder (the one holding this README):
+
 ```bash
+python3 -m venv .venv && . .venv/bin/activate
 pip install -e . && msdlab demo
 pip install -e ".[grade]" && msdlab check
 ```
 
-The first command installs msdlab and drops a jelly cube on the floor (it
-prints the energy ledger and saves an animation in `msdlab-output/`). The
-second installs what the checks need (pytest and hypothesis: the `grade`
-extra, the same that grades your work) and runs the checks of all five tasks
-on your files in `assignments/`: until you write them, each check says what
-is still to do.
+The first line makes a virtual environment in `.venv/` and activates it:
+msdlab and what it needs are installed there, not into your system's Python
+(which Debian and Ubuntu refuse). In a new terminal, activate it again with
+`. .venv/bin/activate` (on Windows: `.venv\\Scripts\\activate`). The second
+line installs msdlab and drops a jelly cube on the floor (it prints the energy
+ledger and saves an animation in `msdlab-output/`). The third installs what
+the checks need (pytest and hypothesis: the `grade` extra, the same that grades
+your work) and runs the checks of all five tasks on your files in
+`assignments/`: until you write them, each check says what is still to do.
 
 ## Your work
+
+The tasks and the equations (1.1)-(1.4) they cite are those of
+[the brief](docs/brief.md).
 
 | task | file | what you write |
 | --- | --- | --- |
@@ -57,11 +67,23 @@ your files may take a few seconds (`--call-timeout S` to change); the last
 line shows your public points and what the hidden checks, which run when
 your work is graded, are worth. The notebooks in `notebooks/` walk through
 each task with plots and animations; install JupyterLab with them (the
-`notebooks` extra) and open them:
+`notebooks` extra, in the same environment) and open them:
 
 ```bash
 pip install -e ".[notebooks]" && jupyter lab notebooks
 ```
+
+They open on the environment's Python kernel ("Python 3 (ipykernel)").
+{docs}"""
+
+STUDENT_DOCS = """
+## Documentation
+
+The student pages, in `docs/`: [start here](docs/index.md),
+[installing](docs/install.md), [the brief](docs/brief.md),
+[the five tasks](docs/tasks.md), [checking your work](docs/check.md),
+[reading the feedback](docs/feedback.md), [the notebooks](docs/notebooks.md),
+[the live view](docs/live-view.md) and [the brief's questions](docs/questions.md).
 """
 
 STUDENT_GITIGNORE = """\
@@ -122,7 +144,7 @@ def build(out: Path, root: Path, force: bool = False, student: str | None = None
         target = out / source.relative_to(root)
         target.parent.mkdir(parents=True, exist_ok=True)
         if source.suffix == ".ipynb":
-            _write_for_students(source, target)
+            _write_for_students(source, target, own_numbers.numbers(student))
         else:
             shutil.copyfile(source, target)
         written.append(target)
@@ -131,8 +153,11 @@ def build(out: Path, root: Path, force: bool = False, student: str | None = None
         (out / "pyproject.toml").write_text(student_pyproject(pyproject), encoding="utf-8")
         written.append(out / "pyproject.toml")
     if student is not None:
-        written.append(_personalise(out / "assignments", student))
-    (out / "README.md").write_text(STUDENT_README, encoding="utf-8")
+        written.append(_personalise(out / "assignments", root / "solutions", student))
+    pages = release_docs.write(root, out)
+    readme = STUDENT_README.format(docs=STUDENT_DOCS if pages else "")
+    (out / "README.md").write_text(readme, encoding="utf-8")
+    written += pages
     (out / ".gitignore").write_text(STUDENT_GITIGNORE, encoding="utf-8")
     points = out / CHECKS / manifest.FILE_NAME
     _write_points(root / CHECKS, points)
@@ -168,13 +193,11 @@ def student_pyproject(text: str) -> str:
     return "".join(kept + pending)
 
 
-def _personalise(assignments: Path, student: str) -> Path:
-    """Put ``student``'s own numbers into the templates; write their id beside them."""
-    numbers = own_numbers.numbers(student)
-    for task in TASKS:
-        template = assignments / f"task{task}.py"
-        source = template.read_text(encoding="utf-8")
-        template.write_text(own_numbers.personalised(task, source, numbers), encoding="utf-8")
+def _personalise(assignments: Path, solutions: Path, student: str) -> Path:
+    """Write the templates with ``student``'s own numbers, made from ``solutions`` as the
+    course's are; write their id beside them."""
+    for name, text in templates.render(solutions, own_numbers.numbers(student)).items():
+        (assignments / name).write_text(text, encoding="utf-8")
     return own_numbers.write_student(assignments, student)
 
 
@@ -192,10 +215,15 @@ def _write_points(checks: Path, path: Path) -> None:
         raise ReleaseError(f"the checks in {checks} could not be collected:\n{done.stdout[-2000:]}")
 
 
-def _write_for_students(source: Path, target: Path) -> None:
+def _write_for_students(source: Path, target: Path, own: own_numbers.Numbers) -> None:
     """Copy a notebook without outputs or execution counts (a run in the checkout shows the
-    solutions'), unmarked: the students' Jupyter saves their outputs (`notebook_file`)."""
+    solutions'), its cells made from its source (``src/NAME.py`` beside it) with the
+    student's numbers ``own``, unmarked: the students' Jupyter saves their outputs
+    (`notebook_file`)."""
     notebook = json.loads(source.read_text(encoding="utf-8"))
+    cells = source.parent / "src" / f"{source.stem}.py"
+    if cells.is_file():
+        notebook["cells"] = notebook_source.notebook_cells(cells, own)
     notebook_file.as_kept(notebook, source.name)
     notebook_file.unmarked(notebook)
     target.write_text(json.dumps(notebook, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
