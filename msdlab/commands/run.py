@@ -76,7 +76,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         " and write one table of outcomes (repeatable)",
     )
     parser.add_argument(
-        "--out", type=Path, metavar="FILE.csv", help="the sweep's table (default: SCENE-sweep.csv)"
+        "--out",
+        type=Path,
+        metavar="FILE.csv",
+        help="the sweep's table (default: msdlab-output/SCENE-sweep.csv)",
     )
     parser.add_argument(
         "--cluster",
@@ -207,7 +210,7 @@ def _experiments(scene: Scene, settings: dict[str, object], args: argparse.Names
 
 def _sweep(scene: Scene, settings: dict[str, object], args: argparse.Namespace) -> int:
     axes = sweep.parse_sweeps(scene, args.sweep)
-    out = args.out or Path(f"{scene.name}-sweep.csv")
+    out = args.out or Path("msdlab-output") / f"{scene.name}-sweep.csv"
     count = len(sweep.combinations(axes))
     options = dict(fixed=settings, duration=args.duration or scene.duration, dt=args.dt,
                    integrators=INTEGRATORS, integrator=args.integrator)  # fmt: skip

@@ -198,3 +198,22 @@ def test_every_extra_is_stated(page):
     text = (ROOT / page).read_text(encoding="utf-8")
     stated = {e for group in NAMED_EXTRA.findall(text) for e in group.split(",")}
     assert stated >= set(EXTRAS), f"{page} does not state {sorted(set(EXTRAS) - stated)}"
+
+
+EXTRA_ROW = re.compile(r'^\| `pip install -e "\.\[(\w+)\]"` \|[^|]*\| ([^|]*) \|$', re.M)
+SAID_AS = {"pydata-sphinx-theme": "theme"}  # how a page's table names a distribution
+
+
+@pytest.mark.parametrize("page", ["README.md", "docs/index.md"])
+def test_each_extras_row_names_every_distribution_it_installs(page):
+    """The table's "adds" column of each extra names every distribution pyproject.toml gives
+    that extra (the test extra's row names the other extras instead)."""
+    rows = EXTRA_ROW.findall((ROOT / page).read_text(encoding="utf-8"))
+    assert {extra for extra, _ in rows} == set(EXTRAS), f"{page} has no row for some extras"
+    for extra, adds in rows:
+        named = [Requirement(text).name for text in EXTRAS[extra]]
+        unsaid = [
+            name for name in named
+            if name != "msdlab" and SAID_AS.get(name, name).lower() not in adds.lower()
+        ]  # fmt: skip
+        assert not unsaid, f"{page}: the [{extra}] row does not say it installs {unsaid}"
