@@ -9,7 +9,8 @@ is `msdlab.instructor`, which the student bundle does not contain.)
   input a property check failed on.
 - `oracles`: what the public checks compare with besides the engine (the template's loop,
   energies, engine-made variants of typical mistakes); no answers.
-- `runner`: run the checks in a fresh pytest process (``msdlab check``, the notebooks).
+- `runner`: run the checks in a fresh pytest process, the one way (``msdlab check``, the
+  notebooks, ``msdlab grade``).
 - `notebook`: the notebooks' helper for trying and checking a task.
 - `notebook_file`: a course notebook as the repository keeps it, without outputs.
 - `report`: the machine-readable result of a check run, and its text table.

@@ -23,9 +23,10 @@
 
 from __future__ import annotations
 
+import inspect
 import os
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -165,6 +166,23 @@ task2 = _task_fixture(2)
 task3 = _task_fixture(3)
 task4 = _task_fixture(4)
 task5 = _task_fixture(5)
+
+
+def check_arguments(
+    check: Callable[..., Any], task: int, module: Any, numbers: own_numbers.Numbers
+) -> dict[str, Any]:
+    """The fixtures a graded check of ``task`` takes, as this plugin gives them, for a caller
+    that calls the checks without pytest (``msdlab validate``): ``taskN`` (``module``) and
+    ``own_numbers`` (``numbers``). A check that takes another is refused, naming it."""
+    given = {f"task{task}": module, "own_numbers": numbers}
+    taken = list(inspect.signature(check).parameters)
+    unknown = [name for name in taken if name not in given]
+    if unknown:
+        raise TypeError(
+            f"{check.__name__} takes {', '.join(unknown)}: a graded check of task {task} may "
+            f"take only the fixtures {', '.join(given)}"
+        )
+    return {name: given[name] for name in taken}
 
 
 def pytest_runtest_setup(item: pytest.Item) -> None:

@@ -1,7 +1,11 @@
 """Running the checks in a fresh pytest process and reading back their report.
 
-Used by ``msdlab check`` and by the notebooks' `Course.check`: the checks of one
-task (or all) in a checks folder, on a folder of task files.
+`CheckRun` is the one way the checks run: ``msdlab check`` and the notebooks'
+`Course.check` (`run_checks`: the checks of one task or all, on a folder of task files)
+and ``msdlab grade`` (each submission's judge, with the sandbox's plugin) start pytest with
+its arguments in the `environment` made here. (``msdlab validate`` calls the same checks
+in its own process, on hundreds of versions of a task file, with the fixtures the course's
+plugin gives: `msdlab.course.pytest_plugin.check_arguments`.)
 """
 
 from __future__ import annotations
@@ -13,6 +17,8 @@ import shutil
 import subprocess
 import sys
 import tempfile
+from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 
 from . import PROJECT_ROOT, TASKS, loader
@@ -21,7 +27,8 @@ from .report import CheckReport
 CHECKS = Path("tests") / "tasks"
 PLUGINS = ("msdlab.course.pytest_plugin", "_hypothesis_pytestplugin", "pytest_timeout")
 """The pytest plugins the checks run with: the course's, Hypothesis' and pytest-timeout (the
-course's pytest config sets its ``timeout``)."""
+course's pytest config sets its ``timeout``). Only these load: pytest's search of every
+installed package for plugins (xdist, anyio, nbval, ...) cost a second."""
 CALL_TIMEOUT = 10.0
 """Seconds one call into a task file may take by default (`call_limit`); the slowest call the
 reference solutions make takes well under a second."""
@@ -33,6 +40,97 @@ class ChecksDidNotRun(RuntimeError):
     def __init__(self, message: str, output: str = "") -> None:
         super().__init__(message)
         self.output = output
+
+
+@dataclass(frozen=True)
+class CheckRun:
+    """One run of the checks in a pytest process of its own: the one way ``msdlab check``,
+    the notebooks' `Course.check` and ``msdlab grade`` run them.
+
+    The checks in ``checks`` (of ``task``, None: every task; the hidden ones only with
+    ``hidden``) on the task files in ``implementation``; the JSON `CheckReport` goes to
+    ``report``, the points of every check found to ``points`` (`manifest`). Each call into
+    a task file may take ``call_timeout`` seconds (None: the course plugin's default, or
+    what a plugin of ``plugins`` that runs the task files elsewhere says). ``workspace``:
+    a folder to stand in that holds nothing but the run (grading's), where no pytest
+    configuration around the checks applies. ``options``: further options of ``plugins``.
+    """
+
+    checks: Path
+    implementation: Path
+    report: Path
+    task: int | None = None
+    hidden: bool = False
+    call_timeout: float | None = None
+    points: Path | None = None
+    verbose: bool = False
+    plugins: tuple[str, ...] = PLUGINS
+    options: tuple[str, ...] = ()
+    workspace: Path | None = None
+
+    def arguments(self) -> list[str]:
+        """pytest's arguments: only the files of `task` where it is given (collecting the
+        others' takes a second), its checks chosen by marker (every check found with
+        `hidden` and no task), the report asked for."""
+        marker = f"task{self.task}" if self.task else ""
+        if not self.hidden:
+            marker = f"({marker or ' or '.join(f'task{n}' for n in TASKS)}) and not hidden"
+        files = sorted(self.checks.glob(f"test_task{self.task}.py")) + sorted(
+            self.checks.glob(f"test_task{self.task}_*.py")
+        )
+        arguments = [
+            *(map(str, files) if self.task and files else [str(self.checks)]),
+            *(option for name in self.plugins for option in ("-p", name)),
+            f"--impl={self.implementation}",
+            f"--msdlab-report={self.report}",
+            *(["-m", marker] if marker else []),
+            "-p", "no:cacheprovider",
+            "--tb=short" if self.verbose else "--tb=no",
+            "-q",
+        ]  # fmt: skip
+        if self.call_timeout is not None:
+            arguments.append(f"--call-timeout={self.call_timeout:g}")
+        if self.points is not None:
+            arguments.append(f"--msdlab-points={self.points}")
+        if self.workspace is not None:
+            arguments += ["--no-header", "--confcutdir", str(self.checks)]
+            arguments += ["--rootdir", str(self.workspace), "-o", "addopts="]
+        return [*arguments, *self.options]
+
+    def command(self) -> list[str]:
+        """The command line of a fresh pytest process that runs `arguments`."""
+        return [sys.executable, "-m", "pytest", *self.arguments()]
+
+
+def environment(base: Mapping[str, str] | None = None) -> dict[str, str]:
+    """The environment the checks' pytest process runs in: ``base`` (default: this
+    process's) with
+
+    - the numpy kernel unless ``MSDLAB_KERNEL`` says otherwise: the checks' bodies are
+      small, compiling them would cost more than it saves;
+    - no bytecode written (``PYTHONDONTWRITEBYTECODE``): no ``__pycache__`` beside the task
+      files and the checks, which compile in milliseconds; everything else loads the
+      bytecode its installer wrote (`compile_msdlab` writes msdlab's own);
+    - only the plugins named (`PLUGINS`, ``PYTEST_DISABLE_PLUGIN_AUTOLOAD``).
+    """
+    return {
+        "MSDLAB_KERNEL": "numpy",
+        **(os.environ if base is None else base),
+        "PYTHONDONTWRITEBYTECODE": "1",
+        "PYTEST_DISABLE_PLUGIN_AUTOLOAD": "1",
+    }
+
+
+def compile_msdlab() -> None:
+    """Write the bytecode of msdlab's modules that is missing or out of date (an editable
+    install, a release folder: no installer compiled them), so that the checks' process,
+    which writes none (`environment`), loads them compiled. Up to date, this only compares
+    times (milliseconds); a folder the user cannot write to is left as it is."""
+    if sys.dont_write_bytecode:
+        return
+    import compileall
+
+    compileall.compile_dir(PROJECT_ROOT / "msdlab", quiet=2, workers=1)
 
 
 def run_checks(
@@ -47,34 +145,23 @@ def run_checks(
     call_timeout: float = CALL_TIMEOUT,
     points: Path | None = None,
 ) -> tuple[CheckReport, str]:
-    """Run the checks of ``task`` (None: all tasks) on the task files in ``folder``.
+    """Run the checks of ``task`` (None: all tasks) on the task files in ``folder`` (a
+    `CheckRun` standing in ``checks``).
 
-    Returns the report and pytest's output; ``save`` keeps a copy of the JSON
-    report, ``points`` gets the points manifest of every check found (`manifest`).
-    Hidden checks run only with ``hidden``. Each call into a task file may take
-    ``call_timeout`` seconds, the whole run ``timeout``. The checks run on the
-    numpy kernel, as when graded (their bodies are small: no compiling), unless
-    ``MSDLAB_KERNEL`` says otherwise.
+    Returns the report and pytest's output; ``save`` keeps a copy of the JSON report,
+    ``points`` gets the points manifest of every check found (`manifest`). Hidden checks
+    run only with ``hidden``. Each call into a task file may take ``call_timeout``
+    seconds, the whole run ``timeout``.
     """
+    compile_msdlab()
     with tempfile.TemporaryDirectory(prefix="msdlab-check-") as scratch:
         report_path = Path(scratch) / "report.json"
-        command = pytest_command(checks, folder, task, hidden, report_path, verbose)
-        command.append(f"--call-timeout={call_timeout:g}")
-        if points is not None:
-            command.append(f"--msdlab-points={points}")
+        run = CheckRun(checks, folder, report_path, task, hidden, call_timeout, points, verbose)
         try:
             process = subprocess.run(
-                command,
+                run.command(),
                 cwd=checks,
-                env={
-                    "MSDLAB_KERNEL": "numpy",
-                    # compiled modules kept, but outside the task and check folders
-                    "PYTHONPYCACHEPREFIX": str(bytecode_cache()),
-                    **os.environ,
-                    # only the plugins the checks use (`PLUGINS`): the others installed
-                    # beside them (xdist, anyio, nbval, ...) cost a second to load
-                    "PYTEST_DISABLE_PLUGIN_AUTOLOAD": "1",
-                },
+                env=environment(),
                 capture_output=True,
                 text=True,
                 timeout=timeout,
@@ -92,14 +179,6 @@ def run_checks(
         if save is not None:
             shutil.copyfile(report_path, save)
         return CheckReport.read(report_path), output
-
-
-def bytecode_cache() -> Path:
-    """Where the checks' process keeps the modules it compiled (``PYTHONPYCACHEPREFIX``), so
-    the next run loads them (about a second less): the user's cache folder, not
-    ``__pycache__`` folders beside the task files and checks."""
-    cache = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(cache) / "msdlab" / "bytecode"
 
 
 def missing_test_tools() -> list[str]:
@@ -145,31 +224,3 @@ def implementation_folder(spec: str, cwd: Path) -> Path:
     if not folder.is_dir():
         raise FileNotFoundError(f"no folder of task files at {folder}")
     return folder
-
-
-def pytest_command(
-    checks: Path, folder: Path, task: int | None, hidden: bool, report: Path, verbose: bool
-) -> list[str]:
-    """The pytest command line that runs the chosen checks on ``folder``: only the files of
-    ``task`` where it is given (collecting the others' takes a second)."""
-    selected = f"task{task}" if task else " or ".join(f"task{n}" for n in TASKS)
-    marker = selected if hidden else f"({selected}) and not hidden"
-    files = sorted(checks.glob(f"test_task{task}.py")) + sorted(
-        checks.glob(f"test_task{task}_*.py")
-    )
-    plugins = [option for name in PLUGINS for option in ("-p", name)]
-    return [
-        sys.executable,
-        "-m",
-        "pytest",
-        *(map(str, files) if task and files else [str(checks)]),
-        *plugins,
-        f"--impl={folder}",
-        f"--msdlab-report={report}",
-        "-m",
-        marker,
-        "-p",
-        "no:cacheprovider",
-        "--tb=short" if verbose else "--tb=no",
-        "-q",
-    ]

@@ -28,8 +28,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..analysis import cluster
-from ..course import TASKS, reference_cache
+from ..course import TASKS, reference_cache, runner
 from ..course.report import CheckReport
+from ..course.runner import CheckRun
 from .judges import ForkedJudges
 
 MAX_FILE_BYTES = 1_000_000
@@ -133,18 +134,22 @@ def grade(
         shutil.copytree(checks, workspace / "checks", ignore=shutil.ignore_patterns("__pycache__"))
         os.chmod(workspace, 0o700)  # the sandbox sees only its bind-mounted copy of the tasks
         report_path = workspace / "report.json"
-        arguments = [
-            str(workspace / "checks"), "-q", "--no-header",
-            "-p", "no:cacheprovider", "-p", "msdlab.course.pytest_plugin",
-            "-p", "_hypothesis_pytestplugin", "-p", "msdlab.instructor.pytest_sandbox",
-            "--confcutdir", str(workspace / "checks"),
-            "--rootdir", str(workspace), "-o", "addopts=", "--impl", str(workspace / "submission"),
-            "--sandbox", "--sandbox-timeout", str(call_timeout), "--sandbox-memory", str(memory_mb),
-            "--msdlab-report", str(report_path),
-            "--allow-delegation", ",".join(str(task) for task in allow_delegation),
-            *([f"--student={submission.name}"] if own_numbers else []),
-        ]  # fmt: skip
-        environment = judge_environment()
+        run = CheckRun(
+            workspace / "checks",
+            workspace / "submission",
+            report_path,
+            hidden=True,
+            verbose=True,  # the last error pytest shows says why a judge gave no report
+            plugins=(*runner.PLUGINS, "msdlab.instructor.pytest_sandbox"),
+            options=(
+                "--sandbox", "--sandbox-timeout", str(call_timeout),
+                "--sandbox-memory", str(memory_mb),
+                "--allow-delegation", ",".join(str(task) for task in allow_delegation),
+                *([f"--student={submission.name}"] if own_numbers else []),
+            ),
+            workspace=workspace,
+        )  # fmt: skip
+        environment = runner.environment()
         environment["MSDLAB_SANDBOX_ISOLATION"] = isolation
         (workspace / "tmp").mkdir()  # the sandboxes' logs, removed with the workspace
         environment["TMPDIR"] = str(workspace / "tmp")
@@ -154,7 +159,7 @@ def grade(
             environment["MSDLAB_SANDBOX_UID"] = str(uid)
         if references is not None:
             environment[reference_cache.ENV] = str(references)
-        status, printed = _judge(arguments, workspace, environment, timeout, server)
+        status, printed = _judge(run.arguments(), workspace, environment, timeout, server)
         if uid is not None:
             _kill_user(uid)
         report = _read_report(report_path) if status in (0, 1) else None
@@ -170,16 +175,6 @@ def grade(
         return Grade(submission.name, None, [note], time.monotonic() - started)
     finally:
         shutil.rmtree(workspace, ignore_errors=True)
-
-
-def judge_environment() -> dict[str, str]:
-    """The environment of every judge, before its submission's own settings."""
-    # the checks' bodies are small: the numpy kernel spares each judge the JIT start-up;
-    # only the plugins the judge names load (pytest's search of every installed package
-    # for plugins took half of the judge's start-up)
-    environment = dict(os.environ, PYTHONDONTWRITEBYTECODE="1", MSDLAB_KERNEL="numpy")
-    environment["PYTEST_DISABLE_PLUGIN_AUTOLOAD"] = "1"
-    return environment
 
 
 def grade_all(

@@ -27,7 +27,6 @@ import ast
 import contextlib
 import dataclasses
 import importlib.util
-import inspect
 import json
 import random
 import shutil
@@ -44,6 +43,7 @@ import numpy as np
 
 from ..course import call_limit, delegation, own_numbers
 from ..course.loader import FolderImplementation
+from ..course.pytest_plugin import check_arguments
 from . import trivial
 
 BEGIN, END = "### BEGIN SOLUTION", "### END SOLUTION"
@@ -170,7 +170,9 @@ def run_checks(
     seconds: float = 30.0,
     stop_at_first_failure: bool = False,
 ) -> dict[str, Outcome]:
-    """Each check's `Outcome` on ``module`` (a task module loaded from ``folder``)."""
+    """Each check's `Outcome` on ``module`` (a task module loaded from ``folder``), called
+    in this process with the fixtures the course's pytest plugin gives (`check_arguments`:
+    the template's own numbers), its refusal of delegation and a time limit."""
     _hypothesis_profile()
     outcomes: dict[str, Outcome] = {}
     for check in checks:
@@ -182,7 +184,9 @@ def run_checks(
                 np.errstate(all="ignore"),
             ):
                 warnings.simplefilter("ignore")
-                check.function(**_arguments(check, module))
+                check.function(
+                    **check_arguments(check.function, check.task, module, own_numbers.DEFAULT)
+                )
         except (KeyboardInterrupt, SystemExit):
             raise
         except BaseException as error:  # whatever the code under test raises
@@ -192,14 +196,6 @@ def run_checks(
         else:
             outcomes[check.name] = Outcome(True)
     return outcomes
-
-
-def _arguments(check: Check, module: Any) -> dict[str, Any]:
-    """The fixtures ``check`` takes: its task's module, and the template's own numbers."""
-    arguments = {f"task{check.task}": module}
-    if "own_numbers" in inspect.signature(check.function).parameters:
-        arguments["own_numbers"] = own_numbers.DEFAULT
-    return arguments
 
 
 def run_source(

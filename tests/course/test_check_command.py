@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import importlib.util
 import re
 import shutil
 import sys
+from pathlib import Path
 
 import pytest
 
+import msdlab
 from msdlab.cli import main
 from msdlab.commands import check
 from msdlab.course import PROJECT_ROOT, manifest, runner
@@ -58,18 +61,20 @@ def test_pytests_own_output_has_no_warning_about_the_courses_config(capsys):
     assert "passed" in out and "Unknown config option" not in out
 
 
-def test_the_checks_keep_compiled_modules_in_the_cache_not_in_the_course(monkeypatch, tmp_path):
-    """The next ``msdlab check`` loads the modules it compiled (a second less to wait), and
+def test_the_checks_leave_no_bytecode_in_the_course_and_msdlab_compiled(monkeypatch, tmp_path):
+    """The next ``msdlab check`` loads msdlab's modules compiled (a second less to wait), and
     no ``__pycache__`` appears beside the task files or the checks."""
     monkeypatch.delenv("PYTHONDONTWRITEBYTECODE", raising=False)
-    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    monkeypatch.setattr(sys, "dont_write_bytecode", False)
     tasks, checks = tmp_path / "tasks", tmp_path / "checks"
     shutil.copytree(SOLUTIONS, tasks, ignore=shutil.ignore_patterns("__pycache__"))
     shutil.copytree(CHECKS, checks, ignore=shutil.ignore_patterns("__pycache__", "*hidden*"))
+    compiled = Path(importlib.util.cache_from_source(str(Path(msdlab.__file__).parent / "body.py")))
+    compiled.unlink(missing_ok=True)
     report, output = runner.run_checks(checks, tasks, 1)
     assert report.all_passed, output
     assert not [*tasks.rglob("__pycache__"), *checks.rglob("__pycache__")]
-    assert any(runner.bytecode_cache().rglob("task1*.pyc"))
+    assert compiled.is_file()
 
 
 def test_templates_fail_with_what_to_do_each_said_once(capsys):

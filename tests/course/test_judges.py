@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from msdlab.instructor.grading import judge_environment
+from msdlab.course import runner
 from msdlab.instructor.judges import ForkedJudges
 
 CHECKS = """
@@ -48,7 +48,7 @@ def server() -> ForkedJudges:
 def judge(server: ForkedJudges, folder: Path, timeout: float = 120.0, **settings: str):
     (folder / "tmp").mkdir(exist_ok=True)
     (folder / "test_checks.py").write_text(textwrap.dedent(CHECKS))
-    environment = {**judge_environment(), "GIVEN": str(folder), "TMPDIR": str(folder / "tmp")}
+    environment = {**runner.environment(), "GIVEN": str(folder), "TMPDIR": str(folder / "tmp")}
     arguments = ["-q", "-p", "no:cacheprovider", "--rootdir", str(folder), str(folder)]
     return server.run(arguments, folder, {**environment, **settings}, timeout)
 
