@@ -148,14 +148,32 @@ def failure_rates(rows: Sequence[ClassRow]) -> list[CheckRate]:
     return sorted(rates, key=lambda r: (-r.rate, -r.failed, r.column))
 
 
-def usual_causes(rows: Sequence[ClassRow]) -> list[tuple[str, list[str]]]:
-    """Each usual cause the failing checks named and the students who had it, most first."""
-    students = collections.defaultdict(set)
+@dataclass(frozen=True)
+class Misconception:
+    """A usual cause the checks named (its headline), who had it, and one full wording."""
+
+    cause: str
+    students: list[str]
+    example: str
+
+
+def usual_causes(rows: Sequence[ClassRow]) -> list[Misconception]:
+    """Each usual cause the failing checks named, by its `headline`, and the students who
+    had it, most first."""
+    students, examples = collections.defaultdict(set), {}
     for row in (r for r in rows if r.graded):
-        for check in row.checks:
-            if check.cause:
-                students[check.cause].add(row.id)
-    return sorted(((c, sorted(s)) for c, s in students.items()), key=lambda i: (-len(i[1]), i[0]))
+        for check in (c for c in row.checks if c.cause):
+            students[headline(check.cause)].add(row.id)
+            examples.setdefault(headline(check.cause), check.cause)
+    found = [Misconception(c, sorted(s), examples[c]) for c, s in students.items()]
+    return sorted(found, key=lambda m: (-len(m.students), m.cause))
+
+
+def headline(cause: str) -> str:
+    """A cause without the details one check adds (the student's own numbers): the words
+    before a colon, without a closing "(your ...)" ("the stiffness argument is ignored
+    (your STIFFNESS = 0.5 used instead of k = 2)" -> "the stiffness argument is ignored")."""
+    return re.sub(r" \(your [^()]*\)$", "", cause.split(": ", 1)[0])
 
 
 def unverified_groups(rows: Sequence[ClassRow]) -> list[tuple[str, list[str]]]:
@@ -183,7 +201,7 @@ def summary_section(rows: Sequence[ClassRow], page: str) -> str:
     causes = usual_causes(rows)
     if causes:
         lines += ["Usual causes the failing checks named:", ""]
-        lines += [f"- {cause}: {len(ids)} ({_named(ids)})" for cause, ids in causes]
+        lines += [f"- {m.cause}: {len(m.students)} ({_named(m.students)})" for m in causes]
         lines.append("")
     doubtful = unverified_groups(rows)
     count = sum(len(ids) for _, ids in doubtful)
@@ -286,14 +304,14 @@ def _rates_table(rates: list[CheckRate]) -> str:
     return (f"<table>{head}{''.join(rows)}</table>" if rows else "") + rest
 
 
-def _causes_table(causes: list[tuple[str, list[str]]]) -> str:
+def _causes_table(causes: list[Misconception]) -> str:
     if not causes:
         return "<p>No failing check named a usual cause.</p>"
-    head = "<tr><th>usual cause</th><th>students</th><th>who</th></tr>"
+    head = "<tr><th>usual cause</th><th>students</th><th>who</th><th>as a check put it</th></tr>"
     rows = [
-        f"<tr><td>{html.escape(cause)}</td><td class='number'>{len(ids)}</td>"
-        f"<td>{html.escape(_named(ids))}</td></tr>"
-        for cause, ids in causes
+        f"<tr><td>{html.escape(m.cause)}</td><td class='number'>{len(m.students)}</td>"
+        f"<td>{html.escape(_named(m.students))}</td><td>{html.escape(m.example)}</td></tr>"
+        for m in causes
     ]
     return f"<table>{head}{''.join(rows)}</table>"
 

@@ -16,6 +16,7 @@ from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
 from msdlab.course.report import CheckReport, CheckResult
 from msdlab.instructor import class_report
+from msdlab.instructor.class_report import CheckOutcome, ClassRow
 from msdlab.instructor.gradebook import Gradebook
 from msdlab.instructor.grading import Grade
 from msdlab.instructor.intake import Entry
@@ -101,12 +102,29 @@ def test_each_checks_failure_rate_is_what_the_rows_say(graded, source):
 def test_the_usual_causes_name_their_students(graded, tmp_path):
     book, grades = graded
     rows = class_report.rows_of(book, grades)
-    assert class_report.usual_causes(rows) == [
-        (LAYER, ["bo", "cy", "ed"]),
-        (SIGN, ["cy", "di", "ed"]),
-    ]
+    causes = [(m.cause, m.students) for m in class_report.usual_causes(rows)]
+    assert causes == [(LAYER, ["bo", "cy", "ed"]), (SIGN, ["cy", "di", "ed"])]
     section = class_report.summary_section(rows, "grades.class.html")
     assert f"- {LAYER}: 3 (bo, cy, ed)" in section and f"- {SIGN}: 3 (cy, di, ed)" in section
+
+
+@pytest.mark.parametrize(
+    ("cause", "wordings"),
+    [
+        ("the stiffness argument is ignored",
+         ("the stiffness argument is ignored (your STIFFNESS = 0.5 used instead of k = 1)",
+          "the stiffness argument is ignored (your STIFFNESS = 0.8 used instead of k = 2)")),
+        ("the spacing argument is ignored",
+         ("the spacing argument is ignored: your SPACING = 0.1 is the rest length",
+          "the spacing argument is ignored (your SPACING = 0.1 used as the rest length)")),
+    ],
+)  # fmt: skip
+def test_one_misconception_worded_by_several_checks_counts_once(cause, wordings):
+    """Checks add the student's own numbers to a cause; the cause is still one."""
+    checks = tuple(CheckOutcome(2, f"check{i}", False, text) for i, text in enumerate(wordings))
+    rows = [ClassRow(s, True, {}, 0.0, checks, None) for s in ("bo", "cy")]
+    (found,) = class_report.usual_causes(rows)
+    assert (found.cause, found.students, found.example) == (cause, ["bo", "cy"], wordings[0])
 
 
 def test_the_hand_in_times_not_verified_are_listed(graded, tmp_path):
