@@ -34,7 +34,7 @@ td.number { text-align: right; font-variant-numeric: tabular-nums; }
 tr.flagged { background: #fde2e2; }
 .sides { display: grid; grid-template-columns: 1fr 1fr; gap: 1em; }
 .sides pre { border: 1px solid #ccc; padding: 0.5em; overflow-x: auto; font-size: 0.8em;
-             margin: 0; }
+             line-height: 1.4; margin: 0; }
 a.passage { color: inherit; text-decoration: none; border-radius: 2px; }
 a.passage:target { outline: 3px solid #222; }
 .folded { color: #777; font-style: italic; }
@@ -164,7 +164,8 @@ def highlighted(text: str, passages: tuple[Passage, ...], anchor: str, side: int
     shown = text[:SHOWN_CHARACTERS]
     marks, done = [], 0
     for passage in sorted(passages, key=lambda p: p.start):
-        start, end = max(passage.start, done), min(passage.end, len(shown))
+        start, end = _whole_words(shown, passage.start, passage.end)
+        start, end = max(start, done), min(end, len(shown))
         if end > start:
             marks.append((start, end, passage.group))
             done = end
@@ -188,6 +189,16 @@ def highlighted(text: str, passages: tuple[Passage, ...], anchor: str, side: int
     if len(text) > len(shown):
         parts.append(f"… {len(text) - len(shown)} more characters not shown\n")
     return "".join(parts)
+
+
+def _whole_words(text: str, start: int, end: int) -> tuple[int, int]:
+    """[start, end) widened to whole words: copydetect places a match by characters of its
+    reduced code, which may fall inside a name of the text."""
+    while 0 < start < len(text) and (text[start - 1].isalnum() or text[start - 1] == "_"):
+        start -= 1
+    while 0 < end < len(text) and (text[end].isalnum() or text[end] == "_"):
+        end += 1
+    return start, end
 
 
 def _folded(count: int) -> str:
