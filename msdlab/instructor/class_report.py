@@ -379,7 +379,7 @@ def heatmap(rows: Sequence[ClassRow]) -> Figure:
         ax.set_xticks(range(len(students)), [r.id for r in students], rotation=90, fontsize=7)
     else:
         ax.set_xticks([])
-        ax.set_xlabel(f"{len(students)} students, lowest total on the left")
+    ax.set_xlabel(f"{len(students)} students, lowest total on the left", fontsize=9)
     ax.set_title("green passed, red failed, grey not run", fontsize=9)
     return figure
 
