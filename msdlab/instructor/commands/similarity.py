@@ -1,23 +1,28 @@
-"""``msdlab similarity SUBMISSION... --out DIR``: which students' task files share code.
+"""``msdlab similarity SUBMISSION... --out DIR``: which pairs of students share code.
 
 Each SUBMISSION is given as to ``msdlab grade`` (a folder laid out like
 assignments/, a folder holding assignments/, a zip file of either, or --roster
-FILE). Every pair of students is compared per task file with the template's text
-(--template, default the course's assignments/) left out; variable names,
-comments and the order of functions do not hide a copy. Writes DIR/similarity.html
-(pairs ranked, matching passages side by side) and DIR/similarity.csv (task_file,
-first, second, similarity, first_share, second_share, matched, flagged). It flags
-pairs to look at; it changes no points. Needs msdlab[grade] (copydetect).
-"""
+FILE). Only the task files the grader grades are read (regular files, no link, at
+most 1 MB). Every pair of students is compared over all their task files with the
+template's text (--template, default the course's assignments/) left out; variable
+names, comments and the order of functions do not hide a copy. Prints the ten most
+similar pairs; writes DIR/similarity.html (the most similar pairs with their matching
+passages side by side, the others in a table) and DIR/similarity.csv (first, second,
+similarity, first_share, second_share, matched, flagged, task1.py ... task5.py). It
+flags pairs to look at; it changes no points. Needs msdlab[grade] (copydetect)."""
 
 from __future__ import annotations
 
 import argparse
 import importlib.util
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ...course import PROJECT_ROOT
 from .. import intake
+
+if TYPE_CHECKING:  # copydetect, which similarity imports, is optional
+    from ..similarity import Pair
 
 TEMPLATES = PROJECT_ROOT / "assignments"
 THRESHOLD = 0.5  # similarity from which a pair is flagged, by default
@@ -106,7 +111,7 @@ def write_report(
     print(f"report written to {out / 'similarity.html'} and {out / 'similarity.csv'}")
 
 
-def ranked_list(pairs: list, threshold: float) -> str:
+def ranked_list(pairs: list[Pair], threshold: float) -> str:
     """The lines to print: how many pairs are flagged, and the `PRINTED` most similar."""
     flagged = sum(pair.flagged(threshold) for pair in pairs)
     lines = [
