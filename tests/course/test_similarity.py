@@ -156,18 +156,22 @@ def test_a_class_of_30_gets_a_bounded_page_and_a_short_list(tmp_path, capsys):
 
 def test_a_link_is_never_followed_and_an_oversize_file_is_not_read(planted, tmp_path, capsys):
     """A task file linked to another student's would frame that student at 1.00; a task
-    file the grader ignores for its size is ignored here too."""
+    file the grader ignores for its size is ignored here too, and a pipe is not read."""
     original = shutil.copytree(planted["class"] / "original", tmp_path / "class" / "original")
     framed = tmp_path / "class" / "framed"
     shutil.copytree(planted["class"] / "honest_loops" / "assignments", framed)
     (framed / "task2.py").unlink()
     os.symlink(original / "assignments" / "task2.py", framed / "task2.py")
     (framed / "task3.py").write_text("x = 1\n" * (MAX_FILE_BYTES // 6 + 1), encoding="utf-8")
+    (framed / "task4.py").unlink()
+    os.mkfifo(framed / "task4.py")  # reading it would wait for a writer forever
     given = [str(original), str(framed)]
     assert main(["similarity", *given, "--out", str(tmp_path / "report")]) == 0
     printed = capsys.readouterr().out
     row = row_of(tmp_path / "report", "framed", "original")
-    assert row["task2.py"] == row["task3.py"] == "" and float(row["similarity"]) < 0.2, row
+    assert row["task2.py"] == row["task3.py"] == row["task4.py"] == "", row
+    assert float(row["similarity"]) < 0.2, row
+    assert "framed: task4.py is not a regular file" in printed
     assert "framed: task2.py is not a regular file (a link is not followed)" in printed
     assert f"framed: task3.py is larger than {MAX_FILE_BYTES} bytes" in printed
     page = (tmp_path / "report" / "similarity.html").read_text(encoding="utf-8")
