@@ -6,8 +6,11 @@ sim = msd.Simulation(body, msd.Verlet(damping=0.01), dt=1e-3,
                      forces=[msd.Gravity((0, -9.81, 0)), msd.Ground(height=0.0)])
 trajectory = sim.run(duration=1.0, record_every=10)
 
-Its names are imported when first used (`__getattr__`), so ``import msdlab`` alone
-is quick: ``msd.Body`` imports `msdlab.body`, ``msd.max_stable_dt`` `msdlab.analysis`.
+The public names are imported below for every tool that reads code (an IDE's completions,
+a type checker, a map of the imports), and at run time on first use (`__getattr__`), from
+the same lines: ``import msdlab`` alone imports no engine, so that ``msdlab check``
+starts at once; ``msd.Body`` imports `msdlab.body`, ``msd.max_stable_dt``
+`msdlab.analysis` (which imports scipy).
 
 Debugging: under a debugger, or with ``MSDLAB_KERNEL=numpy`` set, the step runs on the
 readable numpy kernel, so a breakpoint in ``msdlab.equations`` (``spring_force``) or in an
@@ -16,45 +19,70 @@ integrator's equation (``Verlet.update``) stops there.
 
 from __future__ import annotations
 
+import functools
 import importlib
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
 
-# The public names, by the module that defines them (`msdlab.analysis` imports scipy).
-_PUBLIC = {
-    "analysis": (
-        "Convergence", "Mode", "bisect_blowup", "convergence_order", "max_stable_dt",
-        "measure_blowup_dt", "stability_limit", "stiffest_mode",
-    ),
-    "body": ("Body", "rotation_matrix"),
-    "constraint": ("Constraint", "StepState"),
-    "dynamics": ("Dynamics",),
-    "energy": (
-        "EnergyLedger", "angular_momentum", "elastic_energy", "gravitational_energy",
-        "kinetic_energy", "momentum",
-    ),
-    "errors": ("SimulationDiverged",),
-    "forces": ("Force", "Gravity", "ViscousDamping"),
-    "integrators": (
-        "RK4", "ExplicitEuler", "ImplicitEuler", "Integrator", "SymplecticEuler",
-        "VelocityVerlet", "Verlet",
-    ),
-    "interaction": ("Drag", "Grab", "Ground", "Prescribed", "SphereContact", "Walls"),
-    "particle": ("Particle",),
-    "simulation": ("Simulation", "Trajectory"),
-    "spring": ("Spring",),
-}  # fmt: skip
-_DEFINED_IN = {name: module for module, names in _PUBLIC.items() for name in names}
+if TYPE_CHECKING:  # the public names; imported on first use at run time (`__getattr__`)
+    from .analysis import (
+        Convergence,
+        Mode,
+        bisect_blowup,
+        convergence_order,
+        max_stable_dt,
+        measure_blowup_dt,
+        stability_limit,
+        stiffest_mode,
+    )
+    from .body import Body, rotation_matrix
+    from .constraint import Constraint, StepState
+    from .dynamics import Dynamics
+    from .energy import (
+        EnergyLedger,
+        angular_momentum,
+        elastic_energy,
+        gravitational_energy,
+        kinetic_energy,
+        momentum,
+    )
+    from .errors import SimulationDiverged
+    from .forces import Force, Gravity, ViscousDamping
+    from .integrators import (
+        RK4,
+        ExplicitEuler,
+        ImplicitEuler,
+        Integrator,
+        SymplecticEuler,
+        VelocityVerlet,
+        Verlet,
+    )
+    from .interaction import Drag, Grab, Ground, Prescribed, SphereContact, Walls
+    from .particle import Particle
+    from .simulation import Simulation, Trajectory
+    from .spring import Spring
 
-__all__ = sorted(_DEFINED_IN)
+
+@functools.cache
+def _defined_in() -> dict[str, str]:
+    """Each public name and the module that defines it, read from the imports above (at
+    the first name used, not at ``import msdlab``)."""
+    import ast
+
+    with open(__file__, encoding="utf-8") as source:
+        tree = ast.parse(source.read())
+    block = next(node for node in tree.body if isinstance(node, ast.If))
+    return {alias.name: node.module for node in block.body for alias in node.names}
 
 
 def __getattr__(name: str) -> Any:
-    """``msdlab.Body`` and the other public names, and submodules (``msdlab.analysis``),
-    imported on first use."""
-    if name in _DEFINED_IN:
-        value = getattr(importlib.import_module(f".{_DEFINED_IN[name]}", __name__), name)
+    """The public names (``msdlab.Body``), their list (``__all__``) and the submodules
+    (``msdlab.analysis``), imported on first use."""
+    if name == "__all__":
+        value: Any = sorted(_defined_in())
+    elif name in _defined_in():
+        value = getattr(importlib.import_module(f".{_defined_in()[name]}", __name__), name)
     else:
         value = _submodule(name)
     globals()[name] = value
@@ -73,4 +101,4 @@ def _submodule(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted({*globals(), *__all__})
+    return sorted({*globals(), *_defined_in()})

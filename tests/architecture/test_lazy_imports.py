@@ -1,14 +1,21 @@
-"""``import msdlab`` and a command's start import only what they use: the public names load
-on first use, and ``msdlab check`` (a student's most frequent command) waits for no engine."""
+"""``import msdlab`` shows its public names to the tools that read code (an IDE's completions)
+and imports them on first use; ``msdlab check`` (a student's most frequent command) waits for
+no engine in its own process, and its checks' process for nothing heavy the checks do not use."""
 
 from __future__ import annotations
 
 import subprocess
 import sys
+import textwrap
+from pathlib import Path
 
 import pytest
 
 import msdlab
+from msdlab.course import PROJECT_ROOT, runner
+
+HEAVY = {"numba", "matplotlib", "anywidget", "IPython"}
+"""Packages no check of a task uses: the compiler, the pictures, the live view."""
 
 
 def imported_after(code: str) -> set[str]:
@@ -22,6 +29,15 @@ def imported_after(code: str) -> set[str]:
 
 def test_importing_msdlab_imports_no_engine():
     assert not imported_after("import msdlab") & {"numpy", "scipy", "numba", "matplotlib"}
+
+
+def test_an_editor_completes_the_public_names():
+    """What an IDE offers after ``msdlab.`` (jedi, IPython's and many editors' completion
+    engine, reads the code without running it)."""
+    jedi = pytest.importorskip("jedi")
+    script = jedi.Script("import msdlab\nmsdlab.", project=jedi.Project(PROJECT_ROOT))
+    offered = {completion.name for completion in script.complete(2, len("msdlab."))}
+    assert set(msdlab.__all__) <= offered
 
 
 def test_a_run_imports_no_dense_linear_algebra():
@@ -41,6 +57,24 @@ def test_the_check_command_starts_without_numpy():
     assert "numpy" not in imported_after(code)
 
 
+def test_the_checks_process_imports_nothing_heavy(tmp_path, monkeypatch):
+    """The pytest process of ``msdlab check 2`` (the reference answers: every check runs to
+    its end) imports neither the compiler nor the pictures."""
+    (tmp_path / "sitecustomize.py").write_text(
+        textwrap.dedent(f"""
+            import atexit, sys
+            atexit.register(lambda: open({str(tmp_path / "modules.txt")!r}, "w").write(
+                " ".join(sorted({{name.split(".")[0] for name in sys.modules}}))))
+        """)
+    )
+    monkeypatch.setenv("PYTHONPATH", str(tmp_path))
+    checks = PROJECT_ROOT / runner.CHECKS
+    report, output = runner.run_checks(checks, PROJECT_ROOT / "solutions", 2)
+    assert report.all_passed, output
+    imported = set((tmp_path / "modules.txt").read_text().split())
+    assert "pytest" in imported and not imported & HEAVY
+
+
 @pytest.mark.parametrize("name", msdlab.__all__)
 def test_every_public_name_is_there_when_used(name):
     value = getattr(msdlab, name)
@@ -51,3 +85,10 @@ def test_a_submodule_is_there_when_used_and_a_wrong_name_is_an_attribute_error()
     assert msdlab.analysis.max_stable_dt is msdlab.max_stable_dt
     with pytest.raises(AttributeError, match="has no attribute 'Bodies'"):
         msdlab.Bodies  # noqa: B018
+
+
+def test_a_star_import_gives_the_public_names():
+    names: dict = {}
+    exec("from msdlab import *", names)
+    assert {"Body", "Simulation", "Verlet", "max_stable_dt"} <= set(names)
+    assert Path(msdlab.__file__).name == "__init__.py"
