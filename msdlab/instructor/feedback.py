@@ -5,8 +5,8 @@
   message or generated input; a task not attempted (or whose file did not load)
   as one line; no path of the grader's temporary folders.
 - `for_instructor`: every check with its full message, and the grading notes.
-- `class_summary`: over the whole grades file, the score distribution per task and the
-  checks failed most often.
+- `class_summary`: over the whole class, the score distribution per task, the checks
+  failed most often, and who handed in nothing or could not be graded.
 """
 
 from __future__ import annotations
@@ -19,10 +19,12 @@ from typing import TYPE_CHECKING
 
 from ..course import TASKS
 from ..course.report import CheckResult
+from .gradebook_db import ABSENT, GRADER_FAILED
 from .grading import Grade
 
 if TYPE_CHECKING:  # the gradebook uses `scrub`
     from .gradebook import Gradebook
+    from .gradebook_db import Record
 
 _TEMPORARY = re.compile(
     r"[^\s'\"()]*msdlab-(?:grade|intake|sandbox|check)-[^/\s'\"()]*((?:/[^/\s'\"():,;]+)*)"
@@ -98,13 +100,20 @@ def for_instructor(grade: Grade, source: str = "", hint: str | None = None) -> s
     return "\n".join(lines) + "\n"
 
 
-def class_summary(book: Gradebook, grades: Sequence[Grade]) -> str:
-    """Markdown over every row of the grades file ``book`` (earlier runs' too): per task the
-    spread of points, then the checks failed most often (from the file's per-check columns,
-    else from ``grades``, this run's)."""
+def class_summary(book: Gradebook, records: Sequence[Record], grades: Sequence[Grade]) -> str:
+    """Markdown over the whole class: per task the spread of points, the checks failed most
+    often (over every submission the gradebook has check results of, ``grades``), and the
+    submissions that were absent or that the grader could not grade."""
     graded = book.graded_rows()
-    total = len(book.rows)
-    lines = ["# Grading summary", "", f"{len(graded)} of {total} submissions graded.", ""]
+    lines = ["# Grading summary", "", f"{len(graded)} of {len(records)} submissions graded.", ""]
+    absent = [r.id for r in records if r.status == ABSENT]
+    if absent:
+        lines += [f"Nothing handed in ({len(absent)}): {', '.join(absent)}.", ""]
+    failed = [r.id for r in records if r.status == GRADER_FAILED]
+    if failed:
+        lines += [f"Could not be graded, the grader's failure and not the students' "
+                  f"({len(failed)}): {', '.join(failed)}. Run the same command with "
+                  "--resume to grade them again.", ""]  # fmt: skip
     if not graded:
         return "\n".join(lines)
     lines += ["| task | points | mean | median | min | max | how many got how many points |",
@@ -117,35 +126,25 @@ def class_summary(book: Gradebook, grades: Sequence[Grade]) -> str:
             f"| {column} | {book.maximum[column]} | {statistics.mean(scores):.1f} | "
             f"{statistics.median(scores):g} | {min(scores):g} | {max(scores):g} | {counts} |"
         )
-    return "\n".join(lines + _most_failed(book, graded, grades)) + "\n"
+    return "\n".join(lines + _most_failed(graded, grades)) + "\n"
 
 
-def _most_failed(
-    book: Gradebook, graded: list[dict[str, str]], grades: Sequence[Grade]
-) -> list[str]:
+def _most_failed(graded: list[dict[str, str]], grades: Sequence[Grade]) -> list[str]:
     """The lines naming the ten checks failed most often, by how many submissions."""
+    reports = [g.report for g in grades if g.report is not None]
+    failed = collections.Counter(
+        f"task{c.task} {c.name}" + (" (hidden)" if c.hidden else "")
+        for report in reports
+        for c in report.checks
+        if not c.passed
+    )
     heading = "Checks failed most often:"
-    if book.detail_columns:  # every row of the file that has the check's column
-        failed, having = collections.Counter(), collections.Counter()
-        for row in graded:
-            for column in (c for c in book.detail_columns if row.get(c)):
-                having[column] += 1
-                failed[column] += float(row[column]) < float(book.maximum[column])
-    else:
-        reports = [g.report for g in grades if g.report is not None]
-        failed = collections.Counter(
-            f"task{c.task} {c.name}" + (" (hidden)" if c.hidden else "")
-            for report in reports
-            for c in report.checks
-            if not c.passed
+    if len(reports) < len(graded):
+        plural = "" if len(reports) == 1 else "s"
+        heading = (
+            f"Checks failed most often by the {len(reports)} submission{plural} with check "
+            "results (rows taken in from an older grades file have none until graded again):"
         )
-        having = collections.Counter({name: len(reports) for name in failed})
-        if len(reports) < len(graded):
-            plural = "" if len(reports) == 1 else "s"
-            heading = (
-                f"Checks failed most often by the {len(reports)} submission{plural} graded "
-                "in this run (grade with --detail to count them over every row):"
-            )
     common = [(name, count) for name, count in failed.most_common(10) if count]
     if not common:
         return []
@@ -153,7 +152,7 @@ def _most_failed(
         "",
         heading,
         "",
-        *(f"- {name}: failed by {count} of {having[name]}" for name, count in common),
+        *(f"- {name}: failed by {count} of {len(reports)}" for name, count in common),
     ]
 
 

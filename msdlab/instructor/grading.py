@@ -18,6 +18,7 @@ import os
 import queue
 import shutil
 import signal
+import stat
 import subprocess
 import sys
 import tempfile
@@ -31,10 +32,13 @@ from ..analysis import cluster
 from ..course import TASKS, reference_cache, runner
 from ..course.report import CheckReport
 from ..course.runner import CheckRun
+from . import processes
 from .judges import ForkedJudges
+from .sandbox import INFRASTRUCTURE_FAILURES
 
 MAX_FILE_BYTES = 1_000_000
 FIRST_UID = 61000  # as root, sandboxes run as reserved user ids from here on
+RETRY_PAUSE = 2.0  # seconds before grading again after the grader's failure, times the attempt
 GRADER_ERROR = "grader error: "
 """The start of the note of a submission the grader failed to grade (no fault of its author)."""
 
@@ -55,6 +59,7 @@ class Grade:
     report: CheckReport | None
     notes: list[str] = field(default_factory=list)
     seconds: float = 0.0
+    attempts: int = 1
 
     @property
     def graded(self) -> bool:
@@ -104,6 +109,7 @@ def grade(
     *,
     timeout: float = 600.0,
     call_timeout: float = 60.0,
+    task_timeout: float = 60.0,
     memory_mb: int = 2048,
     uid: int | None = None,
     isolation: str = "namespace",
@@ -114,6 +120,8 @@ def grade(
 ) -> Grade:
     """Grade one submission with the checks in ``checks`` (see the module docstring).
 
+    ``task_timeout`` is the time the submission's code may take for one task, all its calls
+    together (`sandbox.SandboxProcess`), ``call_timeout`` the time of one call.
     As root the sandbox runs as user ``uid`` (default: one reserved for this call).
     ``isolation`` is the sandbox's level (`sandbox.ISOLATION_LEVELS`); a weaker one
     than ``namespace`` is named in the row's notes. ``references`` is a folder the
@@ -124,9 +132,10 @@ def grade(
     if uid is None and os.geteuid() == 0:
         with reserved_uids(1) as (reserved,):
             return grade(submission, checks, timeout=timeout, call_timeout=call_timeout,
-                         memory_mb=memory_mb, uid=reserved, isolation=isolation,
-                         allow_delegation=allow_delegation, references=references,
-                         server=server, own_numbers=own_numbers)  # fmt: skip
+                         task_timeout=task_timeout, memory_mb=memory_mb, uid=reserved,
+                         isolation=isolation, allow_delegation=allow_delegation,
+                         references=references, server=server,
+                         own_numbers=own_numbers)  # fmt: skip
     started = time.monotonic()
     workspace = Path(tempfile.mkdtemp(prefix="msdlab-grade-"))
     try:
@@ -143,7 +152,7 @@ def grade(
             plugins=(*runner.PLUGINS, "msdlab.instructor.pytest_sandbox"),
             options=(
                 "--sandbox", "--sandbox-timeout", str(call_timeout),
-                "--sandbox-memory", str(memory_mb),
+                "--sandbox-memory", str(memory_mb), "--sandbox-task-timeout", str(task_timeout),
                 "--allow-delegation", ",".join(str(task) for task in allow_delegation),
                 *([f"--student={submission.name}"] if own_numbers else []),
             ),
@@ -163,7 +172,11 @@ def grade(
         if uid is not None:
             _kill_user(uid)
         report = _read_report(report_path) if status in (0, 1) else None
-        if report is not None:
+        failure = _infrastructure_failure(report)
+        if failure is not None:  # the machine's failure, not the submission's
+            report = None
+            notes.append(GRADER_ERROR + failure)
+        elif report is not None:
             notes += _problems(report)
         elif status is None:
             notes.append(f"grading timed out after {timeout:g} s")
@@ -185,27 +198,33 @@ def grade_all(
     progress: Callable[[Grade, int, int], None] | None = None,
     isolation: str = "namespace",
     allow_delegation: Sequence[int] = (),
+    retries: int = 2,
     **limits: float | bool,
 ) -> list[Grade]:
     """Grade ``submissions``, ``jobs`` at a time (threads: each judge is its own process);
-    ``progress(grade, done, count)`` as each ends."""
+    ``progress(grade, done, count)`` as each ends. A submission the grader or the machine
+    failed (`Grade.grader_failed`) is graded again, up to ``retries`` times.
+
+    On KeyboardInterrupt every running judge is ended with its sandboxes, the submissions
+    not yet started are dropped, and the interrupt goes on to the caller within seconds;
+    ``progress`` has been called for every submission graded before it."""
     jobs = max(1, jobs)
     slots: queue.Queue[int | None] = queue.Queue()
     server = ForkedJudges()
+    processes.RUNNING = running = processes.Running()
 
     def one(submission: Submission) -> Grade:
         uid = slots.get()
         try:
-            return grade(
-                submission,
-                checks,
-                uid=uid,
-                isolation=isolation,
-                allow_delegation=allow_delegation,
-                references=references,
-                server=server,
-                **limits,
-            )
+            for attempt in range(1, retries + 2):
+                outcome = grade(submission, checks, uid=uid, isolation=isolation,
+                                allow_delegation=allow_delegation, references=references,
+                                server=server, **limits)  # fmt: skip
+                outcome.attempts = attempt
+                if not outcome.grader_failed or running.stopped:
+                    break
+                time.sleep(RETRY_PAUSE * attempt)  # let a passing overload pass
+            return outcome
         finally:
             slots.put(uid)
 
@@ -219,7 +238,12 @@ def grade_all(
         references = Path(shared)
         for uid in uids:
             slots.put(uid)
-        cluster.collect(pool, one, calls, range(len(calls)), finished, retries=0)
+        try:
+            cluster.collect(pool, one, calls, range(len(calls)), finished, retries=0)
+        except KeyboardInterrupt:
+            pool.shutdown(wait=False, cancel_futures=True)
+            running.stop()
+            raise
     return [as_grade(submissions[i], grades[i]) for i in range(len(calls))]
 
 
@@ -248,21 +272,50 @@ def rows(
 def reserved_uids(count: int) -> Iterator[list[int | None]]:
     """``count`` sandbox user ids that no other grading run on this machine holds.
 
-    Each is held by an exclusive lock on a file in the temporary folder for as
-    long as the ``with`` block lasts, so two runs never kill each other's
-    sandboxes. Without root, sandboxes keep the grader's user: ``None``.
+    Each is held by an exclusive lock (``flock``) on a file in `lock_folder`, one folder
+    for the whole machine whatever a run's ``TMPDIR``, for as long as the ``with`` block
+    lasts, so two runs never share a sandbox user nor kill each other's sandboxes. The
+    kernel drops a lock when its run ends, however it ends. Without root, sandboxes keep
+    the grader's user: ``None``.
     """
     if os.geteuid() != 0:
         yield [None] * count
         return
+    with held_uids(count, lock_folder()) as uids:
+        yield uids
+
+
+LOCK_FOLDERS = (Path("/run/lock/msdlab"), Path("/var/lock/msdlab"), Path("/tmp/msdlab-locks"))
+"""Where the sandbox user ids are locked: the first of these that root owns (created if
+missing); ``/tmp`` itself, not a run's ``TMPDIR``, is the last resort."""
+
+
+def lock_folder() -> Path:
+    """The machine-wide folder of the sandbox user locks (see `LOCK_FOLDERS`)."""
+    for folder in LOCK_FOLDERS:
+        with contextlib.suppress(OSError):
+            folder.mkdir(mode=0o755, exist_ok=True)
+            facts = folder.lstat()
+            private = stat.S_ISDIR(facts.st_mode) and not facts.st_mode & 0o022
+            if facts.st_uid == os.geteuid() and private:
+                return folder
+    raise OSError(f"no folder for the sandbox user locks: make one of {LOCK_FOLDERS[0]}, "
+                  f"{LOCK_FOLDERS[1]} owned by root, mode 755")  # fmt: skip
+
+
+@contextlib.contextmanager
+def held_uids(count: int, folder: Path) -> Iterator[list[int]]:
+    """``count`` user ids from `FIRST_UID` on whose lock files in ``folder`` this process
+    holds (those another process holds are passed over)."""
     handles, uids, uid = [], [], FIRST_UID
     try:
         while len(uids) < count:
-            handle = open(Path(tempfile.gettempdir()) / f"msdlab-sandbox-{uid}.lock", "a")  # noqa: SIM115
+            path = folder / f"sandbox-{uid}.lock"
+            handle = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
             try:
                 fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except BlockingIOError:
-                handle.close()
+                os.close(handle)
             else:
                 handles.append(handle)
                 uids.append(uid)
@@ -270,7 +323,7 @@ def reserved_uids(count: int) -> Iterator[list[int | None]]:
         yield uids
     finally:
         for handle in handles:
-            handle.close()
+            os.close(handle)
 
 
 def summary(grades: Sequence[Grade], seconds: float) -> str:
@@ -330,8 +383,8 @@ def _judge(
 def _run_judge(
     arguments: list[str], workspace: Path, environment: dict, timeout: float
 ) -> tuple[int | None, str]:
-    """Run a fresh judge: its exit status (None: timed out) and what it printed. The whole
-    process group is killed."""
+    """Run a fresh judge: its exit status (None: timed out) and what it printed. The judge
+    and every process below it are killed at the end."""
     process = subprocess.Popen(
         [sys.executable, "-m", "pytest", *arguments],
         cwd=workspace,
@@ -341,16 +394,15 @@ def _run_judge(
         stderr=subprocess.STDOUT,
         start_new_session=True,
     )
-    try:
-        printed, _ = process.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        with contextlib.suppress(ProcessLookupError):
-            os.killpg(process.pid, signal.SIGKILL)
-        process.communicate()
-        return None, ""
-    finally:
-        with contextlib.suppress(ProcessLookupError):
-            os.killpg(process.pid, signal.SIGKILL)  # and anything left behind
+    with processes.RUNNING.judge(process.pid):
+        try:
+            printed, _ = process.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            processes.kill_tree(process.pid)
+            process.communicate()
+            return None, ""
+        finally:
+            processes.kill_tree(process.pid)  # and anything left behind
     return process.returncode, printed.decode(errors="replace")
 
 
@@ -376,6 +428,16 @@ def _kill_user(uid: int) -> None:
             fields = dict(line.split(":", 1) for line in status.read_text().splitlines())
             if int(fields["Uid"].split()[0]) == uid:
                 os.kill(int(status.parent.name), signal.SIGKILL)
+
+
+def _infrastructure_failure(report: CheckReport | None) -> str | None:
+    """Why the checks' results are the machine's failure, not the submission's (a sandbox
+    killed from outside, a call timed out while the machine gave it no time), or None."""
+    for check in report.checks if report is not None else ():
+        if check.exception in INFRASTRUCTURE_FAILURES:
+            first = (check.message.strip().splitlines() or [check.exception])[0]
+            return f"task{check.task} {check.name}: {first}"
+    return None
 
 
 def _read_report(path: Path) -> CheckReport | None:

@@ -48,7 +48,8 @@ class Entry:
     """One submission as handed in: its id, the folder to grade, and notes or a problem.
 
     ``problem`` is set when there is nothing to grade (no task files at all); such
-    a submission gets a row with the problem and makes the run's exit status 1.
+    a submission gets a row with the problem and makes the run's exit status 1, unless
+    the student is ``absent`` (the roster names them, nothing is at their path).
     """
 
     id: str
@@ -56,6 +57,8 @@ class Entry:
     folder: Path
     notes: list[str] = field(default_factory=list)
     problem: str | None = None
+    absent: bool = False
+    """True for a roster's student who handed in nothing (a row of 0 points)."""
 
 
 def task_files(folder: Path) -> list[str]:
@@ -138,6 +141,17 @@ class Intake(contextlib.AbstractContextManager):
         self.entries.append(entry)
         return entry
 
+    def add_absent(self, identifier: str, expected: Path | None) -> Entry:
+        """Add a student who handed in nothing (nothing at ``expected``, or no path given)."""
+        identifier = readable(identifier).strip()
+        if identifier in {entry.id for entry in self.entries} or identifier == MAX_POINTS_ID:
+            raise ValueError(f"{identifier!r} cannot be a submission id: give unique ids")
+        where = f" (no folder or zip file at {readable(str(expected))})" if expected else ""
+        entry = Entry(identifier, expected or Path(), expected or Path(),
+                      problem=f"nothing handed in{where}", absent=True)  # fmt: skip
+        self.entries.append(entry)
+        return entry
+
     def _from_zip(self, identifier: str, source: Path) -> Entry:
         if self._scratch is None:
             self._scratch = Path(tempfile.mkdtemp(prefix="msdlab-intake-"))
@@ -209,19 +223,16 @@ def from_roster(roster: Path) -> Intake:
             if not any(cells) or cells[0].startswith("#") or (number == 1 and _header(cells)):
                 continue
             where = f"roster {roster}, line {number}"
-            if len(cells) < 2 or not cells[0] or not cells[1]:
+            if not cells[0]:
                 raise ValueError(
                     f"{where}: '{','.join(row)}' is not 'id,folder-or-zip' (the submission's "
                     "id, then its folder or zip file)"
                 )
-            path = Path(cells[1]).expanduser()
+            path = Path(cells[1] if len(cells) > 1 else "").expanduser()
             path = path if path.is_absolute() else roster.parent / path
-            if not path.exists():
-                header = " or name the columns (student,submission)" if number == 1 else ""
-                raise FileNotFoundError(
-                    f"{where}: no folder or zip file at {path}; give paths relative to the "
-                    f"roster's folder{header}"
-                )
+            if len(cells) < 2 or not cells[1] or not path.exists():
+                intake.add_absent(cells[0], path if len(cells) > 1 and cells[1] else None)
+                continue
             intake.add(cells[0], path)
     if not intake.entries:
         raise ValueError(f"{roster} lists no submissions (rows of 'id,folder-or-zip')")

@@ -21,11 +21,12 @@ from __future__ import annotations
 import contextlib
 import multiprocessing
 import os
-import signal
 import sys
 import threading
 from multiprocessing import forkserver
 from pathlib import Path
+
+from . import processes
 
 PRELOAD = ["__main__", "hypothesis.strategies", "pytest", "scipy.linalg", "scipy.sparse", "msdlab"]
 SAFE_PATH = sys.version_info >= (3, 11)  # PYTHONSAFEPATH: no working folder on sys.path
@@ -51,11 +52,10 @@ class ForkedJudges:
             target=_judge, args=(arguments, str(cwd), environment, str(output)), daemon=True
         )
         judge.start()
-        judge.join(timeout)
-        status = judge.exitcode
-        judge.kill()  # if it has not made its own session yet
-        with contextlib.suppress(ProcessLookupError, PermissionError):
-            os.killpg(judge.pid, signal.SIGKILL)  # over time, and anything left behind
+        with processes.RUNNING.judge(judge.pid):
+            judge.join(timeout)
+            status = judge.exitcode
+            processes.kill_tree(judge.pid)  # over time, and anything left behind
         judge.join()
         judge.close()
         try:

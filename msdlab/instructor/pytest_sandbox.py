@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from ..course import loader
+from ..course import TASKS, loader
 from .sandbox import RemoteImplementation
 
 _REMOTE = pytest.StashKey[RemoteImplementation]()
@@ -33,6 +33,14 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         default=60.0,
         metavar="S",
         help="with --sandbox: seconds one call into the implementation may take (default 60)",
+    )
+    group.addoption(
+        "--sandbox-task-timeout",
+        type=float,
+        default=None,
+        metavar="S",
+        help="with --sandbox: seconds the implementation may take for one task, all the calls "
+        "of its checks together; once used up, its further calls fail at once (default: none)",
     )
     group.addoption(
         "--sandbox-memory",
@@ -55,6 +63,7 @@ def pytest_msdlab_implementation(
         loader.resolve(spec, root),
         label=str(spec),
         timeout=config.getoption("sandbox_timeout"),
+        task_timeout=config.getoption("sandbox_task_timeout"),
         memory_bytes=config.getoption("sandbox_memory") * 2**20,
         uid=None if uid is None else int(uid),
         isolation=os.environ.get("MSDLAB_SANDBOX_ISOLATION", "namespace"),
@@ -64,7 +73,9 @@ def pytest_msdlab_implementation(
 
 
 def pytest_runtest_setup(item: pytest.Item) -> None:
-    """Each check starts afresh: a function that timed out in an earlier check runs again."""
+    """Each check starts afresh (a function that timed out in an earlier check runs again)
+    and draws on its task's time."""
     remote = item.config.stash.get(_REMOTE, None)
     if remote is not None:
-        remote.forgive()
+        task = next((n for n in TASKS if item.get_closest_marker(f"task{n}")), None)
+        remote.begin_check(task)

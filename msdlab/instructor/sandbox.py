@@ -41,7 +41,7 @@ import numpy as np
 
 from ..course.delegation import DelegationRefused
 from ..integrators import Integrator
-from . import wire
+from . import processes, wire
 
 CHILD = Path(__file__).with_name("sandbox_child.py")
 PACKAGE = Path(__file__).resolve().parents[1]
@@ -52,6 +52,8 @@ SCRATCH_BYTES = 64 * 2**20  # the private /tmp of one sandbox
 INSIDE_LIBRARY = "/sandbox/lib"  # where the msdlab package is seen inside the sandbox
 INSIDE_FOLDER = "/submission"  # where the submission's task files are seen
 INSIDE_SCRATCH = "/tmp"
+KILLED = (-signal.SIGKILL, 128 + signal.SIGKILL)
+"""The child's exit status when SIGKILL ended it (bubblewrap reports 128 + the signal)."""
 ENABLE_HINT = (
     "install bubblewrap (Debian/Ubuntu: apt-get install bubblewrap) and, when not root, "
     "allow unprivileged user namespaces (sysctl kernel.unprivileged_userns_clone=1 and "
@@ -168,6 +170,24 @@ class SubmissionTimeout(SandboxError):
     """A call into the submission took longer than the time limit."""
 
 
+class SandboxLost(SandboxError):
+    """The submission's process was killed from outside (SIGKILL, not by its time limit):
+    the machine's failure, not the submission's."""
+
+
+class MachineBusy(SubmissionTimeout):
+    """A call ran out of time while the machine gave the submission's process next to no
+    processor time: the machine's failure, not the submission's."""
+
+
+INFRASTRUCTURE_FAILURES = frozenset({SandboxLost.__name__, MachineBusy.__name__})
+"""The exceptions a check may end with that are no fault of the submission."""
+BUSY_SHARE = 0.5
+"""A sandbox that got less than this share of one processor after its time ran out, on a
+machine whose load average is above its processor count, was starved, not looping."""
+PROBE_SECONDS = 0.3
+
+
 class SubmissionCrashed(SandboxError):
     """The submission's process died or broke the channel."""
 
@@ -184,6 +204,7 @@ class SandboxProcess:
         folder: Path,
         *,
         timeout: float = 60.0,
+        task_timeout: float | None = None,
         memory_bytes: int = 2 * 2**30,
         uid: int | None = None,
         isolation: str = "namespace",
@@ -192,6 +213,9 @@ class SandboxProcess:
             raise ValueError(f"isolation must be one of {ISOLATION_LEVELS}, not {isolation!r}")
         self.folder = Path(folder).resolve()
         self.timeout = timeout
+        self.task_timeout = task_timeout  # seconds for all calls of one task's checks
+        self.task: int | None = None  # the task of the check running now
+        self.spent: dict[int, float] = {}  # seconds the calls of each task took
         self.memory_bytes = memory_bytes
         self.uid = uid if uid is not None else 65534
         self.strong = isolation == "namespace"
@@ -305,6 +329,17 @@ class SandboxProcess:
         """Let functions that timed out or crashed run again (called before each check)."""
         self.broken.clear()
 
+    def begin_check(self, task: int | None) -> None:
+        """A check of ``task`` starts: its calls draw on that task's time (`task_timeout`)."""
+        self.forgive()
+        self.task = task
+
+    def _time_left(self) -> float | None:
+        """Seconds the calls of the current task may still take (None: no task budget)."""
+        if self.task_timeout is None or self.task is None:
+            return None
+        return self.task_timeout - self.spent.get(self.task, 0.0)
+
     def request(
         self,
         message: dict,
@@ -333,7 +368,26 @@ class SandboxProcess:
         if self.process is None:
             self.start()
         limit = self.timeout if timeout is None else timeout
-        deadline = time.monotonic() + limit
+        left = self._time_left() if timeout is None else None
+        if left is not None and left <= 0:
+            raise SubmissionTimeout(
+                f"not run: the submission's code used up the {self.task_timeout:g} s it may take "
+                f"for task {self.task} (an endless loop, or far too much work?)"
+            )
+        limit = limit if left is None else min(limit, left)
+        started = time.monotonic()
+        try:
+            return self._exchange(message, name, arguments, limit, started + limit)
+        finally:
+            if left is not None:
+                self.spent[self.task] = self.spent.get(self.task, 0.0) + time.monotonic() - started
+
+    def _exchange(
+        self, message: dict, name: str, arguments: dict[str, Any] | None, limit: float,
+        deadline: float,
+    ) -> Any:  # fmt: skip
+        """Send ``message``, serve the child's callbacks, and return its answer (see
+        `request`)."""
         try:
             wire.write_all(self._send_fd, wire.encode(message, self._export))
             while True:
@@ -348,7 +402,10 @@ class SandboxProcess:
             raise
         except (EOFError, BrokenPipeError, wire.WireError, ValueError, KeyError) as error:
             reason = self._death_reason() or f"the channel broke ({error})"
+            killed = self.process is not None and self.process.returncode in KILLED
             self.close()
+            if killed:
+                raise SandboxLost(f"the sandbox was killed from outside ({reason})") from None
             crash = SubmissionCrashed(f"the submission's process {reason}")
             self._remember(name, crash)
             raise crash from None
@@ -374,10 +431,24 @@ class SandboxProcess:
         remaining = self._deadline - time.monotonic()
         ready, _, _ = select.select([self._recv_fd], [], [], max(remaining, 0))
         if not ready:
+            if self._starved():
+                raise MachineBusy(
+                    f"no answer within {self._limit:g} s while the machine was overloaded "
+                    f"(load {os.getloadavg()[0]:.1f} on {os.cpu_count()} processors)"
+                )
             raise SubmissionTimeout(
                 f"the submission did not answer within {self._limit:g} s "
                 "(an endless loop, or far too much work?)"
             )
+
+    def _starved(self) -> bool:
+        """True if the child, out of time, gets next to no processor time on an overloaded
+        machine (`BUSY_SHARE`): the machine's failure, not an endless loop."""
+        if self.process is None or os.getloadavg()[0] <= (os.cpu_count() or 1):
+            return False
+        before = processes.cpu_seconds(self.process.pid)
+        time.sleep(PROBE_SECONDS)
+        return processes.cpu_seconds(self.process.pid) - before < BUSY_SHARE * PROBE_SECONDS
 
     def _death_reason(self) -> str:
         if self.process is None:
@@ -623,6 +694,10 @@ class RemoteImplementation:
     def forgive(self) -> None:
         """A new check starts: functions that timed out may run again."""
         self.sandbox.forgive()
+
+    def begin_check(self, task: int | None) -> None:
+        """A check of ``task`` starts (see `SandboxProcess.begin_check`)."""
+        self.sandbox.begin_check(task)
 
     def refuse_delegation(self, task: int | None) -> None:
         """From now on the engine's answer to ``task`` refuses the submission's calls (None:

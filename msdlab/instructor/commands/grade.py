@@ -3,25 +3,29 @@
 Each SUBMISSION is a folder laid out like assignments/, a folder holding
 assignments/, or a zip file of either; its row's id is its path relative to the
 submissions' common parent (class/alice/assignments -> alice), or the id given
-by --roster FILE (CSV rows 'id,folder-or-zip'). Every submission is graded in
+by --roster FILE (CSV rows 'id,folder-or-zip'; a student whose folder is not there
+gets a row 'nothing handed in', 0 points). Every submission is graded in
 its own workspace by a fresh process running the instructor's checks (hidden
 ones included); the submission's code runs in a sandbox and can only answer
-with data, under a time and memory limit. Every submission gets a CSV row (id,
-source, task1 ... task5, points, the late work columns, total, notes; per check
-with --detail); the first row holds the maximum points. --due, --late-policy
-and --extensions charge late work; the changes in GRADES.adjustments.csv beside
-the CSV (id,task,change,reason) are applied after every run. Rows of earlier
-runs in the CSV are kept, a submission graded again gets its row replaced,
-and --resume skips those already graded with the same checks. --feedback DIR
-writes DIR/students/ID.md (to hand out), DIR/instructor/ID.md (everything)
-and DIR/summary.md (over every row of the CSV). Every run writes the class at a
-glance beside the CSV (GRADES.class.html: points per task, each check's failure rate,
-the usual causes, a check x student map, hand-in times not verified). Exit status 0 if every
-submission was graded, 1 if some could not be (their notes say why), 2 if the
-grader itself failed (its sandbox could not start, or an error of its own, named
-in the notes: no student feedback file is written for those submissions; fix it
-and run again with --resume). With --cluster ADDRESS the submissions are graded
-by a Dask scheduler's workers (msdlab[cluster]).
+with data, under a time and memory limit (--task-timeout: processor seconds per
+task, all its calls together). Each result is committed to the gradebook
+GRADES.db beside the CSV as soon as it is graded; the CSV (id, source, task1 ...
+task5, points, the late work columns, total, notes; per check with --detail; the
+first row holds the maximum points), the feedback (--feedback DIR: DIR/students/ID.md
+to hand out, DIR/instructor/ID.md with everything, DIR/summary.md) and the class at
+a glance (GRADES.class.html) are rendered from it over the whole class; --render
+writes them again without grading. --due, --late-policy and --extensions charge
+late work; the changes in GRADES.adjustments.csv beside the CSV
+(id,task,change,reason) are applied at every rendering. A submission graded again
+gets its row replaced; --resume grades only those not yet graded with the same checks
+and files, and those the grader failed on. Ctrl-C stops the run at once, keeping what
+was graded. A failure of the grader or the machine (a sandbox killed from outside, a
+call out of time on an overloaded machine) is graded again (--retries), never blamed
+on the student. Exit status 0 if every submission was graded, 1 if some could not be
+(their notes say why), 2 if the grader itself failed (named in the notes: no student
+feedback file is written for those submissions; run again with --resume), 130 if
+interrupted. With --cluster ADDRESS the submissions are graded by a Dask
+scheduler's workers (msdlab[cluster]).
 """
 
 from __future__ import annotations
@@ -29,6 +33,8 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
+import signal
+import sqlite3
 import sys
 import tempfile
 import time
@@ -44,8 +50,10 @@ from .. import (
     feedback,
     final_points,
     gradebook,
+    gradebook_db,
     grading,
     intake,
+    render,
     sandbox,
     term_options,
 )
@@ -83,7 +91,27 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--timeout", type=float, default=600.0, help="seconds per submission (%(default)s)"
     )
     parser.add_argument(
+        "--task-timeout",
+        type=float,
+        default=60.0,
+        help="seconds a submission's code may take for one task, all its calls together: "
+        "an endless loop costs this once (%(default)s)",
+    )
+    parser.add_argument(
         "--call-timeout", type=float, default=60.0, help="seconds per call into it (%(default)s)"
+    )
+    parser.add_argument(
+        "--retries",
+        type=int,
+        default=2,
+        help="times a submission is graded again after a failure of the grader or the "
+        "machine, not the student's (%(default)s)",
+    )
+    parser.add_argument(
+        "--render",
+        action="store_true",
+        help="grade nothing: write the grades file (and with --feedback the feedback files and "
+        "summary) again from the gradebook GRADES.db",
     )
     parser.add_argument(
         "--memory", type=int, default=2048, help="memory limit per submission, MB (%(default)s)"
@@ -119,11 +147,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.render:
+        return render_views(args)
     if not (args.checks / "conftest.py").is_file() and not list(args.checks.glob("test_*.py")):
         raise FileNotFoundError(f"no checks in {args.checks}; give --checks DIR")
     if args.jobs < 1 or args.timeout <= 0 or args.call_timeout <= 0 or args.memory < 256:
         raise ValueError("--jobs >= 1, --timeout and --call-timeout > 0 and --memory >= 256 MB")
-    address, jobs = parse_cluster(args.cluster) if args.cluster else (None, args.jobs)
+    if args.task_timeout <= 0 or args.retries < 0:
+        raise ValueError("--task-timeout > 0 s and --retries >= 0")
     problem = sandbox.isolation_problem(args.isolation)
     if problem is not None:
         print(f"msdlab grade: {problem}", file=sys.stderr)
@@ -132,172 +163,254 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError("give SUBMISSION folders or zip files, or --roster FILE (not both)")
     if args.similarity:
         similarity.require_copydetect()
-    book = gradebook.Gradebook.load(args.out)
-    checks = args.checks.resolve()
     terms = term_options.terms(args)
+    connection = open_gradebook(args.out)
+    run_number = gradebook_db.start_run(connection, ["msdlab", *sys.argv[1:]])
+    session = Session(args, connection, terms)
+    try:
+        status = session.grade(run_number)
+    except KeyboardInterrupt:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second Ctrl-C: the views still get out
+        gradebook_db.end_run(connection, run_number, "interrupted")
+        session.render(final=True)
+        print(session.interrupted(), file=sys.stderr)
+        return 130
+    finally:
+        connection.close()
+    return status
 
-    def save() -> dict[str, list[str]]:
-        """Settle every row's final points (late work, manual changes), then write."""
-        explained = final_points.settle(book.rows, terms)
-        book.write(args.out)
-        return explained
 
-    with (
-        intake.from_roster(args.roster)
-        if args.roster
-        else intake.from_paths(args.submissions) as found,
-        tempfile.TemporaryDirectory(prefix="msdlab-intake-") as scratch,
-    ):
-        entries = {entry.id: entry for entry in found.entries}
-        term_options.read_hand_ins(entries, args.handed_in, terms, args.timezone, Path(scratch))
-        prints = {  # nothing is read from a submission refused at intake (a link, ...)
-            i: gradebook.fingerprint(checks, e.folder)
-            for i, e in entries.items()
-            if e.problem is None
-        }
-        todo = [e for e in entries.values() if e.problem is None]
-        if args.resume:
-            todo = [e for e in todo if book.fingerprint_of(e.id) != prints[e.id]]
-        skipped = len(entries) - len(todo) - sum(e.problem is not None for e in entries.values())
-        unusable = [grading.Grade(e.id, None, [e.problem]) for e in entries.values() if e.problem]
-        for grade in unusable:
-            book.record(
-                shown(grade, entries[grade.submission]),
-                entries[grade.submission],
-                None,
-                args.detail,
+def open_gradebook(out: Path) -> sqlite3.Connection:
+    """The gradebook beside ``out``; on its first use, the rows of an older grades file
+    ``out`` are taken in (their adjustments file stays where it is, read every run)."""
+    connection = gradebook_db.connect(gradebook_db.beside(out))
+    with gradebook_db.transaction(connection):
+        taken = connection.execute("SELECT value FROM meta WHERE key = 'imported'").fetchone()
+        if taken is None and Path(out).is_file():
+            book = gradebook.Gradebook.load(out)
+            for row in book.rows.values():
+                gradebook_db.record_imported(connection, row, book.maximum)
+            print(f"took {len(book.rows)} rows of {out} into the gradebook "
+                  f"{gradebook_db.beside(out)}", file=sys.stderr)  # fmt: skip
+        connection.execute("INSERT OR REPLACE INTO meta VALUES ('imported', ?)", (str(out),))
+    return connection
+
+
+def render_views(args: argparse.Namespace) -> int:
+    """``--render``: the views of the gradebook written again, without grading."""
+    if not gradebook_db.beside(args.out).is_file() and not args.out.is_file():
+        raise FileNotFoundError(f"no gradebook at {gradebook_db.beside(args.out)} to render")
+    connection = open_gradebook(args.out)
+    try:
+        records = render.render(
+            connection, args.out, term_options.terms(args), args.feedback, args.detail, page=True
+        )
+    finally:
+        connection.close()
+    print(f"{len(records)} rows rendered from {gradebook_db.beside(args.out)} into {args.out}"
+          + (f" and {args.feedback}" if args.feedback else ""))  # fmt: skip
+    return 0
+
+
+class Session:
+    """One grading run: its submissions, what it has committed, and the views it renders."""
+
+    def __init__(
+        self, args: argparse.Namespace, connection: sqlite3.Connection, terms: final_points.Terms
+    ) -> None:
+        self.args, self.connection, self.terms = args, connection, terms
+        self.run_number: int | None = None
+        self.entries: dict[str, intake.Entry] = {}
+        self.prints: dict[str, str] = {}
+        self.graded: list[grading.Grade] = []
+        self.todo: list[intake.Entry] = []
+        self.own_numbers = False
+
+    def grade(self, run_number: int) -> int:
+        """Grade the submissions, committing each as it is graded; the exit status."""
+        args, self.run_number = self.args, run_number
+        checks = args.checks.resolve()
+        self.own_numbers = own_numbers.enabled(own_numbers.course_of(checks))
+        with (
+            intake.from_roster(args.roster)
+            if args.roster
+            else intake.from_paths(args.submissions) as found,
+            tempfile.TemporaryDirectory(prefix="msdlab-intake-") as scratch,
+        ):
+            self.entries = {entry.id: entry for entry in found.entries}
+            term_options.read_hand_ins(
+                self.entries, args.handed_in, self.terms, args.timezone, Path(scratch)
             )
-        where = f"on the cluster {address}" if address else f"{jobs} at a time"
+            self.prints = {  # nothing is read from a submission refused at intake (a link, ...)
+                i: gradebook.fingerprint(checks, e.folder)
+                for i, e in self.entries.items()
+                if e.problem is None
+            }
+            unusable = self._take_unusable()
+            self.todo = self._todo()
+            started = time.monotonic()
+            grades = self._grade_todo(checks)
+            gradebook_db.end_run(self.connection, run_number, "finished")
+            self.render(final=True)
+            if args.similarity:
+                folders = {i: e.folder for i, e in self.entries.items() if e.problem is None}
+                similarity.write_report(folders, args.out.parent / "similarity")
+        return self._report(unusable + grades, time.monotonic() - started)
+
+    def _take_unusable(self) -> list[grading.Grade]:
+        """Commit the rows of submissions with nothing to grade (absent, refused)."""
+        unusable = []
+        for entry in (e for e in self.entries.values() if e.problem is not None):
+            grade = grading.Grade(entry.id, None, [entry.problem])
+            status = gradebook_db.ABSENT if entry.absent else gradebook_db.NOT_GRADED
+            self._commit(shown(grade, entry), status)
+            if entry.absent:
+                print(f"{entry.id}: {entry.problem}", file=sys.stderr)
+            unusable.append(grade)
+        return unusable
+
+    def _todo(self) -> list[intake.Entry]:
+        """The entries to grade: all, or with --resume those not graded with the same checks
+        and files (the grader's failures among them)."""
+        todo = [e for e in self.entries.values() if e.problem is None]
+        if self.args.resume:
+            known = gradebook_db.statuses(self.connection)
+            todo = [e for e in todo if known.get(e.id) != (gradebook_db.GRADED, self.prints[e.id])]
+        skipped = sum(e.problem is None for e in self.entries.values()) - len(todo)
+        address, jobs = parse_cluster(self.args.cluster) if self.args.cluster else (None, None)
+        where = f"on the cluster {address}" if address else f"{jobs or self.args.jobs} at a time"
         plural = "" if len(todo) == 1 else "s"
         resumed = f" ({skipped} unchanged since graded, skipped)" if skipped else ""
-        print(
-            f"grading {len(todo)} submission{plural}{resumed}, {where}",
-            file=sys.stderr,
-        )
-        width = max(len(e.id) for e in entries.values())
+        print(f"grading {len(todo)} submission{plural}{resumed}, {where}", file=sys.stderr)
+        return todo
 
-        def progress(grade: grading.Grade, done: int, count: int) -> None:
-            entry = entries[grade.submission]
-            book.record(shown(grade, entry), entry, prints[grade.submission], args.detail)
-            save()  # after each: an interrupted run keeps what was graded
-            if grade.graded:
-                result = f"{grade.total}/{grade.report.points} points"
-            else:
-                result = "NOT GRADED: " + "; ".join(grade.notes)
-            tqdm.write(f"[{done:>{len(str(count))}}/{count}] {grade.submission:<{width}}  "
-                       f"{result}  ({grade.seconds:.1f} s)", file=sys.stderr)  # fmt: skip
-
-        started = time.monotonic()
-        own = own_numbers.enabled(own_numbers.course_of(checks))
+    def _grade_todo(self, checks: Path) -> list[grading.Grade]:
+        args = self.args
+        address, jobs = parse_cluster(args.cluster) if args.cluster else (None, args.jobs)
         options = dict(
             timeout=args.timeout,
             call_timeout=args.call_timeout,
+            task_timeout=args.task_timeout,
             memory_mb=args.memory,
             isolation=args.isolation,
             allow_delegation=_tasks(args.allow_delegation),
-            own_numbers=own,
+            own_numbers=self.own_numbers,
         )
-        graded = [grading.Submission(e.id, e.folder) for e in todo]
+        graded = [grading.Submission(e.id, e.folder) for e in self.todo]
         if not graded:
-            grades = []
-        elif address is not None:
-            grades = grade_all_on_cluster(graded, checks, address, progress=progress, **options)
+            return []
+        if address is not None:
+            return grade_all_on_cluster(graded, checks, address, progress=self._progress, **options)
+        return grading.grade_all(
+            graded, checks, jobs=jobs, progress=self._progress, retries=args.retries, **options
+        )
+
+    def _progress(self, grade: grading.Grade, done: int, count: int) -> None:
+        """Commit ``grade`` at once, bring the views up to date and say so."""
+        entry = self.entries[grade.submission]
+        self._commit(shown(grade, entry), _status(grade), grade, self._hint(grade))
+        self.graded.append(grade)
+        self.render()
+        width = max(len(identifier) for identifier in self.entries)
+        if grade.graded:
+            result = f"{grade.total}/{grade.report.points} points"
         else:
-            grades = grading.grade_all(graded, checks, jobs=jobs, progress=progress, **options)
-        explained = save()
-        grades = unusable + grades
-        rows = class_report.rows_of(book, grades)
-        page = class_report.beside(args.out)
-        class_report.write_html(rows, book.maximum, page)
-        hints = copied_hints(grades, entries, set(book.rows)) if own else {}
-        for student, hint in hints.items():
-            print(f"{student}: {hint}", file=sys.stderr)
-        if args.feedback is not None:
-            section = class_report.summary_section(rows, os.path.relpath(page, args.feedback))
-            write_feedback(args.feedback, grades, entries, book, section, hints)
-            final_points.refresh_feedback(
-                args.feedback, book.rows, explained, book.maximum.get("total", "")
-            )
-        if args.similarity:
-            folders = {i: e.folder for i, e in entries.items() if e.problem is None}
-            similarity.write_report(folders, args.out.parent / "similarity")
-    term_options.report(terms, set(book.rows), args.out)
-    print(grading.summary(grades, time.monotonic() - started))
-    if args.isolation != "namespace":
-        print(f"isolation: {args.isolation} (weaker than namespace; submissions were not "
-              "isolated by the operating system)")  # fmt: skip
-    kept = len(book.rows) - len(grades)
-    print(
-        f"grades written to {args.out}" + (f" ({kept} rows of earlier runs kept)" if kept else "")
-    )
-    print(f"class report written to {class_report.beside(args.out)}")
-    failed = [grade for grade in grades if grade.grader_failed]
-    if failed:
-        print(grader_failure(failed), file=sys.stderr)
-        return 2
-    return 0 if all(grade.graded for grade in grades) else 1
+            result = "NOT GRADED: " + "; ".join(grade.notes)
+        tqdm.write(f"[{done:>{len(str(count))}}/{count}] {grade.submission:<{width}}  "
+                   f"{result}  ({grade.seconds:.1f} s)", file=sys.stderr)  # fmt: skip
+
+    def _hint(self, grade: grading.Grade) -> str | None:
+        """With own numbers, for the instructor only: whose task 1 constants a graded
+        submission holds if not its author's (`copied_numbers`); said on stderr too."""
+        if not (self.own_numbers and grade.graded):
+            return None
+        everyone = set(gradebook_db.statuses(self.connection)) | set(self.entries)
+        folder = self.entries[grade.submission].folder
+        hint = copied_numbers.hint(grade.submission, folder, everyone)
+        if hint is not None:
+            tqdm.write(f"{grade.submission}: {hint}", file=sys.stderr)
+        return hint
+
+    def _commit(
+        self,
+        grade: grading.Grade,
+        status: str,
+        raw: grading.Grade | None = None,
+        hint: str | None = None,
+    ) -> None:
+        """One transaction: the row of ``grade`` with its evidence (``hint``: for the
+        instructor only)."""
+        entry = self.entries[grade.submission]
+        handed = self.terms.handed_in.get(grade.submission)
+        when = handed.time.isoformat(timespec="seconds") if handed and handed.time else None
+        result = gradebook_db.Result(
+            grade.submission, intake.escaped(str(entry.source)), status,
+            [feedback.scrub(note) for note in grade.notes], grade.report,
+            self.prints.get(grade.submission), when, handed.source if handed else None,
+            raw.seconds if raw else None, raw.attempts if raw else 1, hint,
+        )  # fmt: skip
+        gradebook_db.record(self.connection, result, self.run_number)
+
+    def render(self, final: bool = False) -> list[gradebook_db.Record]:
+        """Write the views over the whole class (``final``: the class report's page too)."""
+        args = self.args
+        return render.render(
+            self.connection, args.out, self.terms, args.feedback, args.detail, page=final
+        )
+
+    def interrupted(self) -> str:
+        """The one line an interrupted run prints."""
+        left = len(self.todo) - len(self.graded)
+        return (
+            f"msdlab grade: interrupted: {len(self.graded)} of {len(self.todo)} submissions "
+            f"graded this run are saved in {gradebook_db.beside(self.args.out)}; run the same "
+            f"command with --resume to grade the other {left}"
+        )
+
+    def _report(self, grades: list[grading.Grade], seconds: float) -> int:
+        """Print the run's summary; its exit status."""
+        args = self.args
+        known = gradebook_db.statuses(self.connection)
+        term_options.report(self.terms, set(known), args.out)
+        print(grading.summary(grades, seconds))
+        if args.isolation != "namespace":
+            print(f"isolation: {args.isolation} (weaker than namespace; submissions were not "
+                  "isolated by the operating system)")  # fmt: skip
+        kept = len(known) - len(grades)
+        earlier = f" ({kept} rows of earlier runs kept)" if kept else ""
+        print(f"grades written to {args.out}{earlier}")
+        print(f"class report written to {class_report.beside(args.out)}")
+        failed = [grade for grade in grades if grade.grader_failed]
+        if failed:
+            print(grader_failure(failed), file=sys.stderr)
+            return 2
+        return 0 if all(grade.graded or self._absent(grade) for grade in grades) else 1
+
+    def _absent(self, grade: grading.Grade) -> bool:
+        return self.entries[grade.submission].absent
+
+
+def _status(grade: grading.Grade) -> str:
+    if grade.grader_failed:
+        return gradebook_db.GRADER_FAILED
+    return gradebook_db.GRADED if grade.graded else gradebook_db.NOT_GRADED
 
 
 def grader_failure(failed: list[grading.Grade]) -> str:
     """What to tell the instructor when the grader itself failed on ``failed``."""
     note = next(n for n in failed[0].notes if n.startswith(grading.GRADER_ERROR))
     plural = "s" if len(failed) > 1 else ""
+    names = ", ".join(grade.submission for grade in failed)
     return (
-        f"msdlab grade: the grader failed on {len(failed)} submission{plural}, no fault of "
-        f"their authors, who got no feedback file: {feedback.scrub(note)}. Fix the grader and "
-        "run the same command with --resume to grade only those."
+        f"msdlab grade: could not grade {len(failed)} submission{plural} ({names}), the "
+        f"grader's failure and no fault of their authors, who got no feedback file: "
+        f"{feedback.scrub(note)}. Run the same command with --resume to grade only those."
     )
 
 
 def shown(grade: grading.Grade, entry: intake.Entry) -> grading.Grade:
     """``grade`` with the intake's notes on its submission first (for the CSV and feedback)."""
     return dataclasses.replace(grade, notes=[*entry.notes, *grade.notes])
-
-
-def copied_hints(
-    grades: list[grading.Grade], entries: dict[str, intake.Entry], roster: set[str]
-) -> dict[str, str]:
-    """For the instructor: the submissions whose task 1 constants are not their author's
-    own numbers, and whose they are (`copied_numbers`), among ``roster`` and this run's."""
-    everyone = roster | set(entries)
-    found = {
-        grade.submission: copied_numbers.hint(
-            grade.submission, entries[grade.submission].folder, everyone
-        )
-        for grade in grades
-        if grade.graded
-    }
-    return {student: hint for student, hint in found.items() if hint is not None}
-
-
-def write_feedback(
-    folder: Path,
-    grades: list[grading.Grade],
-    entries: dict[str, intake.Entry],
-    book: gradebook.Gradebook,
-    class_section: str = "",
-    hints: dict[str, str] | None = None,
-) -> None:
-    """DIR/students/ID.md (none where the grader failed), DIR/instructor/ID.md (with the
-    ``hints`` for the instructor only), and DIR/summary.md over every row of ``book``,
-    ``class_section`` at its end."""
-    hints = hints or {}
-    for kind in ("students", "instructor"):
-        (folder / kind).mkdir(parents=True, exist_ok=True)
-    for grade in (shown(g, entries[g.submission]) for g in grades):
-        stem = intake.file_stem(grade.submission)
-        student = folder / "students" / f"{stem}.md"
-        if grade.grader_failed:  # nothing to hand out; an earlier run's file is out of date
-            student.unlink(missing_ok=True)
-        else:
-            student.write_text(feedback.for_student(grade), encoding="utf-8")
-        source = intake.escaped(str(entries[grade.submission].source))
-        (folder / "instructor" / f"{stem}.md").write_text(
-            feedback.for_instructor(grade, source, hints.get(grade.submission)),
-            encoding="utf-8",
-        )
-    summary = feedback.class_summary(book, grades) + class_section
-    (folder / "summary.md").write_text(summary, encoding="utf-8")
 
 
 def _tasks(text: str) -> list[int]:
