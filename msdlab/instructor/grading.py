@@ -34,7 +34,7 @@ from ..course.report import CheckReport
 from ..course.runner import CheckRun
 from . import processes
 from .judges import ForkedJudges
-from .sandbox import INFRASTRUCTURE_FAILURES
+from .sandbox import INFRASTRUCTURE_FAILURES, overloaded
 
 MAX_FILE_BYTES = 1_000_000
 FIRST_UID = 61000  # as root, sandboxes run as reserved user ids from here on
@@ -178,6 +178,9 @@ def grade(
             notes.append(GRADER_ERROR + failure)
         elif report is not None:
             notes += _problems(report)
+        elif status is None and overloaded():
+            notes.append(f"{GRADER_ERROR}grading timed out after {timeout:g} s on an overloaded "
+                         "machine")  # fmt: skip
         elif status is None:
             notes.append(f"grading timed out after {timeout:g} s")
         else:

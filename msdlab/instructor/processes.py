@@ -2,8 +2,8 @@
 
 A judge starts its sandboxes in sessions of their own, so killing the judge's process
 group leaves them running; `kill_tree` ends a process with every descendant it has.
-`cpu_seconds` is the processor time a tree of processes has used (to tell a submission
-that works from one the machine gave no time to).
+`cpu_of` is the processor time some processes have used (what a submission's time
+budget is charged).
 """
 
 from __future__ import annotations
@@ -50,12 +50,12 @@ def kill_tree(pid: int) -> None:
             os.kill(member, signal.SIGKILL)
 
 
-def cpu_seconds(pid: int) -> float:
-    """The processor time (user and system, seconds) used so far by ``pid`` and the
-    processes below it that are still running."""
+def cpu_of(pids: list[int]) -> float:
+    """The processor time (user and system, seconds) used so far by the processes ``pids``
+    that are still running."""
     total = 0
-    for member in descendants(pid):
-        fields = _stat(str(member))
+    for pid in pids:
+        fields = _stat(str(pid))
         if fields is not None:
             total += int(fields[11]) + int(fields[12])  # utime, stime
     return total / TICKS

@@ -33,7 +33,7 @@ import sys
 import sysconfig
 import tempfile
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -176,16 +176,12 @@ class SandboxLost(SandboxError):
 
 
 class MachineBusy(SubmissionTimeout):
-    """A call ran out of time while the machine gave the submission's process next to no
-    processor time: the machine's failure, not the submission's."""
+    """A call ran out of wall-clock time, short of its processor time, while the machine was
+    overloaded: the machine's failure, not the submission's."""
 
 
 INFRASTRUCTURE_FAILURES = frozenset({SandboxLost.__name__, MachineBusy.__name__})
 """The exceptions a check may end with that are no fault of the submission."""
-BUSY_SHARE = 0.5
-"""A sandbox that got less than this share of one processor after its time ran out, on a
-machine whose load average is above its processor count, was starved, not looping."""
-PROBE_SECONDS = 0.3
 
 
 class SubmissionCrashed(SandboxError):
@@ -194,6 +190,34 @@ class SubmissionCrashed(SandboxError):
 
 class SubmissionRaised(Exception):
     """The submission raised an exception that is not a Python built-in one."""
+
+
+def overloaded() -> bool:
+    """True if the machine's load average is above its number of processors."""
+    return os.getloadavg()[0] > (os.cpu_count() or 1)
+
+
+class CallClock:
+    """The processor time one call into the submission is charged against its task's budget
+    (the time the submission's processes use: a busy machine does not eat a student's
+    time, and an endless loop costs the budget however loaded the machine is)."""
+
+    POLL_SECONDS = 1.0  # how often the charge is looked at while waiting
+
+    def __init__(self, processor: Callable[[], float], budget: float | None) -> None:
+        self.processor, self.budget = processor, budget
+        self._start = self._seen = processor() if budget is not None else 0.0
+
+    def charged(self) -> float:
+        """Processor seconds charged so far (what ended processes used stays charged; none
+        without a budget)."""
+        if self.budget is not None:
+            self._seen = max(self._seen, self.processor())
+        return self._seen - self._start
+
+    def over_budget(self) -> bool:
+        """True once the call has been charged its budget."""
+        return self.budget is not None and self.charged() >= self.budget
 
 
 class SandboxProcess:
@@ -229,6 +253,8 @@ class SandboxProcess:
         self.broken: dict[str, SandboxError] = {}  # name -> its failure, until `forgive`
         self.refused_task: int | None = None  # whose engine answers the submission may not use
         self._deadline, self._limit = 0.0, timeout  # of the answer being waited for
+        self._clock = CallClock(lambda: 0.0, None)  # the time the current call is charged
+        self._members: list[int] | None = None  # the child's processes, found at first need
 
     @property
     def isolation(self) -> str:
@@ -243,6 +269,8 @@ class SandboxProcess:
         self._launch()
         try:
             self.request({"op": "ping"}, timeout=STARTUP_SECONDS)
+        except SandboxLost:
+            raise
         except SandboxError as error:
             reason = f"cannot start the grading sandbox ({error}): {self.log_tail()}"
             raise SandboxError(reason) from None
@@ -304,6 +332,7 @@ class SandboxProcess:
             )
         os.close(to_child)
         os.close(from_child)
+        self._members = None
         self.exports.clear()
         self.members.clear()
 
@@ -365,22 +394,32 @@ class SandboxProcess:
             raise SubmissionCrashed(
                 "this object was lost when the submission's process was restarted after a failure"
             )
+        left = self._time_left() if timeout is None else None
+        if left is not None and left <= 0:
+            raise SubmissionTimeout(f"not run: {self._used_up()}")
         if self.process is None:
             self.start()
         limit = self.timeout if timeout is None else timeout
-        left = self._time_left() if timeout is None else None
-        if left is not None and left <= 0:
-            raise SubmissionTimeout(
-                f"not run: the submission's code used up the {self.task_timeout:g} s it may take "
-                f"for task {self.task} (an endless loop, or far too much work?)"
-            )
-        limit = limit if left is None else min(limit, left)
-        started = time.monotonic()
+        self._clock = CallClock(self._processor_time, left)
         try:
-            return self._exchange(message, name, arguments, limit, started + limit)
+            return self._exchange(message, name, arguments, limit, time.monotonic() + limit)
         finally:
             if left is not None:
-                self.spent[self.task] = self.spent.get(self.task, 0.0) + time.monotonic() - started
+                self.spent[self.task] = self.spent.get(self.task, 0.0) + self._clock.charged()
+
+    def _processor_time(self) -> float:
+        """Processor seconds the child's processes have used (found once per start)."""
+        if self.process is None:
+            return 0.0
+        if self._members is None or len(self._members) == 1 and self.strong:
+            self._members = processes.descendants(self.process.pid)  # bubblewrap's child too
+        return processes.cpu_of(self._members)
+
+    def _used_up(self) -> str:
+        return (
+            f"the submission's code used up the {self.task_timeout:g} s of processor time it may "
+            f"take for task {self.task} (an endless loop, or far too much work?)"
+        )
 
     def _exchange(
         self, message: dict, name: str, arguments: dict[str, Any] | None, limit: float,
@@ -428,10 +467,16 @@ class SandboxProcess:
 
     def _wait_for_answer(self) -> None:
         """Wait until the child has written something, or raise `SubmissionTimeout`."""
-        remaining = self._deadline - time.monotonic()
-        ready, _, _ = select.select([self._recv_fd], [], [], max(remaining, 0))
-        if not ready:
-            if self._starved():
+        while True:
+            remaining = self._deadline - time.monotonic()
+            wait = max(min(remaining, CallClock.POLL_SECONDS), 0)
+            if select.select([self._recv_fd], [], [], wait)[0]:
+                return
+            if self._clock.over_budget():
+                raise SubmissionTimeout(self._used_up())
+            if time.monotonic() < self._deadline:
+                continue
+            if overloaded():
                 raise MachineBusy(
                     f"no answer within {self._limit:g} s while the machine was overloaded "
                     f"(load {os.getloadavg()[0]:.1f} on {os.cpu_count()} processors)"
@@ -440,15 +485,6 @@ class SandboxProcess:
                 f"the submission did not answer within {self._limit:g} s "
                 "(an endless loop, or far too much work?)"
             )
-
-    def _starved(self) -> bool:
-        """True if the child, out of time, gets next to no processor time on an overloaded
-        machine (`BUSY_SHARE`): the machine's failure, not an endless loop."""
-        if self.process is None or os.getloadavg()[0] <= (os.cpu_count() or 1):
-            return False
-        before = processes.cpu_seconds(self.process.pid)
-        time.sleep(PROBE_SECONDS)
-        return processes.cpu_seconds(self.process.pid) - before < BUSY_SHARE * PROBE_SECONDS
 
     def _death_reason(self) -> str:
         if self.process is None:

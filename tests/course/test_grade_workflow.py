@@ -229,7 +229,8 @@ def test_class_summary_spread_and_most_failed_over_the_whole_class(tmp_path):
     gradebook_db.record(connection, failed, None)
     render.render(connection, tmp_path / "grades.csv", Terms(), tmp_path / "feedback")
     text = (tmp_path / "feedback" / "summary.md").read_text()
-    assert "2 of 3 submissions graded" in text and "| task2 | 7 | 1.5 | 1.5 | 0 | 3 | 0: 1, 3: 1 |" in text
+    assert "2 of 3 submissions graded" in text
+    assert "| task2 | 7 | 1.5 | 1.5 | 0 | 3 | 0: 1, 3: 1 |" in text
     assert "- task2 rest_state: failed by 2 of 2" in text
     assert "- task2 secret_corner (hidden): failed by 1 of 2" in text
 

@@ -21,7 +21,7 @@ from msdlab.instructor.judges import ForkedJudges
 SOLUTIONS = PROJECT_ROOT / "solutions"
 CHECKS = PROJECT_ROOT / "tests" / "tasks"
 TASKS_USED = (1, 2, 5)  # enough to show one task's failure leaves the others alone
-LIMITS = {"timeout": 240.0, "call_timeout": 2.0, "memory_mb": 1024}
+LIMITS = {"timeout": 240.0, "task_timeout": 10.0, "memory_mb": 1024}
 
 
 def submission(root: Path, name: str, **edits: str) -> Path:

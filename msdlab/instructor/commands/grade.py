@@ -94,11 +94,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--task-timeout",
         type=float,
         default=60.0,
-        help="seconds a submission's code may take for one task, all its calls together: "
-        "an endless loop costs this once (%(default)s)",
+        help="processor seconds a submission's code may take for one task, all its calls "
+        "together: an endless loop costs this once, however busy the machine (%(default)s)",
     )
     parser.add_argument(
-        "--call-timeout", type=float, default=60.0, help="seconds per call into it (%(default)s)"
+        "--call-timeout",
+        type=float,
+        default=300.0,
+        help="wall-clock seconds one call into it may take; reached on an overloaded machine, "
+        "the grader's failure, graded again (%(default)s)",
     )
     parser.add_argument(
         "--retries",
