@@ -411,7 +411,7 @@ class SandboxProcess:
         """Processor seconds the child's processes have used (found once per start)."""
         if self.process is None:
             return 0.0
-        if self._members is None or len(self._members) == 1 and self.strong:
+        if self._members is None or (len(self._members) == 1 and self.strong):
             self._members = processes.descendants(self.process.pid)  # bubblewrap's child too
         return processes.cpu_of(self._members)
 
