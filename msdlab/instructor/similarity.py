@@ -18,12 +18,13 @@ regular files, not links, of at most `MAX_FILE_BYTES`.
 from __future__ import annotations
 
 import csv
+import functools
 import io
 import itertools
 import os
 import stat
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -57,10 +58,27 @@ class FileMatch:
     """Two students' versions of one task file and the code they share."""
 
     task_file: str
-    texts: tuple[str, str]  # the two files as handed in
     code: tuple[int, int]  # characters of each one's own reduced code (template left out)
     matched: tuple[int, int]  # of that, characters found in the other's file
-    passages: tuple[tuple[Passage, ...], tuple[Passage, ...]]
+    prints: tuple[CodeFingerprint, CodeFingerprint] = field(repr=False, compare=False)
+
+    @property
+    def texts(self) -> tuple[str, str]:
+        """The two files as handed in."""
+        return self.prints[0].raw_code, self.prints[1].raw_code
+
+    @functools.cached_property
+    def passages(self) -> tuple[tuple[Passage, ...], tuple[Passage, ...]]:
+        """The matching passages of each side (worked out when asked: only the pairs shown
+        in full need them)."""
+        if not any(self.matched):
+            return (), ()
+        _, _, slices = compare_files(*self.prints)
+        groups = _groups(*self.prints)
+        return tuple(
+            tuple(Passage(int(a), int(b), g) for a, b, g in zip(cut[0], cut[1], side))
+            for cut, side in zip(slices, groups)
+        )
 
     @property
     def similarity(self) -> float:
@@ -180,22 +198,10 @@ def _fingerprint(name: str, text: str, template_hashes: list[int]) -> CodeFinger
 
 
 def _file_match(task_file: str, first: CodeFingerprint, second: CodeFingerprint) -> FileMatch:
-    matched, shares, slices = compare_files(first, second)
+    _, shares, _ = compare_files(first, second)
     code = (int(first.token_coverage), int(second.token_coverage))
-    passages: tuple[tuple[Passage, ...], tuple[Passage, ...]] = ((), ())
-    if matched:
-        groups = _groups(first, second)
-        passages = tuple(
-            tuple(Passage(int(a), int(b), t) for a, b, t in zip(cut[0], cut[1], side))
-            for cut, side in zip(slices, groups)
-        )
-    return FileMatch(
-        task_file,
-        (first.raw_code, second.raw_code),
-        code,
-        tuple(round(float(s) * c) for s, c in zip(shares, code)),
-        passages,
-    )
+    matched = tuple(round(float(share) * count) for share, count in zip(shares, code))
+    return FileMatch(task_file, code, matched, (first, second))
 
 
 def _groups(first: CodeFingerprint, second: CodeFingerprint) -> tuple[list[int], list[int]]:
