@@ -7,9 +7,10 @@ in their messages) and how many students each, a check × student map, the stude
 hand-in time could not be verified and those not graded. `summary_section` gives the same
 findings as Markdown.
 
-It reads `ClassRow`s, one per row of the gradebook (`rows_of`): a row's per-check results
-come from this run's reports where the student was graded in it (with the causes), else
-from the gradebook's per-check columns (``--detail``), else they are not known.
+It reads `ClassRow`s, one per row of the grades file (`rows_of`): a row's per-check results
+come from its report in the gradebook (`render` passes every record's, with the messages
+that name the causes), else from the grades file's per-check columns (a row taken in from
+an older grades file with ``--detail``), else they are not known.
 """
 
 from __future__ import annotations
@@ -70,8 +71,8 @@ class ClassRow:
 
 
 def rows_of(book: Gradebook, grades: Sequence[Grade]) -> list[ClassRow]:
-    """Every row of ``book`` as a `ClassRow`, its checks from ``grades`` (this run's) where
-    the student was graded in it, else from the book's per-check columns."""
+    """Every row of ``book`` as a `ClassRow`, its checks from its report in ``grades`` where
+    there is one, else from the book's per-check columns."""
     reports = {g.submission: g.report for g in grades if g.report is not None}
     rows = []
     for identifier in sorted(book.rows):

@@ -184,3 +184,8 @@ def test_grade_writes_the_class_report_and_its_summary_section(tmp_path, capsys)
     summary = (notes / "summary.md").read_text(encoding="utf-8")
     assert "## The class at a glance" in summary and "`../grades.class.html`" in summary
     assert re.search(r"- [^\n]*: 1 \(layer\)", summary), summary  # the cause the check named
+    # graded again alone, the other student's results and causes stay in the report
+    assert main(["grade", str(given[0]), "--out", str(out), "--feedback", str(notes), *common]) == 0
+    page = (tmp_path / "grades.class.html").read_text(encoding="utf-8")
+    assert "2 of 2 students graded" in page and "<td>layer</td>" in page  # who had a cause
+    assert re.search(r"- [^\n]*: 1 \(layer\)", (notes / "summary.md").read_text("utf-8"))
