@@ -363,14 +363,15 @@ def heatmap(rows: Sequence[ClassRow]) -> Figure:
     from matplotlib.colors import ListedColormap
     from matplotlib.figure import Figure
 
-    columns = sorted({c.column for r in rows for c in r.checks}, key=_check_order)
+    seen = {c.column: c.task for r in rows for c in r.checks}  # in the reports' order
+    columns = sorted(seen, key=seen.__getitem__)
     students = sorted(rows, key=lambda r: (r.total, r.id))
     where = {column: i for i, column in enumerate(columns)}
     cells = [[NOT_RUN] * len(students) for _ in columns]
     for j, row in enumerate(students):
         for check in row.checks:
             cells[where[check.column]][j] = PASSED if check.passed else FAILED
-    width = min(6 + 0.22 * len(students), 30)  # inches: the check names, then the students
+    width = min(6 + 0.22 * len(students), 14)  # inches: the check names, then the students
     figure = Figure(figsize=(width, 1.5 + 0.18 * len(columns)), layout="constrained")
     ax = figure.subplots()
     colours = ListedColormap(["#5cb85c", "#d9534f", "#dddddd"])
@@ -383,8 +384,3 @@ def heatmap(rows: Sequence[ClassRow]) -> Figure:
     ax.set_xlabel(f"{len(students)} students, lowest total on the left", fontsize=9)
     ax.set_title("green passed, red failed, grey not run", fontsize=9)
     return figure
-
-
-def _check_order(column: str) -> tuple[int, str]:
-    task, name = column.split(" ", 1)
-    return int(task.removeprefix("task")), name
