@@ -128,3 +128,23 @@ def test_bundle_readme_and_gitignore(bundle):
     assert {".venv/", "msdlab-output/", "__pycache__/", ".hypothesis/"} <= set(ignored)
     points = json.loads((bundle / "tests" / "tasks" / "points.json").read_text())
     assert all(counts["hidden"] > 0 for counts in points["tasks"].values())
+
+
+def test_the_bundle_carries_the_brief_and_the_student_pages_linked_from_its_readme(bundle):
+    """The README's quick start starts with a virtual environment; every relative link of
+    the README and of the pages in docs/ leads to a file of the bundle; the brief's
+    equations (1.1)-(1.4), which the tasks cite, are there; no site-only syntax is left."""
+    readme = (bundle / "README.md").read_text()
+    assert "```bash\npython3 -m venv .venv && . .venv/bin/activate\n" in readme
+    brief = (bundle / "docs" / "brief.md").read_text()
+    assert all(f"\\tag{{1.{n}}}" in brief for n in (1, 2, 3, 4))
+    pages = [bundle / "README.md", *sorted((bundle / "docs").glob("*.md"))]
+    assert len(pages) > 5
+    for page in pages:
+        text = page.read_text()
+        assert "{toctree}" not in text and "{py:obj}" not in text, page
+        for target in re.findall(r"\]\(([^)\s]+)\)", text):
+            path = target.partition("#")[0]
+            if path and not re.match(r"[a-z]+:", path):
+                assert (page.parent / path).is_file(), f"{page.name} links to {target}"
+    assert "docs/brief.md" in readme and "docs/index.md" in readme

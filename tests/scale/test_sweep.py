@@ -56,3 +56,14 @@ def test_a_sweep_on_a_cluster_writes_the_same_table(tmp_path: Path, where: str, 
     assert main([*command, "--out", str(tmp_path / "local.csv")]) == 0
     assert main([*command, "--out", str(tmp_path / "cluster.csv"), "--cluster", spec]) == 0
     assert (tmp_path / "cluster.csv").read_text() == (tmp_path / "local.csv").read_text()
+
+
+def test_without_out_the_table_goes_to_the_ignored_output_folder(tmp_path, monkeypatch):
+    """msdlab-output/, which the course's and the release's .gitignore ignore: a sweep run in
+    a clone leaves git's view of it as it was."""
+    monkeypatch.chdir(tmp_path)
+    status = main(["run", "hanging-particle", "--duration", "2", "--sweep", "dt=0.5,1"])
+    assert status == 0
+    assert [p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*") if p.is_file()] == [
+        "msdlab-output/hanging-particle-sweep.csv"
+    ]
