@@ -12,11 +12,13 @@ and counts, over ``--seconds``:
 - pace: the share of the asked steps the engine did (1.00: it keeps up);
 - Chromium's CPU time (psutil, which ipykernel installs).
 
-For the mesh it then presses on a particle and moves the mouse around a circle for two
-seconds, and reports the delays from a mouse move (the event's time stamp) to the frame
-drawing the held particle at the hand and to the first positions from the engine with it
-there, and the drag's energy drift: the change of the total the energy panel shows
-(in the body plus all taken out) over the hand's work (the "driven" bar's change).
+For the mesh it then presses on a particle and moves the mouse around a circle for four
+seconds, and reports what the page counted while the particle was dragged (new pictures a
+second, the longest gap, the gaps over 50 ms), the delays from a mouse move (the event's
+time stamp) to the frame drawing the held particle at the hand and to the first positions
+from the engine with it there, and the drag's energy drift: the change of the total the
+energy panel shows (in the body plus all taken out less the hand's work) over the hand's
+work (the "hand's work" bar's change).
 The ceiling: requestAnimationFrame callbacks a second of an empty page in the same
 browser, measured before each case; and the machine's load average (`os.getloadavg`).
 
@@ -81,7 +83,7 @@ return { frames: s.frames, pictures: s.pictures ?? s.drawn, updates: s.updates,
   times: s.pictureTimes ?? null, pace: Number(v.status.dataset.pace ?? NaN),
   now: performance.now() }; }"""
 BOOKS = """() => { const c = document.querySelector('.msdlab-energy');
-return [Number(c.dataset.total), JSON.parse(c.dataset.bars).driven ?? 0]; }"""
+return [Number(c.dataset.total), JSON.parse(c.dataset.bars)["hand's work"] ?? 0]; }"""
 
 
 def browser_cpu() -> float:
@@ -97,12 +99,19 @@ def browser_cpu() -> float:
 
 
 def page_counts(page, seconds: float) -> dict:
-    """A second's frames, new pictures and updates over ``seconds``; the longest gap
-    between new pictures and the gaps over 50 ms (ms; None for a page that does not
-    keep their times); the pace; Chromium's CPU (ms a second, all its processes)."""
+    """A second's frames, new pictures and updates over ``seconds`` (`counted_between`);
+    Chromium's CPU (ms a second, all its processes)."""
     before, cpu = page.evaluate(COUNTS), browser_cpu()
     time.sleep(seconds)
     after, cpu = page.evaluate(COUNTS), browser_cpu() - cpu
+    counts = counted_between(before, after)
+    return {**counts, "cpu": 1000 * cpu / counts["seconds"]}
+
+
+def counted_between(before: dict, after: dict) -> dict:
+    """A second's frames, new pictures and updates between two `COUNTS`; the longest gap
+    between new pictures and the gaps over 50 ms (ms; None for a page that does not keep
+    their times); the pace."""
     elapsed = (after["now"] - before["now"]) / 1000
     counted = ("frames", "pictures", "updates", "received")
     rates = {k: (after[k] - before[k]) / elapsed for k in counted}
@@ -115,7 +124,7 @@ def page_counts(page, seconds: float) -> dict:
         "longest gap": None if gaps is None else float(gaps.max()),
         "gaps over 50 ms": None if gaps is None else int(np.sum(gaps > 50)),
         "pace": after["pace"],
-        "cpu": 1000 * cpu / elapsed,
+        "seconds": elapsed,
     }
 
 
@@ -127,11 +136,12 @@ def empty_page_rate(browser, seconds: float = 3.0) -> float:
     return rate
 
 
-def circular_drag(page, seconds: float = 2.0, radius: float = 60.0) -> dict:
+def circular_drag(page, seconds: float = 4.0, radius: float = 60.0) -> dict:
     """Press on the mesh's top-right particle and move the mouse around a circle of
-    ``radius`` px for ``seconds``; the delays (ms) from the moves to the frame drawing the
+    ``radius`` px for ``seconds``; what the page counted while dragged (`counted_between`)
+    and the mouse moves a second; the delays (ms) from the moves to the frame drawing the
     held particle at the hand and to the engine's positions with it there, and the
-    energy panel's total and "driven" bar before the press and a second after release."""
+    energy panel's total and hand's work bar before the press and a second after release."""
     canvas = page.locator(".msdlab-canvas")
     canvas.scroll_into_view_if_needed()  # the reset button's click may have scrolled it away
     box = canvas.bounding_box()
@@ -142,16 +152,20 @@ def circular_drag(page, seconds: float = 2.0, radius: float = 60.0) -> dict:
     books = page.evaluate(BOOKS)
     page.mouse.move(*particle)
     page.mouse.down()
+    before, moves = page.evaluate(COUNTS), 0
     start = time.perf_counter()
     while (elapsed := time.perf_counter() - start) < seconds:
         angle = 2 * np.pi * elapsed / seconds * 2  # twice round
         page.mouse.move(*(particle + radius * np.array([np.cos(angle) - 1, np.sin(angle)])))
+        moves += 1
         time.sleep(1 / 60)
+    during = counted_between(before, page.evaluate(COUNTS))
     page.mouse.up()
     time.sleep(1.0)
     drawn, engine = page.evaluate(DELAYS)
-    total, driven = np.array(page.evaluate(BOOKS)) - books
-    return {"drawn": drawn, "engine": engine, "total": total, "work": -driven}
+    total, work = np.array(page.evaluate(BOOKS)) - books
+    return {"drawn": drawn, "engine": engine, "total": total, "work": work,
+            "during": during, "moves": moves / during["seconds"]}  # fmt: skip
 
 
 def shut_down_kernels(url: str, token: str) -> None:
@@ -219,6 +233,14 @@ def run_case(browser, url: str, token: str, tmp: Path, key: str, seconds: float)
         flush=True,
     )
     if drag is not None:
+        during = drag["during"]
+        print(
+            f"  while dragged ({drag['moves']:.0f} mouse moves/s): {during['frames']:.1f} "
+            f"frames/s, {during['pictures']:.1f} new pictures/s, {during['updates']:.1f} "
+            f"states shown/s of {during['received']:.1f} received; longest gap "
+            f"{during['longest gap']:.0f} ms, {during['gaps over 50 ms']} over 50 ms",
+            flush=True,
+        )
         for what in ("drawn", "engine"):
             if drag[what]:
                 print(

@@ -265,12 +265,12 @@ class Grab(Constraint):
 
     While held, the particle is fixed (forces do not move it), sits on the
     target, and its velocity is the target's displacement over the step / dt,
-    so dashpots and the ledger ("driven") see the hand's motion. On release it
-    keeps that velocity: zero if the hand was still, so it does not fling with
-    the spring forces it resisted while held.
+    so dashpots and the ledger see the hand's motion: the energy it puts in is booked
+    (negative) under "hand". On release it keeps that velocity: zero if the hand was
+    still, so it does not fling with the spring forces it resisted while held.
     """
 
-    ledger_name = "driven"
+    ledger_name = "hand"
 
     def __init__(self) -> None:
         self.particle: int | None = None

@@ -12,11 +12,17 @@
 const LEVELS = 64;
 const PICK_RADIUS = 25; // px: how near the mouse a particle must be to be taken
 const HISTORY = 600; // points of the energy plot
+// the ledger's entries of energy put in (booked negative), shown as the work done
+const PUT_IN = { hand: "hand's work", driven: "driven particles' work" };
 const DENSE = 3000; // springs from which lines are written as pixels (`Pixels`)
 const SURFACE_ONLY = 30000; // springs from which a 3-D body is drawn by its surface
 const QUEUED = 6; // states kept waiting at most: older ones are dropped (6 frames late at most)
 const PICTURE_TIMES = 1200; // times of the last new pictures kept in a view's stats
 const REPORT_EVERY = 1000; // ms between two reports of the page's frame rate to the kernel
+// ms over which the hand's moves go to the kernel together, in one message: a message each
+// (60 a second) cost the kernel a request and the page two status messages each, as many
+// as the states it draws; the kernel plays the moves back at their pace whenever they come
+const MOVES_EVERY = 50;
 
 /** A typed array of `Type` over a DataView, ArrayBuffer or typed array. */
 function typed(data, Type) {
@@ -363,16 +369,26 @@ class EnergyPanel {
     this.bars = {};
   }
 
+  /** The bars: the energies in the body, what each mechanism took out, and the work put
+   * in by the hand and by driven particles (the ledger books it negative, as taken out:
+   * shown as the positive work done); the total, in the body + taken out - put in, stays
+   * level. */
   update(energy) {
     if (!energy) return;
     const bars = { kinetic: energy.kinetic, elastic: energy.elastic,
       gravitational: energy.gravitational };
     if (energy.other) bars["other potential"] = energy.other;
-    for (const [name, value] of Object.entries(energy.dissipated)) bars[name] = value;
-    const sum = Object.values(bars).reduce((s, v) => s + v, 0);
+    let sum = Object.values(bars).reduce((s, v) => s + v, 0);
+    const booked = [];
+    for (const [name, value] of Object.entries(energy.dissipated)) {
+      const label = PUT_IN[name] ?? name;
+      bars[label] = label === name ? value : -value;
+      sum += value;
+      booked.push(label);
+    }
     const top = Math.max(...Object.values(bars).map(Math.abs));
-    for (const name of Object.keys(energy.dissipated)) {
-      if (Math.abs(bars[name]) <= 1e-9 * top) delete bars[name]; // nothing taken out yet
+    for (const label of booked) {
+      if (Math.abs(bars[label]) <= 1e-9 * top) delete bars[label]; // nothing booked yet
     }
     this.bars = bars;
     this.total = sum;
@@ -674,6 +690,13 @@ function render({ model, el }) {
     if (state.status !== undefined && !model.get("error")) view.status.textContent = state.status;
     if (state.readings !== undefined) tools.update(state.readings);
   };
+  let path = [], sending = null; // the hand's moves not sent yet: [time, ...target] each
+  const sendPath = () => {
+    clearTimeout(sending);
+    sending = null;
+    if (path.length) send({ type: "move", path });
+    path = [];
+  };
   const source = {
     latest: () => { // one state a frame
       if (states.length) show(states.shift());
@@ -681,8 +704,14 @@ function render({ model, el }) {
     },
     // with the time of the hand's move (ms): the kernel plays the moves back at their pace
     grab: (particle, target, time) => send({ type: "grab", particle, target, time }),
-    move: (target, time) => send({ type: "move", target, time }),
-    release: () => send({ type: "release" }),
+    move: (target, time) => {
+      path.push([time, ...target]);
+      sending ??= setTimeout(sendPath, MOVES_EVERY);
+    },
+    release: () => {
+      sendPath(); // the moves before it
+      send({ type: "release" });
+    },
     stepping: () => model.get("running") && !model.get("error"),
     readings: () => tools.shown(),
   };
@@ -711,6 +740,7 @@ function render({ model, el }) {
   return () => {
     view.alive = false;
     clearInterval(report);
+    clearTimeout(sending);
     tools.stop();
     model.off("change:positions", onPositions);
     model.off("msg:custom", onMessage);

@@ -310,12 +310,13 @@ class LiveView(anywidget.AnyWidget):
     # ------------------------------------------------------------------ the page's requests
     def _on_message(self, _widget: object, content: dict, buffers: list) -> None:
         """A request from the page, queued for the stepping thread (or done now if none).
-        A grab or move carries the time the hand was there (ms, the page's clock); one
-        without it is timed by its arrival."""
+        A grab carries the time the hand was there (ms, the page's clock; without it, it is
+        timed by its arrival), a move the hand's path since the last (``path``: ``[time,
+        *target]`` each, `MOVES_EVERY` ms of it in live.js)."""
         stamp = float(content.get("time", 1000.0 * time.perf_counter()))
         handlers = {
             "grab": lambda: self._take(content["particle"], content["target"], stamp),
-            "move": lambda: self._move(content["target"], stamp),
+            "move": lambda: self._move(content["path"]),
             "release": self._release,
             "step": self.step_once,
             "reset": self.reset,
@@ -339,10 +340,12 @@ class LiveView(anywidget.AnyWidget):
         self.pick(particle)
         self._moved = True
 
-    def _move(self, target: list[float], stamp: float) -> None:
-        """The hand at ``target`` at time ``stamp`` (ms) (nothing if it holds nothing)."""
+    def _move(self, path: list[list[float]]) -> None:
+        """The hand's moves, each ``[time, *target]`` (ms, world units), in the order made
+        (nothing if it holds nothing)."""
         if self.hand is not None and not self._letting_go:
-            self.hand.add(stamp, target)
+            for time_made, *target in path:
+                self.hand.add(time_made, target)
             self._moved = True
 
     def _release(self) -> None:

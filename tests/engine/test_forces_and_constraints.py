@@ -219,9 +219,9 @@ def test_a_hand_moved_on_a_circle_is_booked_as_the_work_it_did():
     for k in range(1, 241):
         angle = 4 * np.pi * k / 240
         grab.move(centre + 40.0 * np.array([np.cos(angle) - 1.0, np.sin(angle)]))
-        driven = sim.dissipated["driven"]
+        put_in = sim.dissipated["hand"]
         sim.step()
-        gross += abs(sim.dissipated["driven"] - driven)
+        gross += abs(sim.dissipated["hand"] - put_in)
     grab.release()
     sim.run(duration=100.0)  # the drag takes the rest out
     balance = energy_in(sim) + sum(sim.dissipated.values()) - start

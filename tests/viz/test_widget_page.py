@@ -176,15 +176,22 @@ def test_a_finger_drags_a_particle_with_pointer_events(widget_page):
     for fraction in np.linspace(0.2, 1.0, 5):
         finger("touchMove", start + fraction * np.array([60.0, 30.0]))
         kernel.frames()
-    sent = [what[0] for kind, *what in kernel.asked if kind == "send"]
-    grab, *moves = [m for m in sent if m["type"] != "frames"]  # not the page's frame rate
-    assert grab["type"] == "grab" and grab["particle"] == 1
-    assert [m["type"] for m in moves] == ["move"] * len(moves) and len(moves) == 5
-    assert kernel.view.grab.particle == 1
-    for _ in range(60):  # a second at most: the moves are played back at the finger's pace
-        if kernel.view.hand.caught_up:
+
+    def asked() -> tuple[dict, list[dict]]:  # the grab, and the moves (the path) since
+        sent = [what[0] for kind, *what in kernel.asked if kind == "send"]
+        grab, *moves = [m for m in sent if m["type"] != "frames"]  # not the page's frame rate
+        return grab, moves
+
+    for _ in range(60):  # a second at most: the last moves go within 50 ms, played back at
+        _, moves = asked()  # the finger's pace
+        if sum(len(m["path"]) for m in moves) == 5 and kernel.view.hand.caught_up:
             break
         kernel.frames()
+    grab, moves = asked()
+    assert grab["type"] == "grab" and grab["particle"] == 1
+    assert {m["type"] for m in moves} == {"move"}  # the finger's path, a few moves a message
+    assert sum(len(m["path"]) for m in moves) == 5
+    assert kernel.view.grab.particle == 1
     screen_now = page.evaluate(
         """(x) => { const out = new Float32Array(2), depth = new Float32Array(1);
         window.msdlabViews[0].camera.project(Float32Array.from(x), 1, out, depth);
@@ -195,6 +202,34 @@ def test_a_finger_drags_a_particle_with_pointer_events(widget_page):
     finger("touchEnd", start)
     kernel.frames()
     assert kernel.view.grab.particle is None
+
+
+def test_the_hands_quick_moves_reach_the_kernel_together_with_their_times(widget_page):
+    """A mouse moved six times within a few ms: one message with the six moves, in order,
+    each with its time (the kernel plays them back at the hand's pace), not six messages
+    (each a request to the kernel and two status messages back)."""
+    page, kernel = widget_page
+    box = page.locator(".msdlab-canvas").bounding_box()
+    screen = np.array(page.evaluate("() => Array.from(window.msdlabViews[0].painter.screen)"))
+    start = [box["x"] + 1 + float(screen[2]), box["y"] + 1 + float(screen[3])]  # hung mass
+    page.mouse.move(*start)
+    page.mouse.down()
+    page.evaluate(
+        """(start) => { const canvas = document.querySelector('.msdlab-canvas');
+        for (let k = 1; k <= 6; k++) canvas.dispatchEvent(new PointerEvent('pointermove',
+          { pointerId: 1, clientX: start[0] + 5 * k, clientY: start[1], bubbles: true })); }""",
+        start,
+    )
+    page.wait_for_timeout(150)  # longer than the 50 ms the page gathers moves over
+    kernel.frames()
+    sent = [what[0] for kind, *what in kernel.asked if kind == "send"]
+    moves = [m for m in sent if m["type"] == "move"]
+    assert len(moves) == 1 and len(moves[0]["path"]) == 6
+    times = [move[0] for move in moves[0]["path"]]
+    assert times == sorted(times)
+    xs = [move[1] for move in moves[0]["path"]]
+    assert np.all(np.diff(xs) > 0)  # the moves in the order made
+    page.mouse.up()
 
 
 def test_the_keyboard_pauses_steps_resets_and_sets_the_speed(widget_page):
