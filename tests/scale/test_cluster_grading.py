@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from msdlab.cli import main
-from msdlab.course import PROJECT_ROOT
+from msdlab.course import PROJECT_ROOT, own_numbers
 from msdlab.instructor import grading, intake
 from msdlab.instructor.cluster_grading import grade_all_on_cluster
 
@@ -95,3 +95,23 @@ def test_a_grading_that_fails_in_the_grader_keeps_its_row_in_its_place(
         "grader error: the grader lost it (MemoryError: the grader ran out of memory)"
     ]
     assert grades[0].notes == grades[2].notes == ["graded elsewhere"]
+
+
+def test_on_the_cluster_each_student_is_graded_against_their_own_numbers(
+    task1_checks: Path, scheduler: str, tmp_path: Path
+) -> None:
+    """alice's task 1 in her own template: full marks under her id, the floor step missed
+    under carol's (own numbers travel with the grading call to the worker)."""
+    solution = (PROJECT_ROOT / "solutions" / "task1.py").read_text()
+    folder = tmp_path / "alice"
+    folder.mkdir()
+    text = own_numbers.personalised(1, solution, own_numbers.numbers("alice"))
+    (folder / "task1.py").write_text(text)
+    submissions = [grading.Submission(name, folder) for name in ("alice", "carol")]
+    alice, carol = grade_all_on_cluster(
+        submissions, task1_checks, scheduler, own_numbers=True, call_timeout=10.0,
+        isolation="process",
+    )  # fmt: skip
+    assert alice.graded and alice.points(1) == sum(c.points for c in alice.report.checks)
+    failed = {check.name for check in carol.report.checks if not check.passed}
+    assert "steps_to_floor_as_template" in failed
