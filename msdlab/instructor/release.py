@@ -128,7 +128,8 @@ def build(out: Path, root: Path, force: bool = False, student: str | None = None
     if own != (student is not None):
         raise ValueError(
             f"{root / own_numbers.SETTINGS_FILE} gives each student their own numbers: build "
-            "one release per student with --student ID (the roster id)"
+            f"one release per student with --student ID (the roster id), e.g. msdlab release "
+            f"{Path(out).name}/alice --student alice"
             if own
             else "--student is for a course that gives each student their own numbers: set "
             f'"own_numbers": true in {root / own_numbers.SETTINGS_FILE}, or leave --student out'
