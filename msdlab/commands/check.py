@@ -18,7 +18,6 @@ from pathlib import Path
 
 from ..course import TASKS, manifest, own_numbers
 from ..course.loader import ENV_IMPL
-from ..course.report import CheckReport
 from ..course.runner import (
     CALL_TIMEOUT,
     CHECKS,
@@ -115,35 +114,13 @@ def run(args: argparse.Namespace) -> int:
             print(error.output)
             print(error)
             return 2
-        worth = max(
-            manifest.hidden_points(points, task),
-            manifest.hidden_points(checks / manifest.FILE_NAME, task),
-        )
+        worth = manifest.hidden_worth(checks, points, task)
     if args.verbose:
         print(output)
     width = shutil.get_terminal_size((100, 24)).columns
     print()
-    print(report.table(width))
-    print(score_line(report, worth))
-    details = report.details(width)
-    if details:
-        print("\nin full:\n")
-        print(details)
+    print(report.printout(width, worth))
     return 0 if report.all_passed else 1
-
-
-def score_line(report: CheckReport, hidden_worth: int) -> str:
-    """'public P of Q points; hidden checks worth H more run when graded' (or the hidden score
-    when they ran)."""
-    public = [c for c in report.checks if not c.hidden]
-    hidden = [c for c in report.checks if c.hidden]
-    line = f"public {sum(c.earned for c in public)} of {sum(c.points for c in public)} points"
-    if hidden:
-        earned, points = sum(c.earned for c in hidden), sum(c.points for c in hidden)
-        return f"{line}; hidden {earned} of {points} points"
-    if hidden_worth:
-        return f"{line}; hidden checks worth {hidden_worth} more run when graded"
-    return line
 
 
 def parse_task(text: str | None) -> int | None:

@@ -17,6 +17,8 @@ import re
 import traceback
 from pathlib import Path
 
+from .report import WHERE
+
 EXAMPLE_NOTE = re.compile(r"^(Falsifying example|Failing test case): \w+\((?P<args>.*)\)\s*$", re.S)
 """Hypothesis' note on the example a property check failed on."""
 
@@ -24,25 +26,27 @@ ANY_VALUE = "# or any other generated value"
 """Hypothesis' comment on an argument the failure does not depend on."""
 
 
-def raised_in(error: BaseException, folder: Path | None) -> str:
-    """'in your code: assignments/task2.py, line 51, in spring_acceleration' and the line's
-    code, for the innermost frame of ``error``'s traceback in a file of ``folder``; '' when
-    the error was not raised in (or through) the student's files."""
+def raised_in(error: BaseException, folder: Path | None, code: bool = True) -> str:
+    """'in your code: assignments/task2.py, line 51, in spring_acceleration' and (with
+    ``code``) the line's code, for the innermost frame of ``error``'s traceback in a file of
+    ``folder`` (a method named with its class); '' when the error was not raised in (or
+    through) the student's files."""
     if folder is None:
         return ""
     folder = Path(folder).resolve()
     frames = [
-        frame
-        for frame in traceback.extract_tb(error.__traceback__)
-        if Path(frame.filename).resolve().parent == folder
+        (frame, line)
+        for frame, line in traceback.walk_tb(error.__traceback__)
+        if Path(frame.f_code.co_filename).resolve().parent == folder
     ]
     if not frames:
         return ""
-    frame = frames[-1]
-    shown = f"{folder.name}/{Path(frame.filename).name}"
-    code = (frame.line or linecache.getline(frame.filename, frame.lineno or 0)).strip()
-    where = f"in your code: {shown}, line {frame.lineno}, in {frame.name}"
-    return f"{where}\n    {code}" if code else where
+    frame, line = frames[-1]
+    path = frame.f_code.co_filename
+    name = getattr(frame.f_code, "co_qualname", frame.f_code.co_name)  # Python 3.11+
+    where = f"{WHERE}{folder.name}/{Path(path).name}, line {line}, in {name}"
+    text = linecache.getline(path, line).strip() if code else ""
+    return f"{where}\n    {text}" if text else where
 
 
 def failing_inputs(note: str) -> str:

@@ -9,8 +9,11 @@ A check states its expectation with `expect`::
     )
 
 and the student reads "total energy grew 40 % in 200 steps at dt = 0.1. Usual
-cause: ...". `CheckFailed` is an `AssertionError`, so pytest reports it as a
-failed check, not as an error in the check itself.
+cause: ...". A cause the check recognised by computing it (`Recognised`, what
+`matching_variant` returns) is said as the student's mistake, and the report
+names it once for every check that recognised it. `CheckFailed` is an
+`AssertionError`, so pytest reports it as a failed check, not as an error in the
+check itself.
 """
 
 from __future__ import annotations
@@ -19,15 +22,33 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .report import MISTAKE_SENTENCE
+
 
 class CheckFailed(AssertionError):
-    """A check saw wrong physics; the message says what it saw and the usual cause."""
+    """A check saw wrong physics; the message says what it saw and the usual cause.
+
+    ``mistake`` is the typical mistake the check recognised in the result ('' if none):
+    the report names it once for all the checks that recognised it.
+    """
+
+    def __init__(self, message: str, mistake: str = "") -> None:
+        super().__init__(message)
+        self.mistake = mistake
+
+
+class Recognised(str):
+    """A cause the check computed and found equal to the result (`matching_variant`): not the
+    usual cause of such a failure but the student's mistake, said as such."""
 
 
 def expect(condition: object, saw: str, cause: str = "") -> None:
-    """Raise `CheckFailed` with "<saw>. Usual cause: <cause>" unless ``condition`` holds."""
+    """Raise `CheckFailed` unless ``condition`` holds: "<saw>. Usual cause: <cause>.", or for a
+    `Recognised` cause "<saw>. Your result is exactly what this mistake gives: <cause>."."""
     if not bool(condition):
         message = saw.rstrip(". ") + "."
+        if isinstance(cause, Recognised):
+            raise CheckFailed(f"{message} {MISTAKE_SENTENCE.format(cause)}", mistake=str(cause))
         if cause:
             message += f" Usual cause: {cause.rstrip('. ')}."
         raise CheckFailed(message)
@@ -115,13 +136,13 @@ def expect_nontrivial(got: np.ndarray, given: np.ndarray, what: str) -> None:
 
 def matching_variant(
     got: np.ndarray, variants: dict[str, np.ndarray], rtol: float = 1e-6
-) -> str | None:
+) -> Recognised | None:
     """The name of the first variant (a typical mistake, computed by the check) equal to ``got``."""
     got = np.asarray(got, dtype=float)
     for name, values in variants.items():
         values = np.asarray(values, dtype=float)
         if values.shape == got.shape and relative_error(got, values) < rtol:
-            return name
+            return Recognised(name)
     return None
 
 

@@ -51,11 +51,23 @@ class TaskModule:
         try:
             value = getattr(self._module, name)
         except AttributeError:
+            if not name.startswith("__") and self._is_empty():
+                raise AttributeError(
+                    f"{self._path.name} is empty: start again from the template's "
+                    f"{self._path.name} and write the task in it (file {self._path})"
+                ) from None
             raise AttributeError(
                 f"{self._path.name} has no '{name}': keep the names of the template "
                 f"(file {self._path})"
             ) from None
         return call_limit.limited(value, self._call_timeout, self._path.name)
+
+    def _is_empty(self) -> bool:
+        """Whether the task file holds nothing but blank lines (saved empty, or emptied)."""
+        try:
+            return not self._path.read_text(encoding="utf-8", errors="replace").strip()
+        except OSError:
+            return False
 
     def __repr__(self) -> str:
         return f"<task module {self._path}>"

@@ -21,6 +21,7 @@ from __future__ import annotations
 import os
 import re
 import sys
+import tempfile
 import textwrap
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -28,7 +29,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
-from . import loader
+from . import loader, manifest, own_numbers
 from .pytest_plugin import ENV_IMPL
 from .report import CheckReport
 from .runner import ChecksDidNotRun, checks_folder, run_checks
@@ -132,24 +133,22 @@ class Course:
             print(f"skipped: {error}, a result of a cell above that waits for {waiting}")
 
     def check(self, number: int, timeout: float = 900.0) -> CheckReport | None:
-        """Run the checks of task ``number`` on these task files (as ``msdlab check``) and print
-        the table, with what the failing checks saw; return the report (None if they could
-        not run)."""
-        print(f"checks of task {number} on {self.label}:\n")
-        try:
-            report, _ = run_checks(
-                checks_folder(None, self.root), self.folder, number, timeout=timeout
-            )
-        except ChecksDidNotRun as error:
-            print(error.output[-6000:])
-            print(error)
-            return None
-        print(report.table(width=100))
-        details = report.details(width=100)
-        if details:
-            seen = any(not c.passed and c.exception != "NotImplementedError" for c in report.checks)
-            print("\nwhat the failing checks saw:\n" if seen else "")
-            print(details)
+        """Run the checks of task ``number`` on these task files and print what ``msdlab check``
+        prints (`CheckReport.printout`); return the report (None if they could not run)."""
+        print(f"checks of task {number} on {self.label}:")
+        own = own_numbers.announced(self.folder)
+        print(f"  with {own}\n" if own else "")
+        checks = checks_folder(None, self.root)
+        with tempfile.TemporaryDirectory(prefix="msdlab-check-") as scratch:
+            points = Path(scratch) / manifest.FILE_NAME
+            try:
+                report, _ = run_checks(checks, self.folder, number, timeout=timeout, points=points)
+            except ChecksDidNotRun as error:
+                print(error.output[-6000:])
+                print(error)
+                return None
+            worth = manifest.hidden_worth(checks, points, number)
+        print(report.printout(100, worth))
         return report
 
     def _raised_in(self, tb: TracebackType | None) -> str:

@@ -266,7 +266,7 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo):
         result.outcome, result.message = "skipped", _skip_reason(report)
     elif report.failed:
         result.outcome = "failed" if report.when == "call" else "error"
-        result.exception, result.message = _describe(call, _task_folder(item))
+        result.exception, result.message, result.mistake = _describe(call, _task_folder(item))
     elif report.when == "call":
         result.outcome = "passed"
 
@@ -301,17 +301,37 @@ def _result(item: pytest.Item, graded: tuple[int, int, bool]) -> CheckResult:
     return CheckResult(item.nodeid, name, task, points, hidden, outcome="error")
 
 
-def _describe(call: pytest.CallInfo, folder: Path | None) -> tuple[str | None, str]:
-    """The exception's type name and its message in the course's words: where in the task
-    files of ``folder`` it was raised, and the input a property check failed on."""
+def _describe(call: pytest.CallInfo, folder: Path | None) -> tuple[str | None, str, str]:
+    """The exception's type name, its message in the course's words (where in the task files
+    of ``folder`` it was raised, the input a property check failed on, each of the failures
+    Hypothesis found) and the mistake the check recognised ('' if none)."""
     if call.excinfo is None:
-        return None, ""
+        return None, "", ""
     error = call.excinfo.value
-    lines = [str(error).strip()] if str(error).strip() else []
-    if not isinstance(error, (NotImplementedError, call_limit.CallTimedOut)):
+    errors = getattr(error, "exceptions", None)  # an exception group (Python 3.10: a backport)
+    if not isinstance(errors, tuple) or not errors:
+        return type(error).__name__, _explain(error, folder), getattr(error, "mistake", "")
+    kinds = {type(e).__name__ for e in errors}
+    mistakes = {getattr(e, "mistake", "") for e in errors}
+    lines = [f"it fails in {len(errors)} different ways:"]
+    for number, each in enumerate(errors, 1):
+        text = _explain(each, folder)
+        text = text if len(kinds) == 1 else f"{type(each).__name__}: {text}"
+        lines += [f"{number}. {line}" if i == 0 else f"   {line.strip()}"
+                  for i, line in enumerate(text.splitlines())]  # fmt: skip
+    kind = " and ".join(sorted(kinds))
+    return kind, "\n".join(lines), mistakes.pop() if len(mistakes) == 1 else ""
+
+
+def _explain(error: BaseException, folder: Path | None) -> str:
+    """One exception's message in the course's words (see `_describe`)."""
+    lines = [str(error).strip()]
+    if isinstance(error, NotImplementedError):
+        lines.append(failure.raised_in(error, folder, code=False))  # the function to write
+    elif not isinstance(error, call_limit.CallTimedOut):
         lines.append(failure.raised_in(error, folder))
         lines += [failure.failing_inputs(str(note)) for note in getattr(error, "__notes__", ())]
-    return type(error).__name__, "\n".join(line for line in lines if line)
+    return "\n".join(line for line in lines if line)
 
 
 def _task_folder(item: pytest.Item) -> Path | None:

@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from ..course import TASKS
-from ..course.report import CheckResult
+from ..course.report import CheckResult, without_mistake
 from .gradebook_db import ABSENT, GRADER_FAILED
 from .grading import Grade
 
@@ -65,11 +65,18 @@ def for_student(grade: Grade) -> str:
             lines.append(reason)
             continue
         lines.append("")
+        named: dict[str, str] = {}  # a recognised mistake -> the check that named it first
         for check in (c for c in checks if not c.hidden):
             lines.append(f"- {check.name}: {check.earned} of {check.points} points, "
                          f"{'passed' if check.passed else check.outcome}")  # fmt: skip
             if not check.passed:
-                lines += [f"  > {scrub(line)}" for line in _message(check).splitlines() if line]
+                message = _message(check)
+                if check.mistake in named:  # one mistake, named once
+                    message = f"{without_mistake(message, check.mistake)} The same mistake as "
+                    message += f"in {named[check.mistake]}."
+                elif check.mistake:
+                    named[check.mistake] = check.name
+                lines += [f"  > {scrub(line)}" for line in message.splitlines() if line]
         secret = [c for c in checks if c.hidden]
         if secret:
             lines.append(

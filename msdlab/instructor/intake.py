@@ -268,8 +268,7 @@ def _from_folder(identifier: str, source: Path, folder: Path) -> Entry:
     if inner.is_symlink():
         entry.problem = link_problem(inner, folder)
     elif not task_files(folder) and inner.is_dir():
-        entry.folder = inner
-        entry.notes.append(f"graded from the {BUNDLE_FOLDER}/ folder inside the submission")
+        entry.folder = inner  # the bundle handed in whole: its task files, without a note
     if entry.problem is None and not task_files(entry.folder):
         entry.problem = f"no task files (task{TASKS[0]}.py ... task{TASKS[-1]}.py) handed in"
     return entry

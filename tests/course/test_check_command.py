@@ -81,7 +81,9 @@ def test_templates_fail_with_what_to_do_each_said_once(capsys):
     assert main(["check", "task1", "--impl", "assignments"]) == 1
     out = capsys.readouterr().out
     assert re.search(r"task1 particle_count +0/1  FAILED  see \[1\]", out)
-    assert out.count("to do: return the number of particles") == 1  # in full, once
+    # in full, once, with the file and the function to write
+    assert out.count("to do in assignments/task1.py, particle_count: return the number of") == 1
+    assert out.count("to do") == out.count("to do in assignments/task1.py, ") == 5
     assert "total: 0/9 points, 0 of 5 checks passed" in out
     assert "public 0 of 9 points; hidden checks worth 6 more run when graded" in out
 

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+from msdlab.cli import main
 from msdlab.course.loader import SubmissionError
 from msdlab.course.notebook import Course
 
@@ -125,14 +126,21 @@ def test_an_edited_task_file_is_used_without_restarting(course_folder):
     assert task1.particle_count(3) == 27
 
 
-def test_check_runs_the_task_checks_and_prints_the_table(course_folder, capsys):
+def test_check_prints_what_the_command_prints(course_folder, capsys, monkeypatch):
+    """The check cell shows the command's lines: the table, the hidden checks' worth and
+    the messages in full."""
     shutil.copytree(ROOT / "tests" / "tasks", course_folder / "tests" / "tasks")
     report = Course("assignments", start=course_folder).check(1)
-    out = capsys.readouterr().out
-    assert out.startswith("checks of task 1 on assignments")
+    cell = capsys.readouterr().out
+    assert cell.startswith("checks of task 1 on assignments")
     assert report is not None and report.earned == 0 and report.tasks() == [1]
-    assert "total: 0/" in out
-    assert "what the failing checks saw" not in out  # unwritten functions: the table says it
+    assert "total: 0/" in cell and "hidden checks worth 6 more run when graded" in cell
+    monkeypatch.chdir(course_folder)
+    monkeypatch.setenv("COLUMNS", "100")
+    assert main(["check", "1", "--impl", "assignments"]) == 1
+    command = capsys.readouterr().out
+    table = command.index("check ")
+    assert cell[cell.index("check ") :] == command[table:]
 
 
 def test_a_missing_folder_is_named(course_folder):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -112,7 +113,9 @@ def test_impl_option_env_fallback_and_precedence(course):
         "answer": ("failed", "NotImplementedError"),
         "hidden_answer": ("failed", "NotImplementedError"),
     }
-    assert data["checks"][0]["message"] == "Task 1: return 42"
+    assert data["checks"][0]["message"] == (
+        "Task 1: return 42\nin your code: assignments/task1.py, line 2, in answer"
+    )  # the file and function to write
     _, data = run(course, env={"MSDLAB_IMPL": "assignments"})
     assert data["implementation"] == "assignments" and data["totals"]["earned"] == 0
     _, data = run(course, "--impl=solutions", env={"MSDLAB_IMPL": "assignments"})
@@ -154,3 +157,51 @@ def test_graded_checks_need_points(course):
 def test_marker_selection(course):
     _, data = run(course, "-m", "task1 and not hidden")
     assert [c["name"] for c in data["checks"]] == ["answer"]
+
+
+GROUPED = """
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from msdlab.course.feedback import Recognised, expect
+
+pytestmark = pytest.mark.task1
+
+
+@pytest.mark.points(1)
+@settings(max_examples=50, derandomize=True, database=None)
+@given(n=st.integers(0, 10))
+def test_two_ways(task1, n):
+    task1.answer(n)
+
+
+@pytest.mark.points(1)
+def test_recognised(task1):
+    expect(task1.answer(1) == 42, saw="the answer is 41", cause=Recognised("counting from 0"))
+"""
+
+
+def test_hypothesis_groups_are_the_inputs_that_failed_and_a_recognised_mistake_is_kept(course):
+    """Two distinct failures of one property check are listed with their inputs, not as
+    Hypothesis' ExceptionGroup; a recognised mistake is written to the report."""
+    (course / "checks" / "test_demo.py").write_text(GROUPED)
+    (course / "mine" / "task1.py").write_text(
+        "def answer(n):\n"
+        "    if n == 3:\n"
+        "        raise ValueError('three')\n"
+        "    if n == 5:\n"
+        "        raise KeyError('five')\n"
+        "    return 41\n"
+    )
+    _, data = run(course, "--impl=mine")
+    grouped, recognised = data["checks"]
+    assert grouped["exception"] == "KeyError and ValueError"
+    message = grouped["message"]
+    assert "Hypothesis found" not in message and message.startswith("it fails in 2 different ways")
+    for failure in ("ValueError: three", "KeyError: 'five'"):
+        assert re.search(rf"^[12]\. {failure}$", message, re.M), message
+    assert "the input that failed: n = 3" in message and "the input that failed: n = 5" in message
+    assert recognised["mistake"] == "counting from 0"
+    assert recognised["message"] == (
+        "the answer is 41. Your result is exactly what this mistake gives: counting from 0."
+    )
