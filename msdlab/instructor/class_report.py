@@ -2,10 +2,10 @@
 
 The page (`write_html`, no network: its style inline, its pictures PNG data URIs) shows
 the points per task (a histogram each and their numbers), each check's failure rate over
-the students graded with it, the usual causes the failing checks named ("Usual cause: ..."
-in their messages) and how many students each, a check × student map, the students whose
-hand-in time could not be verified and those not graded. `summary_section` gives the same
-findings as Markdown.
+the students graded with it, the causes the failing checks named (the mistake a check
+recognised in the result, or the "Usual cause: ..." of its message) and how many students
+had each, a check × student map, the students whose hand-in time could not be verified
+and those not graded. `summary_section` gives the same findings as Markdown.
 
 It reads `ClassRow`s, one per row of the grades file (`rows_of`): a row's per-check results
 come from its report in the gradebook (`render` passes every record's, with the messages
@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..course import TASKS
+from ..course.report import MISTAKE_SENTENCE, CheckResult
 from .gradebook import Gradebook, check_column
 from .grading import Grade
 
@@ -36,7 +37,10 @@ if TYPE_CHECKING:
 TRUSTED_SOURCES = ("Gradescope's submission time",)
 """Hand-in times the student's own machine did not set (see `handin.NAMES`)."""
 UNKNOWN_TIME = "hand-in time unknown"
-CAUSE = re.compile(r"Usual cause: ([^\n]*?)\.?\s*(?:\n|$)")
+CAUSE = re.compile(
+    rf"(?:Usual cause: |{re.escape(MISTAKE_SENTENCE.split('{}')[0])})([^\n]*?)\.?\s*(?:\n|$)"
+)
+"""A cause in a failing check's message: its usual cause, or the mistake it recognised."""
 LISTED = 10
 """Students named per usual cause (the count covers all of them)."""
 PASSED, FAILED, NOT_RUN = 0, 1, 2  # a cell of the check × student map
@@ -79,7 +83,7 @@ def rows_of(book: Gradebook, grades: Sequence[Grade]) -> list[ClassRow]:
         row = book.rows[identifier]
         if identifier in reports:
             checks = tuple(
-                CheckOutcome(c.task, c.name, c.passed, None if c.passed else cause_of(c.message))
+                CheckOutcome(c.task, c.name, c.passed, None if c.passed else cause_of(c))
                 for c in reports[identifier].checks
             )
         else:
@@ -107,9 +111,13 @@ def _from_columns(row: dict[str, str], book: Gradebook) -> tuple[CheckOutcome, .
     return tuple(outcomes)
 
 
-def cause_of(message: str) -> str | None:
-    """The usual cause a failing check's message names, or None."""
-    found = CAUSE.search(message or "")
+def cause_of(check: CheckResult) -> str | None:
+    """The cause a failing check named: the mistake it recognised in the result, else the
+    usual cause its message names (a message kept without the mistake's field says both the
+    same way), else None."""
+    if check.mistake:
+        return check.mistake
+    found = CAUSE.search(check.message or "")
     return found.group(1).strip() if found else None
 
 

@@ -6,6 +6,7 @@ the page works offline. And `msdlab grade` writes it after a run."""
 from __future__ import annotations
 
 import base64
+import dataclasses
 import re
 import shutil
 import statistics
@@ -14,7 +15,7 @@ import pytest
 
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
-from msdlab.course.report import CheckReport, CheckResult
+from msdlab.course.report import MISTAKE_SENTENCE, CheckReport, CheckResult
 from msdlab.instructor import class_report
 from msdlab.instructor.class_report import CheckOutcome, ClassRow
 from msdlab.instructor.gradebook import Gradebook
@@ -189,3 +190,13 @@ def test_grade_writes_the_class_report_and_its_summary_section(tmp_path, capsys)
     page = (tmp_path / "grades.class.html").read_text(encoding="utf-8")
     assert "2 of 2 students graded" in page and "<td>layer</td>" in page  # who had a cause
     assert re.search(r"- [^\n]*: 1 \(layer\)", (notes / "summary.md").read_text("utf-8"))
+
+
+def test_a_recognised_mistake_is_its_cause_kept_or_read_back_from_the_message():
+    mistake = "the force on the far end has the sign of the near end's"
+    kept = CheckResult("test_task2.py::c", "c", 2, 2, False, "failed", None,
+                       f"saw 3. {MISTAKE_SENTENCE.format(mistake)}", mistake=mistake)  # fmt: skip
+    stored = dataclasses.replace(kept, mistake="")  # a gradebook that keeps the message only
+    assert class_report.cause_of(kept) == class_report.cause_of(stored) == mistake
+    usual = dataclasses.replace(stored, message=f"saw 3. Usual cause: {SIGN}.")
+    assert class_report.cause_of(usual) == SIGN
