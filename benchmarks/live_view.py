@@ -86,6 +86,20 @@ BOOKS = """() => { const c = document.querySelector('.msdlab-energy');
 return [Number(c.dataset.total), JSON.parse(c.dataset.bars)["hand's work"] ?? 0]; }"""
 
 
+# a hand moving the mouse around a circle, its moves made in the page at 60 a second (as a
+# mouse's are: Chromium sends one a frame), as one call: from Python, each move would be a
+# round trip to the browser, a dozen a second on a loaded machine
+HAND = """([x, y, radius, ms]) => new Promise((done) => {
+const canvas = document.querySelector('.msdlab-canvas'), t0 = performance.now();
+let moves = 0;
+const move = () => { const t = performance.now() - t0, angle = 4 * Math.PI * t / ms;
+  canvas.dispatchEvent(new PointerEvent('pointermove', { pointerId: 1, bubbles: true,
+    clientX: x + radius * (Math.cos(angle) - 1), clientY: y + radius * Math.sin(angle) }));
+  moves++;
+  if (t < ms) setTimeout(move, 1000 / 60); else done(moves / (t / 1000)); };
+move(); })"""
+
+
 def browser_cpu() -> float:
     """CPU seconds used so far by the Chromium processes this script started."""
     total = 0.0
@@ -152,20 +166,15 @@ def circular_drag(page, seconds: float = 4.0, radius: float = 60.0) -> dict:
     books = page.evaluate(BOOKS)
     page.mouse.move(*particle)
     page.mouse.down()
-    before, moves = page.evaluate(COUNTS), 0
-    start = time.perf_counter()
-    while (elapsed := time.perf_counter() - start) < seconds:
-        angle = 2 * np.pi * elapsed / seconds * 2  # twice round
-        page.mouse.move(*(particle + radius * np.array([np.cos(angle) - 1, np.sin(angle)])))
-        moves += 1
-        time.sleep(1 / 60)
+    before = page.evaluate(COUNTS)
+    moves = page.evaluate(HAND, [*particle.tolist(), radius, 1000 * seconds])
     during = counted_between(before, page.evaluate(COUNTS))
     page.mouse.up()
     time.sleep(1.0)
     drawn, engine = page.evaluate(DELAYS)
     total, work = np.array(page.evaluate(BOOKS)) - books
     return {"drawn": drawn, "engine": engine, "total": total, "work": work,
-            "during": during, "moves": moves / during["seconds"]}  # fmt: skip
+            "during": during, "moves": moves}  # fmt: skip
 
 
 def shut_down_kernels(url: str, token: str) -> None:

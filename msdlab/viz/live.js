@@ -19,10 +19,14 @@ const SURFACE_ONLY = 30000; // springs from which a 3-D body is drawn by its sur
 const QUEUED = 6; // states kept waiting at most: older ones are dropped (6 frames late at most)
 const PICTURE_TIMES = 1200; // times of the last new pictures kept in a view's stats
 const REPORT_EVERY = 1000; // ms between two reports of the page's frame rate to the kernel
-// ms over which the hand's moves go to the kernel together, in one message: a message each
-// (60 a second) cost the kernel a request and the page two status messages each, as many
-// as the states it draws; the kernel plays the moves back at their pace whenever they come
-const MOVES_EVERY = 50;
+// ms over which the hand's moves go to the kernel together, in one message: each message
+// is a request the kernel's main thread answers (and two status messages back), which
+// takes the interpreter from the stepping thread; with a message a move (60 a second) the
+// page showed 11 new pictures a second while dragged on a loaded machine, 24 with the moves
+// of 50 ms together, 34 with those of 100 ms (benchmarks/live_view.py). The kernel plays
+// the moves back at their pace whenever they come; the page draws the held particle at
+// the hand at once.
+const MOVES_EVERY = 100;
 
 /** A typed array of `Type` over a DataView, ArrayBuffer or typed array. */
 function typed(data, Type) {

@@ -90,7 +90,7 @@ def test_a_hands_circle_arriving_in_bursts_is_booked_as_its_work():
         angle = 4 * np.pi * k / 120
         target = centre + 60.0 * np.array([np.cos(angle) - 1.0, np.sin(angle)])
         path.append([1000 * k / 60, *target])
-        if k % 3 == 0:  # the page sends the moves of 50 ms in one message
+        if k % 3 == 0:  # the page sends the moves of up to 100 ms in one message
             ask(view, type="move", path=path)
             path = []
             view.frame(now := now + 1 / 60 + 0.004 * np.sin(k))
