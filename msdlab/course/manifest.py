@@ -46,3 +46,14 @@ def hidden_worth(checks: Path, found: Path, task: int | None = None) -> int:
     """The points of the hidden checks of ``task``: from the manifest of the checks a run
     ``found`` (written by ``--msdlab-points``), else from the one shipped in ``checks``."""
     return max(hidden_points(found, task), hidden_points(Path(checks) / FILE_NAME, task))
+
+
+def worth(path: Path) -> dict[int, int]:
+    """The points of each task's checks, public and hidden, in the manifest at ``path``."""
+    data = json.loads(Path(path).read_text(encoding="utf-8"))
+    if not isinstance(data, dict) or data.get("schema") != SCHEMA:
+        raise ValueError(f"{path} is not a points manifest ({SCHEMA})")
+    return {
+        int(number): int(counts.get("public", 0)) + int(counts.get("hidden", 0))
+        for number, counts in data.get("tasks", {}).items()
+    }

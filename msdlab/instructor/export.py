@@ -19,13 +19,15 @@ roster ``msdlab grade --roster`` reads, with ``folder`` as its second column.
 from __future__ import annotations
 
 import csv
-import io
 import os
 import sys
 from pathlib import Path
 
 from ..course import TASKS
-from .gradebook import Gradebook, neutralised
+from . import adjustments, final_points, problems
+from .csv_files import write_csv
+from .final_points import Terms
+from .gradebook import Gradebook
 from .intake import escaped, unescaped
 
 FORMATS = ("canvas", "moodle", "csv")
@@ -68,9 +70,7 @@ def table(
     grades: Path, roster: list[dict[str, str]] | None, form: str, assignment: str, out: Path
 ) -> list[list[str]]:
     """The lines of the export of ``grades`` in the format ``form``."""
-    book = Gradebook.load(grades)
-    if not book.rows:
-        raise ValueError(f"{grades} holds no grades; run msdlab grade --out {grades} first")
+    book = settled(grades)
     people = roster if roster is not None else [{"id": i} for i in book.rows]
     _warn_unmatched(book, people, grades)
     if form == "canvas":
@@ -78,6 +78,22 @@ def table(
     if form == "moodle":
         return _moodle(book, people, assignment)
     return _plain(book, people, out)
+
+
+def settled(grades: Path) -> Gradebook:
+    """The grades file ``grades`` with every row's total settled as ``msdlab grade`` settles
+    it (`final_points.settle`): the manual changes written since the last run count, and a
+    mistake in them stops the export as it stops grading."""
+    book = Gradebook.load(grades)
+    if not book.rows:
+        raise ValueError(f"{grades} holds no grades; run msdlab grade --out {grades} first")
+    path = adjustments.beside(grades)
+    changes, found = adjustments.parse(path)
+    maximum = final_points.worth(book.maximum)
+    found += adjustments.problems(changes, str(path))
+    problems.settle(found + adjustments.against_class(changes, str(path), maximum, set(book.rows)))
+    final_points.settle(book.rows, Terms(changes=adjustments.by_student(changes)))
+    return book
 
 
 def _warn_unmatched(book: Gradebook, people: list[dict[str, str]], grades: Path) -> None:
@@ -156,10 +172,6 @@ def _relative(source: str, folder: Path) -> str:
 
 
 def write(lines: list[list[str]], path: Path) -> None:
-    """The lines as a UTF-8 CSV file at ``path`` (no cell a spreadsheet takes for a formula)."""
-    text = io.StringIO()
-    writer = csv.writer(text, lineterminator="\n")
-    for number, line in enumerate(lines):
-        writer.writerow(line if number == 0 else [neutralised(cell) for cell in line])
-    Path(path).parent.mkdir(parents=True, exist_ok=True)
-    Path(path).write_text(text.getvalue(), encoding="utf-8")
+    """The lines as a UTF-8 CSV file at ``path`` (no cell a spreadsheet takes for a formula;
+    the first line, the columns' names, included)."""
+    write_csv(path, lines[1:], header=lines[0])

@@ -5,13 +5,15 @@
 Task changes (`adjustments`) come first; the late penalty is taken from the points after
 them; then the changes to the total. ``adjustment`` is whatever the manual changes added
 in all. Every grading run settles every row of the grades file again, so a row kept from
-an earlier run gets the changes made since. Without ``--due`` a run charges no penalty
-to the submissions it grades and leaves earlier rows' penalties as they were.
+an earlier run gets the changes made since. Without ``--due`` a run leaves earlier rows'
+penalties as they were and refuses to grade again a row charged against a due date
+(`forgotten_due`). ``msdlab export`` settles with the same `settle`.
 """
 
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from datetime import datetime
 from fractions import Fraction
@@ -22,6 +24,7 @@ from .adjustments import Change
 from .handin import HandIn
 from .intake import file_stem
 from .late import LatePolicy, format_points
+from .problems import Problem
 
 COLUMNS = ["points", "due", "handed_in", "handed_in_from", "late", "late_penalty", "adjustment"]
 """The grades file's columns between ``task5`` and ``total``."""
@@ -46,6 +49,15 @@ class Terms:
 
     def due_of(self, identifier: str) -> datetime | None:
         return self.own_due.get(identifier, self.due)
+
+
+def worth(maximum: Mapping[str, str]) -> dict[str, Fraction] | None:
+    """What each task (``task1`` ...) and the ``total`` are worth, from the grades' row of
+    maximum points (None if a run has not written it yet)."""
+    columns = [*(f"task{task}" for task in TASKS), "total"]
+    if not all(maximum.get(column) for column in columns):
+        return None
+    return {column: Fraction(maximum[column]) for column in columns}
 
 
 def settle(rows: dict[str, dict[str, str]], terms: Terms) -> dict[str, list[str]]:
@@ -75,6 +87,23 @@ def _settle_row(identifier: str, row: dict[str, str], terms: Terms) -> list[str]
     row["adjustment"] = format_points(total - Fraction(row["points"]) + penalty) if changes else ""
     row["total"] = format_points(total)
     return lines
+
+
+def forgotten_due(
+    rows: Mapping[str, Mapping[str, str]], regraded: Iterable[str], terms: Terms, where: str
+) -> list[Problem]:
+    """A student graded again without a due date whose row was charged against one: the new
+    row would drop the penalty silently (the rows of ``where``, the grades file)."""
+    return [
+        Problem(
+            f"{where}, row {identifier!r}",
+            f"was graded against the due date {rows[identifier]['due']}; grading it again "
+            "without one would drop its late penalty",
+            "give --due (and --late-policy, --extensions) as in that run",
+        )
+        for identifier in regraded
+        if terms.due_of(identifier) is None and (rows.get(identifier) or {}).get("due")
+    ]
 
 
 def _stamp(row: dict[str, str], handed: HandIn | None) -> None:
@@ -122,13 +151,20 @@ def _term(label: str, value: str | None) -> str:
     return f"{label}{value}"
 
 
-def refresh_feedback(folder: Path, rows: dict[str, dict[str, str]], lines: dict[str, list[str]],
-                     possible: str) -> None:  # fmt: skip
+def refresh_feedback(
+    folder: Path,
+    rows: dict[str, dict[str, str]],
+    lines: dict[str, list[str]],
+    possible: str,
+    private: Mapping[str, list[str]] | None = None,
+) -> None:
     """Put the section on late work and manual changes into each feedback file there is
-    (the student's and the instructor's), replacing the one an earlier run wrote."""
+    (the student's and the instructor's, which alone adds the ``private`` lines, e.g. the
+    adjustments' notes), replacing the one an earlier run wrote."""
     for identifier, row in rows.items():
-        section = feedback_section(row, lines.get(identifier, []), possible)
-        for kind in ("students", "instructor"):
+        shown = lines.get(identifier, [])
+        for kind, extra in (("students", []), ("instructor", (private or {}).get(identifier, []))):
+            section = feedback_section(row, [*shown, *extra], possible)
             path = Path(folder) / kind / f"{file_stem(identifier)}.md"
             if path.is_file():
                 path.write_text(with_section(path.read_text(encoding="utf-8"), section),

@@ -7,24 +7,20 @@ the late work and manual changes (`final_points`), ``total``, optionally one col
 of the checks and the submission's task files).
 The first row, id ``(max points)``, holds what each column is worth.
 
-Every write replaces the file atomically (a temporary file, then `os.replace`), so
-a crash leaves the previous CSV or a complete new one. Rows of earlier runs are
-kept; grading a submission again replaces its row, and a submission whose
-fingerprint is unchanged can be skipped (``--resume``).
+Every write replaces the file atomically (`csv_files.write_csv`), so a crash leaves the
+previous CSV or a complete new one; no cell is a formula to a spreadsheet, and every id
+reads back exactly. Rows of earlier runs are kept; grading a submission again replaces
+its row, and a submission whose fingerprint is unchanged can be skipped (``--resume``).
 """
 
 from __future__ import annotations
 
-import csv
 import hashlib
-import io
-import os
-import re
-import tempfile
 from pathlib import Path
 
 from ..course import TASKS
 from ..course.report import CheckReport
+from .csv_files import read_csv, write_csv
 from .feedback import scrub
 from .final_points import COLUMNS as FINAL_COLUMNS
 from .grading import Grade
@@ -32,9 +28,6 @@ from .intake import MAX_POINTS_ID, Entry, escaped
 
 FIRST = ["id", "source", *(f"task{t}" for t in TASKS), *FINAL_COLUMNS, "total"]
 LAST = ["notes", "fingerprint"]
-FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
-"""A cell starting with one of these is a formula to a spreadsheet; it gets a leading quote."""
-NUMBER = re.compile(r"-?\d+(\.\d+)?")
 
 
 def fingerprint(checks: Path, folder: Path) -> str:
@@ -53,19 +46,6 @@ def check_column(task: int, name: str) -> str:
     return f"task{task} {name}"
 
 
-def neutralised(value: object) -> str:
-    """``value`` as a CSV cell no spreadsheet takes for a formula (a number stays a number)."""
-    text = str(value)
-    if NUMBER.fullmatch(text):
-        return text
-    return "'" + text if text.startswith(FORMULA_STARTS) else text
-
-
-def restored(text: str) -> str:
-    """The value of a cell `neutralised` made."""
-    return text[1:] if text.startswith("'") and text[1:].startswith(FORMULA_STARTS) else text
-
-
 class Gradebook:
     """The rows of the grades file by id (written sorted by id, after the maximum's row)."""
 
@@ -80,20 +60,18 @@ class Gradebook:
         book = cls()
         if not Path(path).exists():
             return book
-        with Path(path).open(newline="", encoding="utf-8") as handle:
-            reader = csv.DictReader(handle)
-            columns = reader.fieldnames or []
-            if columns[:1] != ["id"] or "fingerprint" not in columns:
-                raise ValueError(
-                    f"{path} is not a grades file written by msdlab grade; give another --out"
-                )
-            book.detail_columns = [c for c in columns if c not in FIRST and c not in LAST]
-            for row in reader:
-                values = {key: restored(value or "") for key, value in row.items() if key}
-                if values["id"] == MAX_POINTS_ID:
-                    book.maximum = values
-                else:
-                    book.rows[values["id"]] = values
+        columns, *lines = read_csv(path) or [[]]
+        if columns[:1] != ["id"] or "fingerprint" not in columns:
+            raise ValueError(
+                f"{path} is not a grades file written by msdlab grade; give another --out"
+            )
+        book.detail_columns = [c for c in columns if c not in FIRST and c not in LAST]
+        for line in lines:
+            values = dict(zip(columns, [*line, *[""] * (len(columns) - len(line))]))
+            if values.get("id") == MAX_POINTS_ID:
+                book.maximum = values
+            elif values.get("id"):
+                book.rows[values["id"]] = values
         return book
 
     def fingerprint_of(self, identifier: str) -> str | None:
@@ -134,22 +112,6 @@ class Gradebook:
 
     def write(self, path: Path) -> None:
         """Write the CSV atomically: the old file stays until the new one is complete."""
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
         columns = FIRST + self.detail_columns + LAST
-        text = io.StringIO()
-        writer = csv.DictWriter(text, fieldnames=columns, restval="", extrasaction="ignore")
-        writer.writeheader()
-        for row in (self.maximum, *(self.rows[key] for key in sorted(self.rows))):
-            writer.writerow({key: neutralised(value) for key, value in row.items()})
-        handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-        try:
-            with os.fdopen(handle, "w", encoding="utf-8", newline="") as out:
-                out.write(text.getvalue())
-                out.flush()
-                os.fsync(out.fileno())
-            os.chmod(temporary, 0o644)
-            os.replace(temporary, path)
-        except BaseException:
-            Path(temporary).unlink(missing_ok=True)
-            raise
+        rows = (self.maximum, *(self.rows[key] for key in sorted(self.rows)))
+        write_csv(path, ([row.get(column, "") for column in columns] for row in rows), columns)

@@ -161,7 +161,7 @@ def build(out: Path, root: Path, force: bool = False, student: str | None = None
     written += pages
     (out / ".gitignore").write_text(STUDENT_GITIGNORE, encoding="utf-8")
     points = out / CHECKS / manifest.FILE_NAME
-    _write_points(root / CHECKS, points)
+    write_points(root / CHECKS, points)
     written += [out / "README.md", out / ".gitignore", points]
     leaks = solution_leaks(written, solution_lines(root / "solutions"))
     if leaks:
@@ -202,7 +202,7 @@ def _personalise(assignments: Path, solutions: Path, student: str) -> Path:
     return own_numbers.write_student(assignments, student)
 
 
-def _write_points(checks: Path, path: Path) -> None:
+def write_points(checks: Path, path: Path) -> None:
     """The points manifest of every check, hidden ones included (`msdlab.course.manifest`),
     from collecting the course's checks; the hidden check files themselves do not ship."""
     path.parent.mkdir(parents=True, exist_ok=True)

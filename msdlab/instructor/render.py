@@ -20,7 +20,7 @@ from pathlib import Path
 
 from ..course import TASKS
 from ..course.report import CheckReport
-from . import class_report, feedback, final_points, gradebook_db, intake
+from . import adjustments, class_report, feedback, final_points, gradebook_db, intake
 from .gradebook import Gradebook, check_column
 from .gradebook_db import GRADED, GRADER_FAILED, Record
 from .grading import Grade
@@ -56,7 +56,8 @@ def render(
         if feedback_folder is not None:
             link = os.path.relpath(class_report.beside(out), feedback_folder)
             section = class_report.summary_section(at_a_glance, link)
-            write_feedback(Path(feedback_folder), records, rows, book, section)
+            private = adjustments.private_notes(terms.changes)
+            write_feedback(Path(feedback_folder), records, rows, book, section, private)
     return records
 
 
@@ -109,10 +110,13 @@ def write_feedback(
     rows: dict[str, dict[str, str]],
     book: Gradebook,
     class_section: str = "",
+    private: dict[str, list[str]] | None = None,
 ) -> None:
     """Every submission's feedback files and the summary, ``class_section`` at its end (see
-    the module docstring); a row imported from an older grades file keeps the files it
-    had, with its section on late work and manual changes brought up to date."""
+    the module docstring; ``private``: lines by id only the instructor's file shows, the
+    adjustments' notes); a row imported from an older grades file keeps the files it had,
+    with its section on late work and manual changes brought up to date."""
+    private = private or {}
     for kind in ("students", "instructor"):
         (folder / kind).mkdir(parents=True, exist_ok=True)
     possible = book.maximum.get("total", "")
@@ -123,7 +127,8 @@ def write_feedback(
         section = final_points.feedback_section(rows[record.id], record.explained, possible)
         if record.status == GRADED and not record.checks:
             final_points.refresh_feedback(folder, {record.id: rows[record.id]},
-                                          {record.id: record.explained}, possible)  # fmt: skip
+                                          {record.id: record.explained}, possible,
+                                          private)  # fmt: skip
             continue
         grade = grade_of(record)
         if record.status == GRADER_FAILED:  # nothing to hand out: the grader's failure
@@ -131,7 +136,9 @@ def write_feedback(
         else:
             _write(student, final_points.with_section(feedback.for_student(grade), section))
         text = feedback.for_instructor(grade, record.source, record.hint)
-        _write(instructor, final_points.with_section(text, section))
+        noted = [*record.explained, *private.get(record.id, [])]
+        own_section = final_points.feedback_section(rows[record.id], noted, possible)
+        _write(instructor, final_points.with_section(text, own_section))
     grades = [grade_of(record) for record in records]
     summary = feedback.class_summary(book, records, grades) + class_section
     _write(folder / "summary.md", summary)

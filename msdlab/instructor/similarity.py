@@ -17,7 +17,6 @@ regular files, not links, of at most `MAX_FILE_BYTES`.
 
 from __future__ import annotations
 
-import csv
 import functools
 import io
 import itertools
@@ -32,7 +31,7 @@ from copydetect import CodeFingerprint, compare_files
 from copydetect.utils import find_fingerprint_overlap, get_copied_slices
 
 from ..course import TASKS
-from .gradebook import neutralised
+from . import csv_files
 from .grading import MAX_FILE_BYTES
 
 NOISE = 25
@@ -236,17 +235,15 @@ def write_csv(pairs: list[Pair], path: Path, threshold: float) -> None:
     """One row per pair of students, most similar first (columns `CSV_COLUMNS`; a task
     file's column is that file's similarity, empty where one of them did not hand it in).
     Every cell is written so that no spreadsheet takes it for a formula."""
-    with path.open("w", newline="", encoding="utf-8") as file:
-        writer = csv.writer(file)
-        writer.writerow(CSV_COLUMNS)
-        for pair in pairs:
-            per_file = [pair.file(name) for name in TASK_FILES]
-            cells = [
-                *pair.students,
-                f"{pair.similarity:.2f}",
-                *(f"{share:.2f}" for share in pair.shares),
-                max(pair.matched),
-                "yes" if pair.flagged(threshold) else "no",
-                *("" if f is None else f"{f.similarity:.2f}" for f in per_file),
-            ]
-            writer.writerow([neutralised(cell) for cell in cells])
+    lines = []
+    for pair in pairs:
+        per_file = [pair.file(name) for name in TASK_FILES]
+        lines.append([
+            *pair.students,
+            f"{pair.similarity:.2f}",
+            *(f"{share:.2f}" for share in pair.shares),
+            max(pair.matched),
+            "yes" if pair.flagged(threshold) else "no",
+            *("" if f is None else f"{f.similarity:.2f}" for f in per_file),
+        ])  # fmt: skip
+    csv_files.write_csv(path, lines, header=CSV_COLUMNS)

@@ -1,14 +1,20 @@
-"""The ``msdlab grade`` options on due dates and late work, and the run's `Terms` from them."""
+"""The ``msdlab grade`` options on due dates and late work, and the run's `Terms` from them
+and the instructor's files, checked whole."""
 
 from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
+from collections.abc import Mapping
+from fractions import Fraction
 from pathlib import Path
 
-from . import adjustments, handin, late
+from ..course import TASKS, manifest
+from . import adjustments, final_points, handin, late, release
 from .final_points import Terms
 from .intake import Entry
+from .problems import InstructorFileError, Problem
 
 
 def register(parser: argparse.ArgumentParser) -> None:
@@ -38,18 +44,46 @@ def register(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def terms(args: argparse.Namespace) -> Terms:
-    """The run's due dates, late policy and manual changes, with clear errors for bad ones."""
+def terms(args: argparse.Namespace) -> tuple[Terms, list[Problem]]:
+    """The run's due dates, late policy and manual changes, and every mistake in the options
+    and files they come from that shows without the class (`adjustments.against_class`
+    checks the rest). An unknown --timezone stops here."""
+    found: list[Problem] = []
     zone = late.time_zone(args.timezone)
-    policy = late.LatePolicy.parse(args.late_policy)
-    if args.due is None:
-        if args.late_policy or args.extensions:
-            raise ValueError("--late-policy and --extensions need --due DATE")
-        return Terms(policy=policy, changes=adjustments.read(adjustments.beside(args.out)))
-    due = late.parse_due(args.due, zone)
-    own = late.read_extensions(args.extensions, due, zone) if args.extensions else {}
-    changes = adjustments.read(adjustments.beside(args.out))
-    return Terms(due=due, policy=policy, own_due=own, changes=changes)
+    policy = late.LatePolicy()
+    try:
+        policy = late.LatePolicy.parse(args.late_policy)
+    except InstructorFileError as error:
+        found += error.problems
+    due, own = None, {}
+    if args.due is None and (args.late_policy or args.extensions):
+        found.append(Problem("command line", "--late-policy and --extensions need --due DATE"))
+    elif args.due is not None:
+        try:
+            due = late.parse_due(args.due, zone)
+        except ValueError as error:
+            found.append(Problem("command line", str(error)))
+        if due is not None and args.extensions:
+            own, wrong = late.read_extensions(args.extensions, due, zone)
+            found += wrong
+    path = adjustments.beside(args.out)
+    changes, wrong = adjustments.parse(path)
+    found += wrong + adjustments.problems(changes, str(path))
+    return Terms(due, policy, own, changes=adjustments.by_student(changes)), found
+
+
+def possible_points(maximum: Mapping[str, str], checks: Path) -> dict[str, Fraction]:
+    """What each task (``task1`` ...) and the ``total`` are worth: the grades' row of maximum
+    points ``maximum`` where a run wrote it, else from collecting the ``checks``."""
+    written = final_points.worth(maximum)
+    if written is not None:
+        return written
+    with tempfile.TemporaryDirectory(prefix="msdlab-points-") as scratch:
+        path = Path(scratch) / manifest.FILE_NAME
+        release.write_points(checks, path)
+        worth = manifest.worth(path)
+    points = {f"task{task}": Fraction(worth.get(task, 0)) for task in TASKS}
+    return {**points, "total": sum(points.values(), Fraction(0))}
 
 
 def read_hand_ins(
@@ -71,16 +105,8 @@ def read_hand_ins(
             entry.notes.append(handed.note)
 
 
-def report(terms: Terms, known: set[str], grades_file: Path) -> None:
-    """Say on stderr which changes apply, and which name a student the grades do not have."""
+def report(terms: Terms, grades_file: Path) -> None:
+    """Say on stderr how many manual changes apply."""
     count = sum(len(changes) for changes in terms.changes.values())
     if count:
         print(f"manual changes: {count} from {adjustments.beside(grades_file)}", file=sys.stderr)
-    for identifier in sorted(set(terms.changes) - known):
-        print(
-            f"warning: {adjustments.beside(grades_file)} changes {identifier!r}, who has no row "
-            f"in {grades_file}",
-            file=sys.stderr,
-        )
-    for identifier in sorted(set(terms.own_due) - known):
-        print(f"warning: the extensions name {identifier!r}, who has no row", file=sys.stderr)

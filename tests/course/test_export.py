@@ -21,6 +21,9 @@ alice,{root}/class/alice/assignments,15,20,0,0,0,35,,,,,,-2,33,,abc
 def grades(tmp_path: Path) -> Path:
     path = tmp_path / "grades.csv"
     path.write_text(GRADES.format(root=tmp_path))
+    (tmp_path / "grades.adjustments.csv").write_text(
+        "id,task,change,reason,note\nalice,,-2,report handed in late,asked by email\n"
+    )
     (tmp_path / "roster.csv").write_text(
         "id,folder,name,email,sis_id,tutor\n"
         "alice,class/alice,Alice Doe,alice@uni.example,S1,Kim\n"
@@ -72,3 +75,36 @@ def test_a_roster_without_a_header_and_canvas_without_a_roster_are_refused(grade
     assert "first line must name the columns" in capsys.readouterr().err
     assert main(["export", str(grades), "--format", "canvas", *out]) == 2
     assert "--format canvas needs --roster FILE" in capsys.readouterr().err
+
+
+def test_a_change_written_after_the_last_grading_run_is_in_the_export(grades):
+    with (grades.parent / "grades.adjustments.csv").open("a") as handle:
+        handle.write('"bob, jr",2,=20,"checked by hand: right, but printed in mm"\n')
+    rows = export(grades, "moodle")
+    # bob: 15 + 20 points, less the late penalty as charged (msdlab grade --due charges
+    # it again on the new points)
+    assert [r["msdlab"] for r in rows] == ["33", "33.5"]
+    assert rows[1]["Feedback"] == "checks 15, late penalty 1.5, adjustment 20; total 33.5"
+    assert "asked by email" not in (grades.parent / "out" / "moodle.csv").read_text()
+
+
+@pytest.mark.parametrize(
+    ("line", "says"),
+    [
+        ("alice,1,=900,typo\n", "line 3: task1 is worth 15 points; this line sets it to 900"),
+        ("alice,,-2,report handed in late\n", "line 3: repeats line 2 (the same change and reason"),
+        ("carol,,+1,x\n", None),  # no such student: a warning, the export goes on
+    ],
+)
+def test_a_mistake_in_the_changes_stops_the_export_as_it_stops_grading(grades, capsys, line,
+                                                                       says):  # fmt: skip
+    with (grades.parent / "grades.adjustments.csv").open("a") as handle:
+        handle.write(line)
+    out = grades.parent / "out" / "canvas.csv"
+    arguments = ["export", str(grades), "--format", "csv", "--out", str(out)]
+    status = main(arguments)
+    printed = capsys.readouterr().err
+    if says is None:
+        assert status == 0 and "warning:" in printed and "'carol'" in printed
+    else:
+        assert status == 2 and says in printed and not out.exists()

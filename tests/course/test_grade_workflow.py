@@ -25,7 +25,7 @@ import pytest
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT, reference_cache
 from msdlab.course.report import CheckReport, CheckResult
-from msdlab.instructor import feedback, gradebook, gradebook_db, intake, render
+from msdlab.instructor import csv_files, feedback, gradebook, gradebook_db, intake, render
 from msdlab.instructor.final_points import Terms
 from msdlab.instructor.grading import Grade
 
@@ -243,7 +243,7 @@ def test_gradebook_cells_are_never_formulas_and_survive_a_round_trip(tmp_path):
     path = tmp_path / "grades.csv"
     book.write(path)
     cells = [cell for row in csv.reader(path.open()) for cell in row]
-    assert not any(cell.startswith(gradebook.FORMULA_STARTS) for cell in cells)
+    assert not any(cell.startswith(csv_files.FORMULA_STARTS) for cell in cells)
     rows = list(csv.DictReader(path.open()))
     assert rows[0]["id"] == intake.MAX_POINTS_ID and rows[0]["task2"] == "5"
     assert rows[0]["task2 rest_state"] == "2" and rows[1]["task2 pulls"] == "3"

@@ -15,7 +15,7 @@ import pytest
 
 from msdlab.cli import main
 from msdlab.course.report import CheckReport, CheckResult
-from msdlab.instructor import gradebook, gradebook_db, grading, render
+from msdlab.instructor import csv_files, gradebook, gradebook_db, grading, render
 from msdlab.instructor.final_points import Terms
 
 CHECKS = [
@@ -93,7 +93,7 @@ def test_an_older_grades_file_and_its_adjustments_are_taken_in(tmp_path, capsys)
     assert "took 2 rows of" in capsys.readouterr().err
     rows = rows_of(out)
     assert rows["alice"]["total"] == "9" and rows["alice"]["adjustment"] == "2"
-    assert gradebook.restored(next(i for i in rows if "bob" in i)) == "=bob"
+    assert csv_files.restored(next(i for i in rows if "bob" in i)) == "=bob"
     alice, bob = sorted(gradebook_db.read_class(out), key=lambda r: r.id != "alice")
     assert (alice.status, alice.fingerprint, bob.status) == ("graded", "abc", "not graded")
     assert main(["grade", "--out", str(out), "--render"]) == 0  # taken in once only

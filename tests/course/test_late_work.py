@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from datetime import datetime, timedelta, timezone
 from fractions import Fraction
 
@@ -10,7 +11,10 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from msdlab.cli import main
+from msdlab.instructor import gradebook, intake
+from msdlab.instructor.grading import Grade
 from msdlab.instructor.late import LatePolicy, format_points, parse_due, read_extensions, time_zone
+from msdlab.instructor.problems import InstructorFileError
 
 POLICY = LatePolicy.parse("grace=15m,penalty=10%/day,cap=50%,cutoff=7d")
 points = st.fractions(min_value=0, max_value=100, max_denominator=4)
@@ -71,11 +75,22 @@ def test_each_started_day_costs_the_same(earned, days):
         ("grace=15", "duration like 15m"),
         ("cap=half", "percentage like 10%"),
         ("late=1d", "unknown part 'late=1d'"),
+        ("grace=99999999999d", "grace=99999999999d is longer than a term can use: at most 366d"),
+        ("grace=15m,penalty=10%/day,grace=1h", "grace is given twice; keep one grace=..."),
+        ("penalty=150%/day", "penalty=150%: more than all the points; at most 100%"),
+        ("cap=50,cap=20%,cutoff=1x", "cap is given twice"),
     ],
 )
 def test_a_policy_written_wrong_says_how_to_write_it(policy, says):
-    with pytest.raises(ValueError, match=says):
+    with pytest.raises(ValueError, match=re.escape(says)):
         LatePolicy.parse(policy)
+
+
+def test_every_mistake_of_a_policy_is_named_at_once():
+    with pytest.raises(InstructorFileError) as refused:
+        LatePolicy.parse("cap=50,cap=20%,cutoff=1x")
+    assert [problem.where for problem in refused.value.problems] == ["--late-policy"] * 2
+    assert "2 mistakes in the instructor's files" in str(refused.value)
 
 
 def test_a_due_date_without_offset_is_wall_clock_time_in_the_course_zone():
@@ -118,17 +133,84 @@ def test_extensions_add_a_duration_or_give_a_date(tmp_path):
     due = parse_due("2027-03-01T23:59", timezone.utc)
     path = tmp_path / "extensions.csv"
     path.write_text("id,extension,due,reason\nalice,2d,,illness\nbob,,2027-03-05T12:00,travel\n")
-    own = read_extensions(path, due, timezone.utc)
+    own, problems = read_extensions(path, due, timezone.utc)
+    assert problems == []
     assert own == {
         "alice": due + timedelta(days=2),
         "bob": datetime(2027, 3, 5, 12, tzinfo=timezone.utc),
     }
     path.write_text("alice,2d\n")
-    with pytest.raises(ValueError, match="first line must name the columns"):
-        read_extensions(path, due, timezone.utc)
+    (problem,) = read_extensions(path, due, timezone.utc)[1]
+    assert "line 1: the first line must name the columns" in str(problem)
     path.write_text("id,extension\nalice,two days\n")
-    with pytest.raises(ValueError, match="line 2: extension='two days'"):
-        read_extensions(path, due, timezone.utc)
+    (problem,) = read_extensions(path, due, timezone.utc)[1]
+    assert "line 2: extension='two days'" in str(problem)
+
+
+@pytest.mark.parametrize(
+    ("lines", "says"),
+    [
+        ("alice,2d,illness\nalice,3d,again\n", "line 3: 'alice' has a second extension (the "
+         "first is on line 2); keep one line per student"),
+        ("alice,2d,ill, then away\n", "line 2: more fields than the first line names columns "
+         "(left over: then away)"),
+        (",2d,illness\n", "line 2: no student id"),
+        ("alice,99999999999d,x\n", "line 2: extension=99999999999d is longer than a term can "
+         "use: at most 366d"),
+    ],
+)  # fmt: skip
+def test_extension_mistakes_are_named_with_their_line(tmp_path, lines, says):
+    path = tmp_path / "extensions.csv"
+    path.write_text("id,extension,reason\n" + lines)
+    problems = read_extensions(path, parse_due("2027-03-01T23:59Z", None), timezone.utc)[1]
+    assert [says in str(problem) for problem in problems] == [True], problems
+    assert all(problem.refused for problem in problems)
+
+
+def test_an_extension_and_a_due_date_on_one_line_is_refused(tmp_path):
+    path = tmp_path / "extensions.csv"
+    path.write_text("id,extension,due\nalice,2d,2027-03-05T12:00\nbob,,2027-03-05T12:00\n")
+    own, (problem,) = read_extensions(path, parse_due("2027-03-01T23:59Z", None), timezone.utc)
+    assert "line 2: both an extension (2d) and a due date (2027-03-05T12:00); give one" in str(
+        problem
+    )
+    assert list(own) == ["bob"]
+
+
+@pytest.mark.parametrize(
+    ("text", "says"),
+    [
+        ("2027-03-28T02:30", "2027-03-28T02:30 does not exist on the clock of Europe/Berlin "
+         "(daylight saving time); write the one you mean with its offset: "
+         "2027-03-28T01:30+01:00 or 2027-03-28T03:30+02:00"),
+        ("2027-10-31T02:30", "2027-10-31T02:30 happens twice on the clock of Europe/Berlin "
+         "(daylight saving time); write the one you mean with its offset: "
+         "2027-10-31T02:30+02:00 or 2027-10-31T02:30+01:00"),
+    ],
+)  # fmt: skip
+def test_a_due_time_the_clock_skips_or_shows_twice_is_refused_with_its_candidates(text, says):
+    with pytest.raises(ValueError) as refused:
+        parse_due(text, time_zone("Europe/Berlin"))
+    assert str(refused.value) == f"--due {says}"
+    written = says.rsplit(": ", 1)[1].split(" or ")
+    instants = {parse_due(candidate, None) for candidate in written}
+    assert len(instants) == 2  # each candidate is an instant of its own, and reads back
+
+
+def test_a_due_time_the_machine_clock_skips_is_refused(monkeypatch):
+    import time
+
+    monkeypatch.setenv("TZ", "America/New_York")
+    time.tzset()
+    try:
+        with pytest.raises(ValueError, match="does not exist on this machine's clock"):
+            parse_due("2027-03-14T02:30", None)
+        with pytest.raises(ValueError, match="happens twice on this machine's clock"):
+            parse_due("2027-11-07T01:30", None)
+        assert parse_due("2027-03-14T03:30", None).utcoffset() == timedelta(hours=-4)
+    finally:
+        monkeypatch.undo()
+        time.tzset()
 
 
 @pytest.mark.parametrize(
@@ -165,3 +247,48 @@ def test_bad_late_options_stop_the_run_before_grading(tmp_path, capsys, options,
     assert main(["grade", *given]) == 2
     printed = capsys.readouterr()
     assert says in printed.err and "grading" not in printed.err
+
+
+def test_every_mistake_in_the_instructors_files_stops_grading_before_it_starts(tmp_path, capsys):
+    alice = tmp_path / "class" / "alice"
+    alice.mkdir(parents=True)
+    (alice / "task1.py").write_text("")
+    (tmp_path / "extensions.csv").write_text(
+        "id,extension,due\nalice,2d,2027-03-05T12:00\nalice,,2027-03-28T02:30\n"
+    )
+    (tmp_path / "grades.adjustments.csv").write_text(
+        "id,task,change,reason\nalice,1,=900,typo\nalice,2,+1,twice\nalice,2,+1,twice\n"
+    )
+    extensions = str(tmp_path / "extensions.csv")
+    options = ["--due", "2027-03-01T23:59", "--timezone", "Europe/Berlin", "--late-policy",
+               "grace=99999999999d,grace=1h", "--extensions", extensions]  # fmt: skip
+    out = tmp_path / "grades.csv"
+    assert main(["grade", str(alice), "--out", str(out), *options]) == 2
+    printed = capsys.readouterr().err
+    said = [
+        "6 mistakes in the instructor's files; fix and run again",
+        "--late-policy: grace=99999999999d is longer than a term can use",
+        "--late-policy: grace is given twice",
+        "extensions.csv, line 2: both an extension (2d) and a due date",
+        "extensions.csv, line 3: 'alice' has a second extension (the first is on line 2)",
+        "grades.adjustments.csv, line 2: task1 is worth 15 points; this line sets it to 900",
+        "grades.adjustments.csv, line 4: repeats line 3",
+    ]
+    assert [line for line in said if line not in printed] == []
+    assert "grading 1 submission" not in printed and not out.exists()
+
+
+def test_regrading_a_late_student_without_the_due_date_is_refused_before_grading(tmp_path, capsys):
+    alice = tmp_path / "alice"
+    alice.mkdir()
+    (alice / "task1.py").write_text("")
+    book = gradebook.Gradebook()
+    book.record(Grade("alice", None, []), intake.Entry("alice", alice, alice), None, False)
+    book.rows["alice"].update(due="2027-03-01T23:59+01:00", late_penalty="2")
+    out = tmp_path / "grades.csv"
+    book.write(out)
+    assert main(["grade", str(alice), "--out", str(out)]) == 2
+    printed = capsys.readouterr().err
+    assert "row 'alice': was graded against the due date 2027-03-01T23:59+01:00" in printed
+    assert "give --due (and --late-policy, --extensions) as in that run" in printed
+    assert "grading 1 submission" not in printed

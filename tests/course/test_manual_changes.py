@@ -138,3 +138,80 @@ def test_the_total_is_always_points_minus_penalty_plus_adjustment(made, hours_la
     assert settled["late_penalty"] >= 0
     if not made:
         assert rows["alice"]["adjustment"] == "" and settled["total"] <= 14
+
+
+WORTH = {**{f"task{t}": Fraction(p) for t, p in zip(range(1, 6), (15, 20, 20, 15, 25))},
+         "total": Fraction(95)}  # fmt: skip
+
+
+def mistakes(tmp_path, text: str, known=("alice", "bob"), header="id,task,change,reason,note"):
+    """The problems of an adjustments file holding ``text`` below ``header``."""
+    path = tmp_path / "grades.adjustments.csv"
+    path.write_text(header + "\n" + text)
+    made, found = adjustments.parse(path)
+    found += adjustments.problems(made, str(path))
+    return [*found, *adjustments.against_class(made, str(path), WORTH, set(known))]
+
+
+@pytest.mark.parametrize(
+    ("text", "says"),
+    [
+        ("alice,1,=900,typo\n", "line 2: task1 is worth 15 points; this line sets it to 900; "
+         "write a change within 0 ... 15"),
+        ("alice,,+96,typo\n", "line 2: total is worth 95 points; this line changes it by 96"),
+        ("alice,2,+1,checked\nbob,1,=3,x\nalice,2,+1,checked\n",
+         "line 4: repeats line 2 (the same change and reason: it would count twice); delete "
+         "one; to add twice, write the sum once"),
+        ("alice,2,+1,checked, the sign was right\n", "line 2: a note starting with a space, "
+         "the end of the reason? (left over: the sign was right); a comma inside a reason or "
+         "note must be in double quotes"),
+        ("alice,2,+1,checked, the sign, was right\n", "line 2: more fields than the first line "
+         "names columns (left over: was right)"),
+        ("alice,2,+1,checked\nalice,2,=4,by hand\n", "line 2: line 3 sets alice's task2 later, "
+         "so this change would count for nothing"),
+        ("Alice,2,+1,checked\n", "line 2: no submission has the id 'Alice'; did you mean "
+         "'alice'?"),
+    ],
+)  # fmt: skip
+def test_each_mistake_of_the_changes_is_refused_with_its_line_and_fix(tmp_path, text, says):
+    found = mistakes(tmp_path, text)
+    assert [str(problem) for problem in found if says in str(problem)], found
+    assert len(found) == 1 and found[0].refused
+
+
+def test_a_change_for_a_student_not_graded_yet_is_a_warning(tmp_path):
+    (found,) = mistakes(tmp_path, "carol,2,+1,checked\n")
+    assert not found.refused and "no submission has the id 'carol'" in str(found)
+
+
+def test_the_header_names_the_columns_and_the_private_note(tmp_path):
+    (found,) = mistakes(tmp_path, "alice,2,+1,x,y\n", header="id,task,change,reason,comment")
+    assert "line 1: the first line must be 'id,task,change,reason,note'" in str(found)
+    assert mistakes(tmp_path, "alice,2,+1,x\n", header="id,task,change,reason") == []
+
+
+def test_a_private_note_reaches_the_instructors_feedback_only(tmp_path):
+    path = tmp_path / "grades.adjustments.csv"
+    path.write_text("id,task,change,reason,note\nalice,1,=0,it is another's work,copied from bob\n")
+    made = adjustments.read(path)
+    assert str(made["alice"][0]) == "task 1 set to 0 points: it is another's work"
+    for kind in ("students", "instructor"):
+        (tmp_path / kind).mkdir()
+        (tmp_path / kind / "alice.md").write_text("# Feedback: alice\n\n**10 of 95 points**\n")
+    rows = {"alice": row(10)}
+    lines = final_points.settle(rows, Terms(changes=made))
+    private = adjustments.private_notes(made)
+    final_points.refresh_feedback(tmp_path, rows, lines, "95", private)
+    student = (tmp_path / "students" / "alice.md").read_text()
+    teacher = (tmp_path / "instructor" / "alice.md").read_text()
+    assert "another's work" in student and "copied from bob" not in student
+    assert "private note" in teacher and "copied from bob" in teacher
+
+
+def test_regrading_a_late_student_without_the_due_date_is_refused():
+    rows = {"alice": {**row(10), "due": "2027-03-01T23:59+00:00", "late_penalty": "1"},
+            "bob": row(10)}  # fmt: skip
+    (found,) = final_points.forgotten_due(rows, ["alice", "bob"], Terms(), "grades.csv")
+    assert "grades.csv, row 'alice': was graded against the due date 2027-03-01T23:59" in str(found)
+    assert "give --due" in found.fix
+    assert final_points.forgotten_due(rows, ["alice"], Terms(due=DUE), "grades.csv") == []

@@ -20,7 +20,7 @@ from modules import module_at
 
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT, TASKS
-from msdlab.instructor.gradebook import restored
+from msdlab.instructor.csv_files import restored
 from msdlab.instructor.grading import MAX_FILE_BYTES
 from msdlab.instructor.similarity_report import IN_FULL, TABLE_ROWS
 

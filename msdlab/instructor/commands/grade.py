@@ -16,7 +16,9 @@ to hand out, DIR/instructor/ID.md with everything, DIR/summary.md) and the class
 a glance (GRADES.class.html) are rendered from it over the whole class; --render
 writes them again without grading. --due, --late-policy and --extensions charge
 late work; the changes in GRADES.adjustments.csv beside the CSV
-(id,task,change,reason) are applied at every rendering. A submission graded again
+(id,task,change,reason[,note: private]) are applied at every rendering. These
+options and files are checked whole before anything is graded: every mistake is
+named with its line and the fix. A submission graded again
 gets its row replaced; --resume grades only those not yet graded with the same checks
 and files, and those the grader failed on. Ctrl-C stops the run at once, keeping what
 was graded. A failure of the grader or the machine (a sandbox killed from outside, a
@@ -45,6 +47,7 @@ from tqdm.auto import tqdm
 from ...analysis.cluster import parse_cluster
 from ...course import PROJECT_ROOT, TASKS, own_numbers
 from .. import (
+    adjustments,
     class_report,
     copied_numbers,
     feedback,
@@ -53,6 +56,7 @@ from .. import (
     gradebook_db,
     grading,
     intake,
+    problems,
     render,
     sandbox,
     term_options,
@@ -167,7 +171,8 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError("give SUBMISSION folders or zip files, or --roster FILE (not both)")
     if args.similarity:
         similarity.require_copydetect()
-    terms = term_options.terms(args)
+    terms, mistakes = term_options.terms(args)
+    problems.settle(mistakes)  # the class's ids and points are checked after the intake
     connection = open_gradebook(args.out)
     run_number = gradebook_db.start_run(connection, ["msdlab", *sys.argv[1:]])
     session = Session(args, connection, terms)
@@ -204,11 +209,11 @@ def render_views(args: argparse.Namespace) -> int:
     """``--render``: the views of the gradebook written again, without grading."""
     if not gradebook_db.beside(args.out).is_file() and not args.out.is_file():
         raise FileNotFoundError(f"no gradebook at {gradebook_db.beside(args.out)} to render")
+    terms, mistakes = term_options.terms(args)
+    problems.settle(mistakes)
     connection = open_gradebook(args.out)
     try:
-        records = render.render(
-            connection, args.out, term_options.terms(args), args.feedback, args.detail, page=True
-        )
+        records = render.render(connection, args.out, terms, args.feedback, args.detail, page=True)
     finally:
         connection.close()
     print(f"{len(records)} rows rendered from {gradebook_db.beside(args.out)} into {args.out}"
@@ -250,8 +255,8 @@ class Session:
                 for i, e in self.entries.items()
                 if e.problem is None
             }
-            unusable = self._take_unusable()
             self.todo = self._todo()
+            unusable = self._take_unusable()
             started = time.monotonic()
             grades = self._grade_todo(checks)
             gradebook_db.end_run(self.connection, run_number, "finished")
@@ -260,6 +265,24 @@ class Session:
                 folders = {i: e.folder for i, e in self.entries.items() if e.problem is None}
                 similarity.write_report(folders, args.out.parent / "similarity")
         return self._report(unusable + grades, time.monotonic() - started)
+
+    def _mistakes(self, todo: list[intake.Entry]) -> list[problems.Problem]:
+        """The mistakes of the instructor's files that only the class shows: manual changes
+        beyond what a task is worth or naming a lookalike of an id, a student graded again
+        without the due date their row was charged against."""
+        records = gradebook_db.read_records(self.connection)
+        path = adjustments.beside(self.args.out)
+        found = []
+        if path.is_file():
+            maximum = render.grades_file(records, {}, False).maximum
+            worth = term_options.possible_points(maximum, self.args.checks.resolve())
+            known = {*self.entries, *(record.id for record in records)}
+            changes = [c for listed in self.terms.changes.values() for c in listed]
+            found += adjustments.against_class(changes, str(path), worth, known)
+        rows = {record.id: record.final for record in records}
+        regraded = [entry.id for entry in todo]
+        where = str(gradebook_db.beside(self.args.out))
+        return found + final_points.forgotten_due(rows, regraded, self.terms, where)
 
     def _take_unusable(self) -> list[grading.Grade]:
         """Commit the rows of submissions with nothing to grade (absent, refused)."""
@@ -280,6 +303,7 @@ class Session:
         if self.args.resume:
             known = gradebook_db.statuses(self.connection)
             todo = [e for e in todo if known.get(e.id) != (gradebook_db.GRADED, self.prints[e.id])]
+        problems.settle(self._mistakes(todo))  # before anything is graded or committed
         skipped = sum(e.problem is None for e in self.entries.values()) - len(todo)
         address, jobs = parse_cluster(self.args.cluster) if self.args.cluster else (None, None)
         where = f"on the cluster {address}" if address else f"{jobs or self.args.jobs} at a time"
@@ -375,7 +399,7 @@ class Session:
         """Print the run's summary; its exit status."""
         args = self.args
         known = gradebook_db.statuses(self.connection)
-        term_options.report(self.terms, set(known), args.out)
+        term_options.report(self.terms, args.out)
         print(grading.summary(grades, seconds))
         if args.isolation != "namespace":
             print(f"isolation: {args.isolation} (weaker than namespace; submissions were not "
