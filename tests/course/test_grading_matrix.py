@@ -4,8 +4,9 @@ The matrix: each isolation mode (namespace, process) × each hand-in form (a fol
 a git repository, the Gradescope autograder run as Gradescope runs it) × the reference
 answers (solutions/) and the templates (assignments/), with the course's own numbers off
 and on. The checks are the course's own, hidden ones included, so every task's checks run
-in the sandbox. Each (mode, numbers) is graded once, in one ``msdlab grade`` run over every
-form and answer (a roster names them), and its rows are shared by the cells that read them.
+in the sandbox. The folder, zip and git forms of one (mode, numbers) are graded once, in
+one ``msdlab grade`` run (a roster names them), the Gradescope form once per answer, and
+every result is shared by the cells that read it.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import subprocess
 import sys
 import zipfile
 from collections.abc import Callable
+from fractions import Fraction
 from pathlib import Path
 
 import pytest
@@ -25,10 +27,10 @@ import pytest
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT, TASKS, own_numbers
 from msdlab.instructor import sandbox
-from msdlab.instructor.gradescope import ROOT_VARIABLE
+from msdlab.instructor.gradescope import METADATA, ROOT_VARIABLE
 
 MODES = ("namespace", "process")
-FORMS = ("folder", "zip", "git")
+FORMS = ("folder", "zip", "git", "gradescope")
 NUMBERS = {False: "course numbers", True: "own numbers"}
 ANSWERS = {"reference": PROJECT_ROOT / "solutions", "template": PROJECT_ROOT / "assignments"}
 TASK_FILES = [f"task{task}.py" for task in TASKS]
@@ -107,118 +109,106 @@ def course(root: Path, own: bool) -> Path:
 
 
 @pytest.fixture(scope="module")
-def graded(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str, bool], dict]:
-    """``graded(mode, own)``: the grades file's rows by id (and ``"max"``) of one
-    ``msdlab grade`` run over every form and answer, made once per (mode, own)."""
-    runs: dict[tuple[str, bool], dict] = {}
+def graded(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str, bool, str, str], dict]:
+    """``graded(mode, own, form, answer)``: the points of that cell by column (``task1`` ...
+    ``total``) as (earned, possible), and its ``notes``. The folder, zip and git forms of one
+    (mode, own) are graded by one ``msdlab grade`` run, Gradescope's form by the autograder
+    zip run for each answer; each is made once and shared."""
+    runs: dict[tuple, dict] = {}
 
-    def rows(mode: str, own: bool) -> dict:
+    def cell(mode: str, own: bool, form: str, answer: str) -> dict:
         usable(mode)
-        if (mode, own) not in runs:
-            root = tmp_path_factory.mktemp(f"{mode}-{'own' if own else 'course'}")
+        key = (mode, own, "gradescope", answer) if form == "gradescope" else (mode, own)
+        if key not in runs:
+            root = tmp_path_factory.mktemp(f"{mode}-{NUMBERS[own].split()[0]}-{form}")
             root.chmod(0o755)  # as root, the namespace sandbox's user reads the copies
             checks = course(root / "course", own)
-            lines = ["id,folder"]
-            for form in FORMS:
-                for answer in ANSWERS:
-                    identifier = student(form, answer)
-                    files = task_files(answer, identifier, own)
-                    path = HAND_IN[form](root / "class" / identifier, files)
-                    lines.append(f"{identifier},{path.relative_to(root)}")
-            (root / "roster.csv").write_text("\n".join(lines) + "\n")
-            out = root / "out" / "grades.csv"
-            arguments = ["grade", "--roster", str(root / "roster.csv"), "--out", str(out)]
-            arguments += ["--checks", str(checks), "--isolation", mode, "--jobs", "2"]
-            status = main(arguments)
-            with out.open(newline="", encoding="utf-8") as handle:
-                table = {row["id"]: row for row in csv.DictReader(handle)}
-            table["max"] = table.pop("(max points)")
-            runs[mode, own] = {"status": status, "rows": table}
-        return runs[mode, own]
+            if form == "gradescope":
+                runs[key] = {answer: autograded(root, checks, mode, own, answer)}
+            else:
+                runs[key] = grade_run(root, checks, mode, own)
+        return runs[key][answer if form == "gradescope" else student(form, answer)]
 
-    return rows
+    return cell
+
+
+def grade_run(root: Path, checks: Path, mode: str, own: bool) -> dict[str, dict]:
+    """``msdlab grade`` over the folder, zip and git forms of every answer (a roster names
+    them): each one's cell, by id."""
+    lines = ["id,folder"]
+    for form in HAND_IN:
+        for answer in ANSWERS:
+            identifier = student(form, answer)
+            path = HAND_IN[form](root / "class" / identifier, task_files(answer, identifier, own))
+            lines.append(f"{identifier},{path.relative_to(root)}")
+    (root / "roster.csv").write_text("\n".join(lines) + "\n")
+    out = root / "out" / "grades.csv"
+    arguments = ["grade", "--roster", str(root / "roster.csv"), "--out", str(out)]
+    arguments += ["--checks", str(checks), "--isolation", mode, "--jobs", "2"]
+    assert main(arguments) == 0
+    with out.open(newline="", encoding="utf-8") as handle:
+        table = {row["id"]: row for row in csv.DictReader(handle)}
+    possible = table.pop("(max points)")
+    columns = [*(f"task{task}" for task in TASKS), "total"]
+    return {
+        identifier: {
+            **{c: (Fraction(row[c]), Fraction(possible[c])) for c in columns},
+            "notes": row["notes"],
+            "graded": bool(row["fingerprint"]),
+        }
+        for identifier, row in table.items()
+    }
+
+
+def autograded(root: Path, checks: Path, mode: str, own: bool, answer: str) -> dict:
+    """The cell of ``answer`` handed in to the autograder zip ``msdlab gradescope`` builds
+    for the sandbox ``mode`` (unpacked where Gradescope puts it), run as Gradescope runs it:
+    the upload's files in ``submission/``, Gradescope's metadata beside it (the student's
+    roster id as ``sid``), ``run_autograder`` from the root."""
+    out = root / "autograder.zip"
+    assert main(["gradescope", str(out), "--checks", str(checks), "--isolation", mode]) == 0
+    tree = root / "autograder"
+    with zipfile.ZipFile(out) as archive:
+        archive.extractall(tree / "source")
+    shutil.copyfile(tree / "source" / "run_autograder", tree / "run_autograder")
+    identifier = student("gradescope", answer)
+    write_files(tree / "submission", task_files(answer, identifier, own))
+    user = {"name": "A Student", "email": "s@example.org", "sid": identifier}
+    metadata = {"created_at": "2027-03-01T12:00:00.000000+00:00", "users": [user]}
+    (tree / METADATA).write_text(json.dumps(metadata))
+    environment = dict(os.environ, PYTHON=sys.executable, **{ROOT_VARIABLE: str(tree)})
+    subprocess.run(["bash", str(tree / "run_autograder")], cwd=tree, env=environment,
+                   check=True, timeout=600, capture_output=True)  # fmt: skip
+    results = json.loads((tree / "results" / "results.json").read_text())
+    tasks = results["extra_data"].get("tasks", {})
+    possible = sum(test["max_score"] for test in results["tests"])
+    return {
+        **{f"task{t}": (Fraction(tasks.get(f"task{t}", {}).get("score", 0)),
+                        Fraction(tasks.get(f"task{t}", {}).get("max_score", 0))) for t in TASKS},
+        "total": (Fraction(results["score"]), Fraction(possible)),
+        "notes": results["output"],
+        "graded": bool(tasks),
+    }  # fmt: skip
 
 
 @pytest.mark.parametrize("own", NUMBERS, ids=NUMBERS.values())
 @pytest.mark.parametrize("form", FORMS)
 @pytest.mark.parametrize("mode", MODES)
 def test_the_reference_answers_get_full_marks(graded, mode: str, form: str, own: bool) -> None:
-    run = graded(mode, own)
-    row, possible = run["rows"][student(form, "reference")], run["rows"]["max"]
-    assert run["status"] == 0
-    assert row["fingerprint"], row["notes"]  # graded to the end
-    assert int(possible["total"]) > 0
-    for column in (*(f"task{task}" for task in TASKS), "total"):
-        assert row[column] == possible[column], f"{column}: {row['notes']}"
+    cell = graded(mode, own, form, "reference")
+    assert cell["graded"], cell["notes"]
+    assert cell["total"][1] > 0
+    for task in TASKS:
+        earned, possible = cell[f"task{task}"]
+        assert possible > 0 and earned == possible, f"task{task}: {cell['notes']}"
+    assert cell["total"][0] == cell["total"][1]
 
 
 @pytest.mark.parametrize("own", NUMBERS, ids=NUMBERS.values())
 @pytest.mark.parametrize("form", FORMS)
 @pytest.mark.parametrize("mode", MODES)
 def test_the_templates_get_nothing(graded, mode: str, form: str, own: bool) -> None:
-    row = graded(mode, own)["rows"][student(form, "template")]
-    assert row["fingerprint"], row["notes"]
-    assert [row[f"task{task}"] for task in TASKS] == ["0"] * len(TASKS) and row["total"] == "0"
-
-
-# ---------------------------------------------------------------- the Gradescope autograder
-
-
-@pytest.fixture(scope="module")
-def autograded(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str, str], dict]:
-    """``autograded(mode, answer)``: results.json of the autograder zip (built for the
-    sandbox ``mode`` with the course's checks) run on ``answer`` as Gradescope runs it."""
-    roots: dict[str, Path] = {}
-    results: dict[tuple[str, str], dict] = {}
-
-    def run(mode: str, answer: str) -> dict:
-        usable(mode)
-        if mode not in roots:
-            roots[mode] = autograder(tmp_path_factory.mktemp(f"gradescope-{mode}"), mode)
-        if (mode, answer) not in results:
-            results[mode, answer] = run_autograder(roots[mode], task_files(answer, "", False))
-        return results[mode, answer]
-
-    return run
-
-
-def autograder(folder: Path, mode: str) -> Path:
-    """The zip ``msdlab gradescope`` builds, unpacked where Gradescope puts it."""
-    folder.chmod(0o755)
-    out = folder / "autograder.zip"
-    checks = PROJECT_ROOT / "tests" / "tasks"
-    assert main(["gradescope", str(out), "--checks", str(checks), "--isolation", mode]) == 0
-    root = folder / "autograder"
-    with zipfile.ZipFile(out) as archive:
-        archive.extractall(root / "source")
-    shutil.copyfile(root / "source" / "run_autograder", root / "run_autograder")
-    return root
-
-
-def run_autograder(root: Path, files: dict[str, str]) -> dict:
-    """Gradescope's steps for one submission: the upload's files in ``submission/``, its
-    metadata beside it, ``run_autograder`` run from the root; the results it wrote."""
-    shutil.rmtree(root / "submission", ignore_errors=True)
-    shutil.rmtree(root / "results", ignore_errors=True)
-    write_files(root / "submission", files)
-    metadata = {"created_at": "2027-03-01T12:00:00.000000+00:00", "users": [{"sid": "s1"}]}
-    (root / "submission_metadata.json").write_text(json.dumps(metadata))
-    environment = dict(os.environ, PYTHON=sys.executable, **{ROOT_VARIABLE: str(root)})
-    subprocess.run(["bash", str(root / "run_autograder")], cwd=root, env=environment,
-                   check=True, timeout=600, capture_output=True)  # fmt: skip
-    return json.loads((root / "results" / "results.json").read_text())
-
-
-@pytest.mark.parametrize("mode", MODES)
-def test_the_autograder_gives_the_reference_answers_full_marks(autograded, mode: str) -> None:
-    results = autograded(mode, "reference")
-    possible = sum(test["max_score"] for test in results["tests"])
-    assert possible > 0 and results["score"] == possible, results["output"]
-    assert {f"task{task}" for task in TASKS} == set(results["extra_data"]["tasks"])
-
-
-@pytest.mark.parametrize("mode", MODES)
-def test_the_autograder_gives_the_templates_nothing(autograded, mode: str) -> None:
-    results = autograded(mode, "template")
-    assert results["score"] == 0 and results["tests"]
-    assert all(test["score"] == 0 for test in results["tests"])
+    cell = graded(mode, own, form, "template")
+    assert cell["graded"], cell["notes"]
+    assert [cell[f"task{task}"][0] for task in TASKS] == [0] * len(TASKS)
+    assert cell["total"][0] == 0 and cell["total"][1] > 0
