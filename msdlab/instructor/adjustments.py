@@ -166,13 +166,14 @@ def against_class(
     changes: list[Change],
     where: str,
     maximum: Mapping[str, Fraction] | None,
-    known: Collection[str],
+    known: Collection[str] | None,
 ) -> list[Problem]:
     """The mistakes of the changes read from the file ``where`` that only the class shows:
-    changes beyond the points of ``maximum`` (column -> points; None: not known yet), ids
-    that are not ``known`` (refused if a lookalike of one, else warned)."""
+    changes beyond the points of ``maximum`` (column -> points), ids that are not ``known``
+    (refused if a lookalike of one, else warned); None: not checked."""
     found = [_beyond(change, maximum, where) for change in changes] if maximum else []
-    found += [_unknown(change, known, where) for change in changes]
+    if known is not None:
+        found += [_unknown(change, known, where) for change in changes]
     return [problem for problem in found if problem is not None]
 
 

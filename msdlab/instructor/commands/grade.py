@@ -171,22 +171,35 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError("give SUBMISSION folders or zip files, or --roster FILE (not both)")
     if args.similarity:
         similarity.require_copydetect()
-    terms, mistakes = term_options.terms(args)
-    problems.settle(mistakes)  # the class's ids and points are checked after the intake
     connection = open_gradebook(args.out)
-    run_number = gradebook_db.start_run(connection, ["msdlab", *sys.argv[1:]])
-    session = Session(args, connection, terms)
     try:
-        status = session.grade(run_number)
-    except KeyboardInterrupt:
-        signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second Ctrl-C: the views still get out
-        gradebook_db.end_run(connection, run_number, "interrupted")
-        session.render(final=True)
-        print(session.interrupted(), file=sys.stderr)
-        return 130
+        session = Session(args, connection, checked_terms(args, connection))
+        run_number = gradebook_db.start_run(connection, ["msdlab", *sys.argv[1:]])
+        try:
+            return session.grade(run_number)
+        except KeyboardInterrupt:
+            signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second Ctrl-C: the views get out
+            gradebook_db.end_run(connection, run_number, "interrupted")
+            session.render(final=True)
+            print(session.interrupted(), file=sys.stderr)
+            return 130
     finally:
         connection.close()
-    return status
+
+
+def checked_terms(args: argparse.Namespace, connection: sqlite3.Connection) -> final_points.Terms:
+    """The run's terms (`term_options.terms`); every mistake of the options and files that
+    shows before the intake (manual changes beyond what a task is worth included) refused
+    at once. The students' ids are checked after the intake (`Session`)."""
+    terms, mistakes = term_options.terms(args)
+    path = adjustments.beside(args.out)
+    if path.is_file():
+        maximum = render.grades_file(gradebook_db.read_records(connection), {}, False).maximum
+        worth = term_options.possible_points(maximum, args.checks.resolve())
+        changes = [change for listed in terms.changes.values() for change in listed]
+        mistakes += adjustments.against_class(changes, str(path), worth, None)
+    problems.settle(mistakes)
+    return terms
 
 
 def open_gradebook(out: Path) -> sqlite3.Connection:
@@ -209,10 +222,9 @@ def render_views(args: argparse.Namespace) -> int:
     """``--render``: the views of the gradebook written again, without grading."""
     if not gradebook_db.beside(args.out).is_file() and not args.out.is_file():
         raise FileNotFoundError(f"no gradebook at {gradebook_db.beside(args.out)} to render")
-    terms, mistakes = term_options.terms(args)
-    problems.settle(mistakes)
     connection = open_gradebook(args.out)
     try:
+        terms = checked_terms(args, connection)
         records = render.render(connection, args.out, terms, args.feedback, args.detail, page=True)
     finally:
         connection.close()
@@ -268,17 +280,13 @@ class Session:
 
     def _mistakes(self, todo: list[intake.Entry]) -> list[problems.Problem]:
         """The mistakes of the instructor's files that only the class shows: manual changes
-        beyond what a task is worth or naming a lookalike of an id, a student graded again
+        naming an id no submission has (a lookalike refused), a student graded again
         without the due date their row was charged against."""
         records = gradebook_db.read_records(self.connection)
         path = adjustments.beside(self.args.out)
-        found = []
-        if path.is_file():
-            maximum = render.grades_file(records, {}, False).maximum
-            worth = term_options.possible_points(maximum, self.args.checks.resolve())
-            known = {*self.entries, *(record.id for record in records)}
-            changes = [c for listed in self.terms.changes.values() for c in listed]
-            found += adjustments.against_class(changes, str(path), worth, known)
+        known = {*self.entries, *(record.id for record in records)}
+        changes = [c for listed in self.terms.changes.values() for c in listed]
+        found = adjustments.against_class(changes, str(path), None, known)
         rows = {record.id: record.final for record in records}
         regraded = [entry.id for entry in todo]
         where = str(gradebook_db.beside(self.args.out))
