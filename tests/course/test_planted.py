@@ -56,7 +56,8 @@ class Harness:
         return found[0]
 
     def concerned(self, variant) -> list[validate.Check]:
-        """The checks that reach a function the variant changes."""
+        """The checks that reach a function the variant changes (all of them where it changes
+        the file's constants)."""
         task, source = variant.task, self.sources[variant.task]
         if task not in self._reached:
             self._reached[task] = validate.reached(source, task, self.checks[task])
@@ -64,6 +65,8 @@ class Harness:
             validate.definition_at(source, source[: source.index(old)].count("\n") + 1)
             for old, _ in variant.patches
         }
+        if None in changed:
+            return self.checks[task]
         return [c for c in self.checks[task] if changed & self._reached[task][c.name]]
 
 

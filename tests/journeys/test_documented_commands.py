@@ -35,8 +35,8 @@ pytestmark = [
 DOCS = ROOT / "docs"
 INSTRUCTOR = [
     "course", "templates", "grading", "late-work", "manual-changes", "export", "similarity",
-    "gradescope", "clusters", "validate", "own-numbers", "sandbox", "grading-time",
-    "adapting", "index",
+    "gradescope", "clusters", "validate", "mistakes", "own-numbers", "sandbox",
+    "grading-time", "adapting", "index",
 ]  # fmt: skip
 """The instructor's pages in the order of a term (own numbers last: it switches them on)."""
 STUDENT = ["install", "check", "notebooks", "index", "tasks", "feedback", "live-view", "brief",

@@ -2,12 +2,21 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
 import msdlab as msd
 from msdlab.course import oracles
-from msdlab.course.feedback import as_array, expect, matching_variant, num, relative_error
+from msdlab.course.feedback import (
+    Recognised,
+    as_array,
+    expect,
+    matching_variant,
+    num,
+    relative_error,
+)
 from msdlab.course.reference_cache import cached
 
 pytestmark = pytest.mark.task1
@@ -130,8 +139,10 @@ def test_height_after_as_template(task1):
         got = float(task1.height_after(n, BOTTOM, DT, G))
         parabola = BOTTOM + 0.5 * G * (n * DT) ** 2
         cause = (
-            "that is the exact free fall y0 + ½ g t²; the template moves by g dt² in its "
-            "first step, 2 g dt² in the second, ...: y0 + g dt² n(n+1)/2"
+            Recognised(
+                "that is the exact free fall y0 + ½ g t²; the template moves by g dt² in its "
+                "first step, 2 g dt² in the second, ...: y0 + g dt² n(n+1)/2"
+            )
             if n > 0 and np.isclose(got, parabola, rtol=0, atol=1e-12)
             else "the template's recurrence: each step adds g·dt² to the distance moved per "
             "step, so after n steps y = y0 + g dt² (1 + 2 + ... + n)"
@@ -144,15 +155,51 @@ def test_height_after_as_template(task1):
         )
 
 
+@cached  # the same for every submission: computed once per grading run
+def floor_step(bottom: float, g: float) -> np.ndarray:
+    """The step in which the running template's bottom layer (y0 = ``bottom``, acceleration
+    ``g``) first reaches the floor, and its height one step before (an array: the cache
+    keeps arrays and numbers)."""
+    start = oracles.template_positions((3, 2, 3), 0.1, (-1.0, bottom, -1.0))
+    steps = int(2 * np.sqrt(2 * bottom / abs(g)) / DT) + 10  # twice the parabola's
+    frames = oracles.template_run(start, steps, acceleration=(0.0, g, 0.0))
+    on_floor = np.flatnonzero(frames[:, :, 0, :, 1].min(axis=(1, 2)) <= 0.0)
+    first = int(on_floor[0])
+    return np.array([first, frames[first - 1, :, 0, :, 1].min()])
+
+
+def not_own_numbers(task1, own_numbers, got) -> Recognised | None:
+    """The mistake of numbers in task1.py that are not the student's own (another student's
+    copy of the template, or edited), where ``got`` is the floor step of those numbers."""
+    try:
+        bottom, g = float(task1.ORIGIN[1]), float(task1.GRAVITY[1])
+    except Exception:  # no such constants: no such cause
+        return None
+    own = (own_numbers.bottom, own_numbers.gravity)
+    if (
+        np.allclose((bottom, g), own)
+        or not (bottom > 0 > g)
+        or got != int(floor_step(bottom, g)[0])
+    ):
+        return None
+    differ = [
+        f"{name} = {theirs:g} where your copy of the course has {mine:g}"
+        for name, theirs, mine in (("ORIGIN[1]", bottom, own[0]), ("GRAVITY[1]", g, own[1]))
+        if not np.isclose(theirs, mine)
+    ]
+    return Recognised(
+        f"the numbers in your task1.py are not the ones given to you ({'; '.join(differ)}): "
+        "the answer is about your own numbers, put them back"
+    )
+
+
 @pytest.mark.points(2)
 def test_steps_to_floor_as_template(task1, own_numbers):
     """steps_to_floor() is the step in which the running template's floor first catches the
     bottom layer (of the student's own template where each student has their own numbers)."""
     bottom, g = own_numbers.bottom, own_numbers.gravity
-    start = oracles.template_positions((3, 2, 3), 0.1, (-1.0, bottom, -1.0))
-    frames = oracles.template_run(start, 1000, acceleration=(0.0, g, 0.0))  # own: up to 707
-    on_floor = np.flatnonzero(frames[:, :, 0, :, 1].min(axis=(1, 2)) <= 0.0)
-    first = int(on_floor[0])
+    first, height = floor_step(bottom, g)
+    first = int(first)
     for got, call in (
         (task1.steps_to_floor(), "steps_to_floor()"),
         (task1.steps_to_floor(bottom, DT, g), f"steps_to_floor({bottom}, {DT}, {g})"),
@@ -161,10 +208,27 @@ def test_steps_to_floor_as_template(task1, own_numbers):
             got == first,
             saw=f"{call} = {got!r}, but the running template's bottom layer (y0 = {bottom}) "
             f"first reaches the floor in step {first} (its height after step {first - 1} is "
-            f"{num(frames[first - 1, :, 0, :, 1].min())})",
-            cause=f"one step {'early' if got < first else 'late'}: the answer is the first n "
-            "whose height y0 + g dt² n(n+1)/2 is <= 0"
-            if got in (first - 1, first + 1)
-            else "the exact parabola ½ g t² instead of the template's y0 + g dt² n(n+1)/2 "
-            "(solve n(n+1)/2 · |g| dt² >= y0 for the smallest integer n)",
+            f"{num(height)})",
+            cause=(not_own_numbers(task1, own_numbers, got) if call.endswith("()") else None)
+            or floor_step_mistake(got, first, bottom, g),
         )
+
+
+def floor_step_mistake(got: object, first: int, bottom: float, g: float) -> str:
+    """The cause of a wrong floor step: one step off, or the exact parabola's step (both
+    recognised), else the usual cause."""
+    if got in (first - 1, first + 1):
+        return Recognised(
+            f"one step {'early' if got < first else 'late'}: the answer is the first n whose "
+            "height y0 + g dt² n(n+1)/2 is <= 0"
+        )
+    parabola = np.sqrt(2 * bottom / abs(g)) / DT  # ½ |g| t² = y0 at t = n dt
+    if got in (math.floor(parabola), math.ceil(parabola)):
+        return Recognised(
+            "the exact parabola ½ g t² instead of the template's y0 + g dt² n(n+1)/2 (solve "
+            "n(n+1)/2 · |g| dt² >= y0 for the smallest integer n)"
+        )
+    return (
+        "the template's heights are y0 + g dt² n(n+1)/2 (see height_after): the answer is "
+        "the smallest integer n with n(n+1)/2 · |g| dt² >= y0"
+    )

@@ -152,6 +152,16 @@ BUGS = [
         "height_after_for_any_start",
         "g = -0.001 used instead of the argument g",
     ),
+    Variant(  # a friend's copy of the template: another student's own numbers
+        "constants copied from another student",
+        1,
+        (
+            ("ORIGIN = (-1.0, 1.5, -1.0)", "ORIGIN = (-1.0, 1.3, -1.0)"),
+            ("GRAVITY = (0.0, -0.001, 0.0)", "GRAVITY = (0.0, -0.0008, 0.0)"),
+        ),
+        "steps_to_floor_as_template",
+        "not the ones given to you",
+    ),
     bug(
         "floor: no input check",
         1,
@@ -896,6 +906,14 @@ BUGS += [
         "new = (2.0 + lam) * current - (1.0 + lam) * old + acceleration * dt**2",
         "one_step_is_equation_1_4",
         "signs of λ reversed",
+    ),
+    bug(
+        "damping applied to the whole update",
+        5,
+        T5_NEW,
+        "new = (1.0 - lam) * (2.0 * current - old + acceleration * dt**2) + lam * current",
+        "damping_acts_on_velocity_only",
+        "damping applied to the whole update",
     ),
     bug(
         "damping applied to the positions",
