@@ -35,7 +35,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 TRUSTED_SOURCES = ("Gradescope's submission time",)
-"""Hand-in times the student's own machine did not set (see `handin.NAMES`)."""
+"""Hand-in times the student's own machine did not set (see `intake.times.NAMES`)."""
 UNKNOWN_TIME = "hand-in time unknown"
 CAUSE = re.compile(
     rf"(?:Usual cause: |{re.escape(MISTAKE_SENTENCE.split('{}')[0])})([^\n]*?)\.?\s*(?:\n|$)"

@@ -21,13 +21,14 @@ from pathlib import Path
 
 from ..course import TASKS
 from .adjustments import Change
-from .handin import HandIn
-from .intake import file_stem
+from .intake import HandIn, file_stem
 from .late import LatePolicy, format_points
 from .problems import Problem
 
-COLUMNS = ["points", "due", "handed_in", "handed_in_from", "late", "late_penalty", "adjustment"]
-"""The grades file's columns between ``task5`` and ``total``."""
+COLUMNS = ["points", "due", "handed_in", "handed_in_from", "handed_in_control", "late",
+           "late_penalty", "adjustment"]  # fmt: skip
+"""The grades file's columns between ``task5`` and ``total`` (``handed_in_control``: who
+controls the hand-in time's record, `intake.times`)."""
 MARK = "<!-- msdlab: late work and manual changes -->"
 END = "<!-- msdlab: end of late work and manual changes -->"
 _SECTION = re.compile(re.escape(MARK) + ".*?" + re.escape(END) + "\n*", re.S)
@@ -111,6 +112,7 @@ def _stamp(row: dict[str, str], handed: HandIn | None) -> None:
     if handed is not None:
         row["handed_in"] = handed.time.isoformat(timespec="seconds") if handed.time else ""
         row["handed_in_from"] = handed.source
+        row["handed_in_control"] = handed.control
 
 
 def _charge(row: dict[str, str], points: Fraction, due: datetime, terms: Terms, own: bool) -> None:
@@ -122,8 +124,19 @@ def _charge(row: dict[str, str], points: Fraction, due: datetime, terms: Terms, 
     handed = datetime.fromisoformat(row["handed_in"])
     lateness = terms.policy.charge(points, handed - due)
     when = f"due {_shown(due)}{' (your extension)' if own else ''}, handed in {_shown(handed)}"
-    row["late"] = f"{when} ({row.get('handed_in_from') or 'time'}): {lateness.reason}"
+    row["late"] = f"{when} ({_evidence(row)}): {lateness.reason}"
     row["late_penalty"] = format_points(lateness.penalty) if lateness.penalty else ""
+
+
+def _evidence(row: dict[str, str]) -> str:
+    """Where the hand-in time was read, and whether the student could have set it."""
+    source = row.get("handed_in_from") or "time"
+    control = row.get("handed_in_control")
+    return f"{source}, {CONTROL_SHOWN[control]}" if control in CONTROL_SHOWN else source
+
+
+CONTROL_SHOWN = {"student": "set by the student's machine, not verified",
+                 "unreadable": "unreadable"}  # fmt: skip
 
 
 def _shown(moment: datetime) -> str:

@@ -3,7 +3,7 @@
 `build` writes the zip: ``setup.sh`` installs msdlab from the zip itself with its
 ``grade`` extra (what the checks import) from the package index; ``run_autograder`` runs
 ``python3 -m msdlab.instructor.gradescope``, which grades the student's task
-files (at the top of ``/autograder/submission`` or in its ``assignments/``)
+files (at the top of ``/autograder/submission`` or in its ``assignments/``, taken in by `intake`)
 with the instructor's checks, hidden ones included, by the same `grading.grade`
 as ``msdlab grade``, and writes ``/autograder/results/results.json`` in
 Gradescope's format: the total ``score``, one test per check (``name``,
@@ -35,9 +35,9 @@ from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from ..course import TASKS, own_numbers
+from ..course import own_numbers
 from ..course.report import CheckResult
-from . import grading
+from . import grading, intake
 
 CONFIG = "msdlab-autograder.json"
 HIDDEN_VISIBILITIES = ("after_published", "hidden")
@@ -116,17 +116,6 @@ def build(out: Path, project: Path, checks: Path, settings: Settings) -> list[st
         return archive.namelist()
 
 
-def submission_folder(submission: Path) -> Path:
-    """Where the task files are: the top of the submission, its ``assignments/``, or the one
-    folder below that holds them (a zip of the course folder)."""
-    candidates = [submission, submission / "assignments", *sorted(submission.glob("*/assignments"))]
-    candidates += sorted(path for path in submission.glob("*") if path.is_dir())
-    for folder in candidates:
-        if any((folder / f"task{task}.py").is_file() for task in TASKS):
-            return folder
-    return submission
-
-
 def results(grade: grading.Grade, hidden_visibility: str) -> dict[str, object]:
     """The results.json content for one graded submission (Gradescope's format)."""
     if grade.report is None:
@@ -166,7 +155,6 @@ def run_autograder(root: Path) -> dict[str, object]:
     ``root/results/results.json``; return its content."""
     source = root / "source"
     settings = Settings(**json.loads((source / CONFIG).read_text(encoding="utf-8")))
-    folder = submission_folder(root / "submission")
     own = own_numbers.enabled(source)
     student = roster_id(root / METADATA, settings.roster_id) if own else "submission"
     if student is None:
@@ -177,15 +165,17 @@ def run_autograder(root: Path) -> dict[str, object]:
         )
         grade = grading.Grade("submission", None, [problem])
     else:
-        grade = grading.grade(
-            grading.Submission(student, folder),
-            source / "checks",
-            timeout=settings.timeout,
-            call_timeout=settings.call_timeout,
-            memory_mb=settings.memory_mb,
-            isolation=settings.isolation,
-            own_numbers=own,
-        )
+        with intake.Intake() as taken:
+            entry = taken.add_gradescope(root)
+            grade = grading.grade(
+                grading.Submission(student, entry.folder),
+                source / "checks",
+                timeout=settings.timeout,
+                call_timeout=settings.call_timeout,
+                memory_mb=settings.memory_mb,
+                isolation=settings.isolation,
+                own_numbers=own,
+            )
     content = results(grade, settings.hidden_visibility)
     target = root / "results" / "results.json"
     target.parent.mkdir(parents=True, exist_ok=True)

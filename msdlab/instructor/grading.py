@@ -33,10 +33,10 @@ from ..course import TASKS, reference_cache, runner
 from ..course.report import CheckReport
 from ..course.runner import CheckRun
 from . import processes
+from .intake import MAX_FILE_BYTES
 from .judges import ForkedJudges
 from .sandbox import INFRASTRUCTURE_FAILURES, overloaded
 
-MAX_FILE_BYTES = 1_000_000
 FIRST_UID = 61000  # as root, sandboxes run as reserved user ids from here on
 RETRY_PAUSE = 2.0  # seconds before grading again after the grader's failure, times the attempt
 GRADER_ERROR = "grader error: "

@@ -11,9 +11,8 @@ from fractions import Fraction
 from pathlib import Path
 
 from ..course import TASKS, manifest
-from . import adjustments, final_points, handin, late, release
+from . import adjustments, final_points, intake, late, release
 from .final_points import Terms
-from .intake import Entry
 from .problems import InstructorFileError, Problem
 
 
@@ -38,9 +37,18 @@ def register(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--handed-in",
-        choices=handin.SOURCES,
+        choices=intake.SOURCES,
         default="auto",
         help="where the hand-in time is read (default: auto)",
+    )
+    parser.add_argument(
+        "--unverified-time",
+        choices=intake.UNVERIFIED_POLICIES,
+        default="flag",
+        help="what a hand-in time the student could have set (a commit date, zip or file "
+        "time) or that could not be read gets: flag (default: taken as read, marked in the "
+        "row, the feedback and the summary), accept (taken as read), late (charged as "
+        "handed in when this run took it in)",
     )
 
 
@@ -86,23 +94,25 @@ def possible_points(maximum: Mapping[str, str], checks: Path) -> dict[str, Fract
     return {**points, "total": sum(points.values(), Fraction(0))}
 
 
-def read_hand_ins(
-    entries: dict[str, Entry], source: str, terms: Terms, timezone: str | None, scratch: Path
-) -> None:
-    """Each entry's hand-in time into ``terms``; an entry graded from a commit's files
-    gets that folder; a hand-in time that could not be read is noted where it matters."""
-    zone = late.time_zone(timezone)
-    for identifier, entry in entries.items():
-        if entry.problem is not None:
-            continue
-        due = terms.due_of(identifier)
-        cutoff = due + terms.policy.cutoff if due and terms.policy.cutoff is not None else None
-        handed = handin.handed_in(entry, source, zone, cutoff, scratch / str(len(terms.handed_in)))
-        terms.handed_in[identifier] = handed
-        if handed.folder is not None:
-            entry.folder = handed.folder
-        if handed.note and (due is not None or handed.time is not None):
-            entry.notes.append(handed.note)
+def rules(args: argparse.Namespace, terms: Terms) -> intake.Rules:
+    """How the intake reads and takes each submission's hand-in time in this run."""
+    return intake.Rules(
+        source=args.handed_in,
+        zone=late.time_zone(args.timezone),
+        due_of=terms.due_of if terms.due is not None else (lambda identifier: None),
+        cutoff=terms.policy.cutoff,
+        unverified=args.unverified_time,
+    )
+
+
+def unverified(entries: list[intake.Entry]) -> str | None:
+    """The console's line counting the hand-in times not verified (None: every one was)."""
+    flagged = [e.id for e in entries if e.handed_in is not None and not e.handed_in.verified]
+    if not flagged:
+        return None
+    shown = ", ".join(flagged[:8]) + (", ..." if len(flagged) > 8 else "")
+    return (f"hand-in time not verified for {len(flagged)} of {len(entries)} submissions "
+            f"(set by the student's machine, or unreadable): {shown}")  # fmt: skip
 
 
 def report(terms: Terms, grades_file: Path) -> None:

@@ -226,6 +226,7 @@ def test_grade_command_writes_rows_feedback_and_exit_status(tmp_path, capsys):
         "due",
         "handed_in",
         "handed_in_from",
+        "handed_in_control",
         "late",
         "late_penalty",
         "adjustment",

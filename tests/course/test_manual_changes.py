@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from msdlab.instructor import adjustments, final_points
 from msdlab.instructor.final_points import Terms
-from msdlab.instructor.handin import HandIn
+from msdlab.instructor.intake import HandIn
 from msdlab.instructor.late import LatePolicy
 
 DUE = datetime(2027, 3, 1, 23, 59, tzinfo=timezone.utc)
@@ -33,7 +33,7 @@ def changes(tmp_path, text: str) -> dict[str, list[adjustments.Change]]:
 
 def test_task_changes_come_before_the_penalty_and_total_changes_after(tmp_path):
     made = changes(tmp_path, "alice,2,=10,checked by hand\nalice,total,+1,report\n")
-    late = HandIn(datetime(2027, 3, 2, 1, tzinfo=timezone.utc), "zip entry times")
+    late = HandIn(datetime(2027, 3, 2, 1, tzinfo=timezone.utc), "zip entry times", "student")
     terms = Terms(DUE, LatePolicy.parse("penalty=10%/day"), {}, {"alice": late}, made)
     rows = {"alice": row(10, 0, 0, 0, 0)}
     lines = final_points.settle(rows, terms)["alice"]
@@ -50,7 +50,7 @@ def test_task_changes_come_before_the_penalty_and_total_changes_after(tmp_path):
 
 
 def test_an_extension_moves_the_due_date_and_is_named(tmp_path):
-    late = HandIn(datetime(2027, 3, 2, 1, tzinfo=timezone.utc), "file modification time")
+    late = HandIn(datetime(2027, 3, 2, 1, tzinfo=timezone.utc), "file modification time", "student")
     terms = Terms(DUE, LatePolicy.parse("penalty=10%/day"), {"alice": DUE.replace(day=3)},
                   {"alice": late})  # fmt: skip
     rows = {"alice": row(10)}
@@ -128,7 +128,7 @@ change = st.builds(
 
 @given(st.lists(change, max_size=4), st.integers(min_value=-48, max_value=200))
 def test_the_total_is_always_points_minus_penalty_plus_adjustment(made, hours_late):
-    handed = HandIn(DUE + timedelta(hours=hours_late), "zip entry times")
+    handed = HandIn(DUE + timedelta(hours=hours_late), "zip entry times", "student")
     policy = LatePolicy.parse("penalty=10%/day,cap=50%,cutoff=7d")
     rows = {"alice": row(10, 4, 0, 0, 0)}
     final_points.settle(rows, Terms(DUE, policy, {}, {"alice": handed}, {"alice": made}))

@@ -171,11 +171,11 @@ def test_a_link_is_never_followed_and_an_oversize_file_is_not_read(planted, tmp_
     row = row_of(tmp_path / "report", "framed", "original")
     assert row["task2.py"] == row["task3.py"] == row["task4.py"] == "", row
     assert float(row["similarity"]) < 0.2, row
-    assert "framed: task4.py is not a regular file" in printed
-    assert "framed: task2.py is not a regular file (a link is not followed)" in printed
-    assert f"framed: task3.py is larger than {MAX_FILE_BYTES} bytes" in printed
+    assert "framed: task4.py was left out: not a regular file" in printed
+    assert "framed: task2.py was left out: not a regular file (a link is not foll" in printed
+    assert f"framed: task3.py was left out: larger than {MAX_FILE_BYTES} bytes" in printed
     page = (tmp_path / "report" / "similarity.html").read_text(encoding="utf-8")
-    assert "task2.py is not a regular file" in page
+    assert "task2.py was left out: not a regular file" in page
 
 
 def test_the_csv_is_safe_to_open_in_a_spreadsheet(planted, tmp_path):

@@ -1,10 +1,15 @@
 """``msdlab grade SUBMISSION... --out grades.csv``: grade a class's submissions.
 
 Each SUBMISSION is a folder laid out like assignments/, a folder holding
-assignments/, or a zip file of either; its row's id is its path relative to the
-submissions' common parent (class/alice/assignments -> alice), or the id given
-by --roster FILE (CSV rows 'id,folder-or-zip'; a student whose folder is not there
-gets a row 'nothing handed in', 0 points). Every submission is graded in
+assignments/, a zip file of either, or a git repository (or a folder in one: its
+commits are read as data, never by running git); its row's id is its path relative to
+the submissions' common parent (class/alice/assignments -> alice), or the id given
+by --roster FILE (a first line 'id,folder', then one line per student; a student
+whose folder is not there gets a row 'nothing handed in', 0 points). With both, each
+SUBMISSION's id must be in the roster. An id that is not a student's (reserved, a
+lookalike, unknown) refuses that one submission; the others are graded. Each hand-in
+time is marked by who controls it; --unverified-time says what one the student could
+set gets. Every submission is graded in
 its own workspace by a fresh process running the instructor's checks (hidden
 ones included); the submission's code runs in a sandbox and can only answer
 with data, under a time and memory limit (--task-timeout: processor seconds per
@@ -38,7 +43,6 @@ import os
 import signal
 import sqlite3
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -74,7 +78,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("submissions", nargs="*", type=Path, metavar="SUBMISSION")
     parser.add_argument(
-        "--roster", type=Path, default=None, help="CSV of 'id,folder-or-zip' rows instead"
+        "--roster",
+        type=Path,
+        default=None,
+        help="the class: a CSV whose first line names its columns, 'id' and 'folder' (the "
+        "folder or zip handed in); with SUBMISSIONs, each one's id must be a roster id",
     )
     parser.add_argument("--out", type=Path, required=True, help="CSV file to write")
     parser.add_argument("--feedback", type=Path, default=None, help="folder for feedback files")
@@ -167,8 +175,8 @@ def run(args: argparse.Namespace) -> int:
     if problem is not None:
         print(f"msdlab grade: {problem}", file=sys.stderr)
         return 2
-    if bool(args.roster) == bool(args.submissions):
-        raise ValueError("give SUBMISSION folders or zip files, or --roster FILE (not both)")
+    if not args.roster and not args.submissions:
+        raise ValueError("give SUBMISSION folders or zip files, or --roster FILE")
     if args.similarity:
         similarity.require_copydetect()
     connection = open_gradebook(args.out)
@@ -246,22 +254,18 @@ class Session:
         self.graded: list[grading.Grade] = []
         self.todo: list[intake.Entry] = []
         self.own_numbers = False
+        self.refused: list[str] = []
 
     def grade(self, run_number: int) -> int:
         """Grade the submissions, committing each as it is graded; the exit status."""
         args, self.run_number = self.args, run_number
         checks = args.checks.resolve()
-        self.own_numbers = own_numbers.enabled(own_numbers.course_of(checks))
-        with (
-            intake.from_roster(args.roster)
-            if args.roster
-            else intake.from_paths(args.submissions) as found,
-            tempfile.TemporaryDirectory(prefix="msdlab-intake-") as scratch,
-        ):
+        self.own_numbers = own_numbers_of(checks, args)
+        rules = term_options.rules(args, self.terms)
+        with intake.taken_in(args.submissions, args.roster, rules) as found:
             self.entries = {entry.id: entry for entry in found.entries}
-            term_options.read_hand_ins(
-                self.entries, args.handed_in, self.terms, args.timezone, Path(scratch)
-            )
+            self.refused = found.refused
+            self._say_what_the_intake_found(found)
             self.prints = {  # nothing is read from a submission refused at intake (a link, ...)
                 i: gradebook.fingerprint(checks, e.folder)
                 for i, e in self.entries.items()
@@ -275,7 +279,11 @@ class Session:
             self.render(final=True)
             if args.similarity:
                 folders = {i: e.folder for i, e in self.entries.items() if e.problem is None}
-                similarity.write_report(folders, args.out.parent / "similarity")
+                similarity.write_report(
+                    folders,
+                    args.out.parent / "similarity",
+                    left_out_before=similarity.left_out_at(found),
+                )
         return self._report(unusable + grades, time.monotonic() - started)
 
     def _mistakes(self, todo: list[intake.Entry]) -> list[problems.Problem]:
@@ -291,6 +299,16 @@ class Session:
         regraded = [entry.id for entry in todo]
         where = str(gradebook_db.beside(self.args.out))
         return found + final_points.forgotten_due(rows, regraded, self.terms, where)
+
+    def _say_what_the_intake_found(self, found: intake.Intake) -> None:
+        """Put the hand-in times into the terms; print the submissions refused for their id
+        and the count of hand-in times not verified."""
+        handed = {i: e.handed_in for i, e in self.entries.items() if e.handed_in is not None}
+        self.terms.handed_in.update(handed)
+        for line in found.refused:
+            print(line, file=sys.stderr)
+        if self.terms.due is not None and term_options.unverified(found.entries):
+            print(term_options.unverified(found.entries), file=sys.stderr)
 
     def _take_unusable(self) -> list[grading.Grade]:
         """Commit the rows of submissions with nothing to grade (absent, refused)."""
@@ -420,7 +438,11 @@ class Session:
         if failed:
             print(grader_failure(failed), file=sys.stderr)
             return 2
-        return 0 if all(grade.graded or self._absent(grade) for grade in grades) else 1
+        if self.refused:
+            print(f"{len(self.refused)} submission{'s' * (len(self.refused) > 1)} refused for "
+                  "their id (no row; see above)", file=sys.stderr)  # fmt: skip
+        everyone = all(grade.graded or self._absent(grade) for grade in grades)
+        return 0 if everyone and not self.refused else 1
 
     def _absent(self, grade: grading.Grade) -> bool:
         return self.entries[grade.submission].absent
@@ -430,6 +452,31 @@ def _status(grade: grading.Grade) -> str:
     if grade.grader_failed:
         return gradebook_db.GRADER_FAILED
     return gradebook_db.GRADED if grade.graded else gradebook_db.NOT_GRADED
+
+
+def own_numbers_of(checks: Path, args: argparse.Namespace) -> bool:
+    """Whether each student is graded against their own numbers: the setting of the course
+    ``checks`` belong to. Refused where that course has no setting but the installed course
+    has them on (``--checks`` outside the course would turn them off silently), or where no
+    roster names the students (their numbers follow the roster id, not a path)."""
+    course = own_numbers.course_of(checks)
+    settings = course / own_numbers.SETTINGS_FILE
+    if not settings.is_file() and own_numbers.enabled(PROJECT_ROOT):
+        raise ValueError(
+            f"{PROJECT_ROOT / own_numbers.SETTINGS_FILE} gives each student their own numbers, "
+            f"but the checks {checks} lie outside that course (no {settings}): copy "
+            f"{own_numbers.SETTINGS_FILE} to {course}, or give --checks inside the course"
+        )
+    own = own_numbers.enabled(course)
+    if own and not args.roster:
+        raise ValueError(
+            f"{settings} gives each student their own numbers, which follow the roster id: "
+            "give --roster FILE (a first line 'id,folder', then one line per student) so each "
+            "submission is graded against its owner's numbers, not a path's"
+        )
+    where = settings if settings.is_file() else f"no {settings}"
+    print(f"own numbers: {'on' if own else 'off'} ({where})", file=sys.stderr)
+    return own
 
 
 def grader_failure(failed: list[grading.Grade]) -> str:

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -38,7 +39,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("submissions", nargs="*", type=Path, metavar="SUBMISSION")
     parser.add_argument(
-        "--roster", type=Path, default=None, help="CSV of 'id,folder-or-zip' rows instead"
+        "--roster",
+        type=Path,
+        default=None,
+        help="the class: a CSV whose first line names its columns, 'id' and 'folder'",
     )
     parser.add_argument(
         "--out", type=Path, default=Path("similarity"), help="folder for the report (%(default)s)"
@@ -59,15 +63,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if bool(args.roster) == bool(args.submissions):
-        raise ValueError("give SUBMISSION folders or zip files, or --roster FILE (not both)")
-    with (
-        intake.from_roster(args.roster)
-        if args.roster
-        else intake.from_paths(args.submissions) as found
-    ):
+    if not args.roster and not args.submissions:
+        raise ValueError("give SUBMISSION folders or zip files, or --roster FILE")
+    with intake.taken_in(args.submissions, args.roster) as found:
+        for line in found.refused + [
+            f"not compared: {e.id}: {e.problem}" for e in found.entries if e.problem
+        ]:
+            print(line, file=sys.stderr)
         folders = {e.id: e.folder for e in found.entries if e.problem is None}
-        write_report(folders, args.out, args.template, args.threshold)
+        write_report(folders, args.out, args.template, args.threshold, left_out_at(found))
     return 0
 
 
@@ -80,14 +84,22 @@ def require_copydetect() -> None:
         )
 
 
+def left_out_at(found: intake.Intake) -> list[str]:
+    """What the intake left out of the submissions it took in ('ID: NOTE'), for the report."""
+    return [f"{e.id}: {note}" for e in found.entries if e.problem is None
+            for note in e.notes if intake.LEFT_OUT in note]  # fmt: skip
+
+
 def write_report(
     folders: dict[str, Path],
     out: Path,
     template: Path = TEMPLATES,
     threshold: float = THRESHOLD,
+    left_out_before: list[str] | None = None,
 ) -> None:
     """Compare the submissions in ``folders`` (id -> folder); write out/similarity.html and
-    out/similarity.csv and print the most similar pairs."""
+    out/similarity.csv and print the most similar pairs. ``left_out_before``: what the
+    intake left out of them (`left_out_at`)."""
     require_copydetect()
     if not 0.0 < threshold <= 1.0:
         raise ValueError(f"--threshold is a similarity between 0 and 1, got {threshold}")
@@ -95,7 +107,7 @@ def write_report(
         raise FileNotFoundError(f"no template folder at {template}; give --template DIR")
     from .. import similarity, similarity_report
 
-    texts, left_out = {}, []
+    texts, left_out = {}, list(left_out_before or [])
     for student, folder in folders.items():
         texts[student], problems = similarity.task_texts(folder)
         left_out += [f"{student}: {problem}" for problem in problems]
