@@ -137,13 +137,14 @@ def handed_in(home, bundle) -> Path:
                     ignore=shutil.ignore_patterns("__pycache__"))  # fmt: skip
     shutil.copytree(room / ALICE / "assignments", room / BOB / "assignments")
     (room / BOB / "assignments" / own_numbers.STUDENT_FILE).write_text(json.dumps({"id": BOB}))
+    (room / "roster.csv").write_text(f"id\n{ALICE}\n{BOB}\n")  # own numbers follow the roster
     return room
 
 
 def test_grading_locally_uses_each_students_own_numbers(home, handed_in, shell):
     done = shell(
-        "msdlab grade class/*/assignments --out grades.csv --feedback feedback/ "
-        "--checks msdlab/tests/tasks" + ISOLATION,
+        "msdlab grade class/*/assignments --roster class/roster.csv --out grades.csv "
+        "--feedback feedback/ --checks msdlab/tests/tasks" + ISOLATION,
         home,
     )
     assert done.status == 0, done
