@@ -31,9 +31,9 @@ class InstructorFileError(ValueError):
     """The instructor's files or options hold mistakes that stop the run (all of them named)."""
 
     def __init__(self, problems: list[Problem]) -> None:
-        self.problems = problems
+        self.problems = sorted(problems, key=_place)
         count = f"{len(problems)} mistake{'s' * (len(problems) != 1)}"
-        lines = "\n".join(f"  {problem}" for problem in problems)
+        lines = "\n".join(f"  {problem}" for problem in self.problems)
         super().__init__(f"{count} in the instructor's files; fix and run again:\n{lines}")
 
 
@@ -55,3 +55,9 @@ def raise_refused(problems: Iterable[Problem]) -> None:
     refused = [problem for problem in problems if problem.refused]
     if refused:
         raise InstructorFileError(refused)
+
+
+def _place(problem: Problem) -> tuple[str, int]:
+    """Where ``problem`` is, in order: its file (or option), then its line."""
+    where, _, line = problem.where.rpartition(", line ")
+    return (where, int(line)) if where and line.isdigit() else (problem.where, 0)

@@ -7,6 +7,7 @@ import argparse
 import sys
 import tempfile
 from collections.abc import Mapping
+from datetime import datetime, timezone
 from fractions import Fraction
 from pathlib import Path
 
@@ -71,8 +72,9 @@ def terms(args: argparse.Namespace) -> tuple[Terms, list[Problem]]:
             due = late.parse_due(args.due, zone)
         except ValueError as error:
             found.append(Problem("command line", str(error)))
-        if due is not None and args.extensions:
-            own, wrong = late.read_extensions(args.extensions, due, zone)
+        if args.extensions:  # its mistakes are named even when --due is wrong (then refused)
+            stand_in = due or datetime.now(timezone.utc)
+            own, wrong = late.read_extensions(args.extensions, stand_in, zone)
             found += wrong
     path = adjustments.beside(args.out)
     changes, wrong = adjustments.parse(path)

@@ -4,6 +4,7 @@ and what the feedback says. (A grading run that keeps them: test_term_runs.py.)"
 from __future__ import annotations
 
 import re
+import shutil
 from datetime import datetime, timedelta, timezone
 from fractions import Fraction
 
@@ -11,6 +12,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from msdlab.cli import main
+from msdlab.course import PROJECT_ROOT
 from msdlab.instructor import adjustments, final_points
 from msdlab.instructor.final_points import Terms
 from msdlab.instructor.intake import HandIn
@@ -215,3 +218,22 @@ def test_regrading_a_late_student_without_the_due_date_is_refused():
     assert "grades.csv, row 'alice': was graded against the due date 2027-03-01T23:59" in str(found)
     assert "give --due" in found.fix
     assert final_points.forgotten_due(rows, ["alice"], Terms(due=DUE), "grades.csv") == []
+
+
+def test_a_lookalike_id_stops_grading_after_the_intake_an_unknown_one_is_warned(tmp_path, capsys):
+    (tmp_path / "alice").mkdir()
+    (tmp_path / "alice" / "task1.py").write_text("")
+    checks = tmp_path / "checks"
+    checks.mkdir()
+    for name in ("conftest.py", "test_task1.py"):  # task 1's checks: what a change may be
+        shutil.copy(PROJECT_ROOT / "tests" / "tasks" / name, checks)
+    (tmp_path / "grades.adjustments.csv").write_text(
+        "id,task,change,reason,note\nAlice,,+1,report,\nbob,,+1,report,copied\n"
+    )
+    out = tmp_path / "grades.csv"
+    arguments = ["grade", str(tmp_path / "alice"), "--out", str(out), "--checks", str(checks)]
+    assert main([*arguments, "--isolation", "process"]) == 2
+    printed = capsys.readouterr().err
+    assert "line 2: no submission has the id 'Alice'; did you mean 'alice'?" in printed
+    assert "warning: " in printed and "line 3: no submission has the id 'bob'" in printed
+    assert "grading 1 submission" not in printed and not out.exists()
