@@ -310,23 +310,46 @@ def lock_folder() -> Path:
 def held_uids(count: int, folder: Path) -> Iterator[list[int]]:
     """``count`` user ids from `FIRST_UID` on whose lock files in ``folder`` this process
     holds (those another process holds are passed over)."""
-    handles, uids, uid = [], [], FIRST_UID
+    handles: list[int] = []
+    uids, uid = [], FIRST_UID
     try:
         while len(uids) < count:
-            path = folder / f"sandbox-{uid}.lock"
-            handle = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
-            try:
-                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
-                os.close(handle)
-            else:
-                handles.append(handle)
+            held = _lock_all([folder / f"sandbox-{uid}.lock", *_legacy_locks(uid)])
+            if held is not None:
+                handles += held
                 uids.append(uid)
             uid += 1
         yield uids
     finally:
         for handle in handles:
             os.close(handle)
+
+
+def _legacy_locks(uid: int) -> list[Path]:
+    """Where older msdlab runs lock ``uid`` (their temporary folder; ``/tmp`` by default):
+    held too, so that a run of an older version on the same machine passes it over."""
+    return list(dict.fromkeys(Path(p) / f"msdlab-sandbox-{uid}.lock"
+                              for p in ("/tmp", tempfile.gettempdir())))  # fmt: skip
+
+
+def _lock_all(paths: list[Path]) -> list[int] | None:
+    """Exclusive locks on every file of ``paths`` (created if missing, never through a
+    link), or None, holding none, if another process holds one of them."""
+    handles = []
+    for path in paths:
+        try:
+            handle = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
+        except OSError:  # a link or a file of someone else's where no run of ours locks
+            continue
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(handle)
+            for held in handles:
+                os.close(held)
+            return None
+        handles.append(handle)
+    return handles
 
 
 def summary(grades: Sequence[Grade], seconds: float) -> str:
