@@ -17,6 +17,7 @@ from ..course import TASKS, loader
 from .sandbox import RemoteImplementation
 
 _REMOTE = pytest.StashKey[RemoteImplementation]()
+_TASK = pytest.StashKey[int | None]()  # the task of the check setting up or running
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -69,13 +70,15 @@ def pytest_msdlab_implementation(
         isolation=os.environ.get("MSDLAB_SANDBOX_ISOLATION", "namespace"),
     )
     config.stash[_REMOTE] = remote
+    remote.begin_check(config.stash.get(_TASK, None))  # made while the first check sets up
     return remote
 
 
 def pytest_runtest_setup(item: pytest.Item) -> None:
     """Each check starts afresh (a function that timed out in an earlier check runs again)
     and draws on its task's time."""
+    task = next((n for n in TASKS if item.get_closest_marker(f"task{n}")), None)
+    item.config.stash[_TASK] = task
     remote = item.config.stash.get(_REMOTE, None)
     if remote is not None:
-        task = next((n for n in TASKS if item.get_closest_marker(f"task{n}")), None)
         remote.begin_check(task)
