@@ -19,7 +19,8 @@ Tables (schema `SCHEMA_VERSION`):
   ``hint`` (for the instructor only, never a student: whose own numbers it holds).
 - ``checks``: one row per check of a graded submission, in the report's order
   (``position``): the fields of `CheckResult` (``task``, ``name``, ``points``,
-  ``hidden``, ``outcome``, ``exception``, ``message``, ``duration``, ``nodeid``).
+  ``hidden``, ``outcome``, ``exception``, ``message``, ``duration``, ``nodeid``,
+  ``mistake``, ...).
 - ``tasks``: per submission and task the points ``earned`` of ``possible`` (from its
   checks, or imported from an older grades file, which has no checks).
 - ``final``: the term's rules applied to each row (`final_points.COLUMNS`: ``points``,
@@ -37,6 +38,7 @@ points, final total and check results; `connect` opens the database for SQL of o
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import os
 import socket
@@ -55,8 +57,9 @@ GRADED, NOT_GRADED, ABSENT, GRADER_FAILED = "graded", "not graded", "absent", "g
 STATUSES = (GRADED, NOT_GRADED, ABSENT, GRADER_FAILED)
 BUSY_SECONDS = 120.0
 """How long a write waits for another run's transaction to end."""
-CHECK_FIELDS = ("nodeid", "name", "task", "points", "hidden", "outcome", "exception",
-                "message", "duration")  # fmt: skip
+CHECK_FIELDS = tuple(field.name for field in dataclasses.fields(CheckResult))
+"""The ``checks`` table's columns after ``submission`` and ``position``: a field added to
+`CheckResult` later is added to an older gradebook's table when it is opened."""
 SETTLED = [column for column in FINAL_COLUMNS if column not in ("handed_in", "handed_in_from")]
 
 _SCHEMA = f"""
@@ -72,10 +75,7 @@ CREATE TABLE IF NOT EXISTS submissions (
     run INTEGER REFERENCES runs (run), graded_at TEXT NOT NULL, hint TEXT);
 CREATE TABLE IF NOT EXISTS checks (
     submission TEXT NOT NULL REFERENCES submissions (id) ON DELETE CASCADE,
-    position INTEGER NOT NULL, nodeid TEXT NOT NULL, name TEXT NOT NULL,
-    task INTEGER NOT NULL, points INTEGER NOT NULL, hidden INTEGER NOT NULL,
-    outcome TEXT NOT NULL, exception TEXT, message TEXT NOT NULL, duration REAL NOT NULL,
-    PRIMARY KEY (submission, position));
+    position INTEGER NOT NULL, {", ".join(CHECK_FIELDS)}, PRIMARY KEY (submission, position));
 CREATE TABLE IF NOT EXISTS tasks (
     submission TEXT NOT NULL REFERENCES submissions (id) ON DELETE CASCADE,
     task INTEGER NOT NULL, earned TEXT NOT NULL, possible TEXT NOT NULL,
@@ -139,6 +139,7 @@ def connect(path: Path) -> sqlite3.Connection:
             for statement in _SCHEMA.split(";")[:-1]:
                 connection.execute(statement)
             _check_version(connection, path)
+            _add_check_fields(connection)
     except sqlite3.DatabaseError as error:
         connection.close()
         raise ValueError(
@@ -158,6 +159,13 @@ def transaction(connection: sqlite3.Connection) -> Iterator[sqlite3.Connection]:
         connection.execute("ROLLBACK")
         raise
     connection.execute("COMMIT")
+
+
+def _add_check_fields(connection: sqlite3.Connection) -> None:
+    """Add to the ``checks`` table the `CheckResult` fields it lacks (made by an older msdlab)."""
+    present = {row[1] for row in connection.execute("PRAGMA table_info(checks)")}
+    for name in (name for name in CHECK_FIELDS if name not in present):
+        connection.execute(f"ALTER TABLE checks ADD COLUMN {name}")
 
 
 def _check_version(connection: sqlite3.Connection, path: Path) -> None:

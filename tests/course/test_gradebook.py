@@ -19,7 +19,17 @@ from msdlab.instructor import csv_files, gradebook, gradebook_db, grading, rende
 from msdlab.instructor.final_points import Terms
 
 CHECKS = [
-    CheckResult("t::a", "rest_state", 2, 2, False, "failed", "CheckFailed", "net force 0.5"),
+    CheckResult(
+        "t::a",
+        "rest_state",
+        2,
+        2,
+        False,
+        "failed",
+        "CheckFailed",
+        "net force 0.5",
+        mistake="gravity's sign",
+    ),
     CheckResult("t::b", "pulls", 2, 3, False, "passed"),
     CheckResult("t::c", "secret", 2, 2, True, "passed"),
 ]
