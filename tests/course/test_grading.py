@@ -15,7 +15,7 @@ import pytest
 
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
-from msdlab.instructor import grading, sandbox
+from msdlab.instructor import gradebook_db, grading, sandbox
 from msdlab.instructor.judges import ForkedJudges
 
 SOLUTIONS = PROJECT_ROOT / "solutions"
@@ -241,17 +241,22 @@ def test_grade_command_writes_rows_feedback_and_exit_status(tmp_path, capsys):
     assert "[1/1]" in output.err and "graded 1 of 2" in output.out
 
 
-def test_a_submission_that_outlasts_its_time_limit_still_gets_a_row(tmp_path):
+@pytest.mark.parametrize("busy", [False, True], ids=["quiet machine", "overloaded machine"])
+def test_a_submission_that_outlasts_its_time_limit_still_gets_a_row(tmp_path, monkeypatch, busy):
+    """On a quiet machine the student's; on an overloaded one the grader's, graded again."""
+    monkeypatch.setattr(grading, "overloaded", lambda: busy)
     slow = submission(tmp_path, "slow", task1="import time\ntime.sleep(60)\n")
     checks = tmp_path / "checks"
     checks.mkdir()
     shutil.copy(CHECKS / "test_task1.py", checks)
     out = tmp_path / "grades.csv"
     status = main(["grade", str(slow), "--out", str(out), "--checks", str(checks), "--timeout", "8",
-                   "--call-timeout", "30"])  # fmt: skip
+                   "--call-timeout", "30", "--retries", "1"])  # fmt: skip
     row = {row["id"]: row for row in csv.DictReader(out.open())}["slow"]
-    assert status == 1
     assert row["total"] == "0" and "timed out after 8 s" in row["notes"]
+    assert status == (2 if busy else 1)
+    assert ("grader error" in row["notes"]) == busy
+    assert gradebook_db.read_class(out)[0].attempts == (2 if busy else 1)
 
 
 @pytest.mark.skipif(os.geteuid() != 0, reason="sandbox user ids are used only when grading as root")
