@@ -30,13 +30,14 @@ from ..course import TASKS
 from ..course.report import MISTAKE_SENTENCE, CheckResult
 from .gradebook import Gradebook, check_column
 from .grading import Grade
+from .intake.times import STUDENT, UNREADABLE
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 TRUSTED_SOURCES = ("Gradescope's submission time",)
 """Hand-in times the student's own machine did not set (see `intake.times.NAMES`)."""
-UNKNOWN_TIME = "hand-in time unknown"
+UNKNOWN_TIME, UNREADABLE_TIME = "hand-in time unknown", "hand-in time unreadable"
 CAUSE = re.compile(
     rf"(?:Usual cause: |{re.escape(MISTAKE_SENTENCE.split('{}')[0])})([^\n]*?)\.?\s*(?:\n|$)"
 )
@@ -122,13 +123,16 @@ def cause_of(check: CheckResult) -> str | None:
 
 
 def unverified(row: dict[str, str]) -> str | None:
-    """Why a row's hand-in time could not be verified: not known, or (where a due date
-    applies) read from a clock the student's machine set."""
-    late = row.get("late", "")
-    if late.startswith(UNKNOWN_TIME) or UNKNOWN_TIME in row.get("notes", ""):
+    """Why a row's hand-in time could not be verified: not known (or not readable), or, where
+    a due date applies, kept by a clock the student controls (``handed_in_control``; a row
+    from before that column: any source but `TRUSTED_SOURCES`)."""
+    control, notes = row.get("handed_in_control", ""), row.get("notes", "")
+    unknown = row.get("late", "").startswith(UNKNOWN_TIME) or UNKNOWN_TIME in notes
+    if control == UNREADABLE or unknown or UNREADABLE_TIME in notes:
         return "hand-in time unknown"
     source = row.get("handed_in_from", "")
-    if row.get("due") and source and source not in TRUSTED_SOURCES:
+    set_by_student = control == STUDENT if control else source not in TRUSTED_SOURCES
+    if row.get("due") and source and set_by_student:
         return f"hand-in time from the {source}, which the student's machine set"
     return None
 

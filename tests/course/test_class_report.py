@@ -55,7 +55,8 @@ def report_of(student: str) -> CheckReport:
 @pytest.fixture
 def graded(tmp_path) -> tuple[Gradebook, list[Grade]]:
     """Five graded students (their rows with per-check columns) and one who handed in
-    nothing to grade; di's hand-in time is unknown, ed's from his own clock."""
+    nothing to grade; di's hand-in time is unknown, ed's from his own clock, ada's from
+    Gradescope (a row from before the column saying who controls the time)."""
     book, grades = Gradebook(), []
     for student in FAILS:
         grade = Grade(student, report_of(student))
@@ -66,7 +67,7 @@ def graded(tmp_path) -> tuple[Gradebook, list[Grade]]:
     due = {"due": "2027-03-01T23:59+01:00"}
     book.rows["di"].update(due, late="hand-in time unknown: no late penalty")
     book.rows["ed"].update(due, handed_in="2027-03-01T20:00+00:00")
-    book.rows["ed"]["handed_in_from"] = "file modification time"
+    book.rows["ed"].update(handed_in_from="file modification time", handed_in_control="student")
     book.rows["ada"].update(due, handed_in="2027-03-01T20:00+00:00")
     book.rows["ada"]["handed_in_from"] = "Gradescope's submission time"
     return book, grades
@@ -200,3 +201,20 @@ def test_a_recognised_mistake_is_its_cause_kept_or_read_back_from_the_message():
     assert class_report.cause_of(kept) == class_report.cause_of(stored) == mistake
     usual = dataclasses.replace(stored, message=f"saw 3. Usual cause: {SIGN}.")
     assert class_report.cause_of(usual) == SIGN
+
+
+@pytest.mark.parametrize(
+    ("row", "listed"),
+    [
+        ({"handed_in_from": "last commit", "handed_in_control": "student"}, True),
+        ({"handed_in_from": "zip entry times", "handed_in_control": "instructor"}, False),
+        ({"handed_in_from": "zip entry times", "handed_in_control": "unreadable"}, True),
+        ({"handed_in_from": "file modification time"}, True),  # a row from before the column
+        ({"handed_in_from": "Gradescope's submission time"}, False),
+    ],
+)
+def test_who_controls_the_hand_in_time_decides_whether_it_is_verified(row, listed):
+    due = {"due": "2027-03-01T23:59+01:00", "handed_in": "2027-03-01T20:00+00:00"}
+    assert (class_report.unverified(due | row) is not None) == listed
+    if row.get("handed_in_control") != "unreadable":  # without a due date the time is moot
+        assert class_report.unverified(row) is None
