@@ -10,7 +10,14 @@ from typing import Any, Generic, TypeVar
 import numpy as np
 
 from .errors import as_vectors, check_non_negative, check_positive, shown
-from .lattice import GridSprings, grid_pair_blocks, grid_positions, neighbour_offsets
+from .lattice import (
+    GRID_EXAMPLE,
+    GridSprings,
+    grid_pair_blocks,
+    grid_positions,
+    grid_shape,
+    neighbour_offsets,
+)
 from .particle import Particle
 from .spring import Spring
 from .tracked import TrackedArray
@@ -429,9 +436,7 @@ class Body:
         (√3·spacing). The grid is at rest: every spring starts at its rest length.
         The springs are kept per offset (`grid_springs`) until a spring array is read.
         """
-        shape = tuple(operator.index(n) for n in shape)
-        if len(shape) not in (2, 3) or min(shape) < 1:
-            raise ValueError(f"grid shape must be 2 or 3 positive sizes, got {shape}")
+        shape = grid_shape(shape)
         spacing = check_positive("spacing", spacing, "Grid spacing is in m and must be > 0.")
         origin = np.zeros(len(shape)) if origin is None else np.asarray(origin, dtype=float)
         if origin.shape != (len(shape),):
@@ -439,7 +444,8 @@ class Body:
         offsets = neighbour_offsets(len(shape), neighbours)
         body = cls()
         body.add_particles(grid_positions(shape, spacing, origin), masses=mass)
-        k, c = Body.stiffness.check(body, stiffness, 1), Body.spring_damping.check(body, damping, 1)
+        k = _per_row("stiffness", stiffness, 1, f"Use k >= 0 in N/m, e.g. {GRID_EXAMPLE}.")
+        c = _per_row("damping", damping, 1, "Use a dashpot c >= 0 in N·s/m, e.g. damping=0.1.")
         rest = spacing * np.sqrt((offsets**2).sum(axis=1))
         body._keep_grid_springs(GridSprings(shape, offsets, rest, float(k), float(c)))
         body.grid_shape = shape

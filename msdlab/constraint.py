@@ -40,6 +40,7 @@ class Constraint(ABC):
     """A rule applied after each integrator step; see the module docstring."""
 
     ledger_name = "other"
+    example = ""  # how to create one, for error messages: "msd.Ground()"
 
     def check(self, body: Body) -> None:
         """Raise ValueError if this constraint cannot act on ``body``."""

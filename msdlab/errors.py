@@ -29,9 +29,19 @@ def shown(value: object) -> str:
     return repr(value)
 
 
+def as_numbers(name: str, values: object, hint: str = "") -> np.ndarray:
+    """``values`` (a number or numbers) as a float array, else ValueError naming ``name``,
+    what was given and ``hint`` (say what works: ``"e.g. stiffness=100.0"``)."""
+    try:
+        return np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        message = f"{name} must be a number, got {shown(values)}."
+        raise ValueError(f"{message} {hint}".strip()) from None
+
+
 def check_positive(name: str, value: float, hint: str = "") -> float:
     """``value`` as a float if it is finite and > 0, else ValueError."""
-    number = float(value)
+    number = float(as_numbers(name, value, hint))
     if not math.isfinite(number) or number <= 0:
         message = f"{name} must be a positive finite number, got {shown(value)}."
         raise ValueError(f"{message} {hint}".strip())
@@ -43,7 +53,7 @@ def check_non_negative(
 ) -> np.ndarray:
     """``values`` as a float array if all are finite and >= 0 (> 0 if not ``zero``),
     else ValueError naming the first bad one."""
-    array = np.asarray(values, dtype=float)
+    array = as_numbers(name, values, hint)
     bad = ~np.isfinite(array) | ((array < 0) if zero else (array <= 0))
     if bad.any():
         first = int(np.flatnonzero(bad)[0])

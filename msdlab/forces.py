@@ -21,6 +21,7 @@ class Force(ABC):
     """
 
     ledger_name = "other"
+    example = ""  # how to create one, for error messages: "msd.Gravity((0, -9.81, 0))"
 
     def check(self, body: Body) -> None:
         """Raise ValueError if this force cannot act on ``body`` (e.g. wrong dimension)."""
@@ -56,6 +57,8 @@ class Force(ABC):
 
 class Gravity(Force):
     """Uniform gravity: F = m g on every particle; g in m/s², e.g. (0, -9.81, 0)."""
+
+    example = "msd.Gravity((0, -9.81, 0))"
 
     def __init__(self, g: Sequence[float] = (0.0, -9.81, 0.0)) -> None:
         self.g = np.asarray(g, dtype=float)
@@ -95,6 +98,7 @@ class ViscousDamping(Force):
     """
 
     ledger_name = "viscous"
+    example = "msd.ViscousDamping(0.1)"
 
     def __init__(self, coefficient: float) -> None:
         self.coefficient = float(check_non_negative("viscous damping coefficient", coefficient))

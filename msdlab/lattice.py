@@ -9,10 +9,28 @@ from __future__ import annotations
 
 import itertools
 import math
+import operator
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+
+from .errors import shown
+
+GRID_EXAMPLE = "Body.grid((4, 4, 4), spacing=0.1, stiffness=100.0)"
+
+
+def grid_shape(shape: object) -> tuple[int, ...]:
+    """``shape`` as a tuple of 2 or 3 positive sizes (particles per axis), else an error
+    saying what was given and what works."""
+    example = f"give one size per axis, e.g. {GRID_EXAMPLE} for a 4×4×4 cube"
+    try:
+        sizes = tuple(operator.index(n) for n in shape)  # type: ignore[attr-defined]
+    except TypeError:
+        raise TypeError(f"grid shape must be 2 or 3 sizes, got {shown(shape)}; {example}") from None
+    if len(sizes) not in (2, 3) or min(sizes) < 1:
+        raise ValueError(f"grid shape must be 2 or 3 sizes >= 1, got {shown(shape)}; {example}")
+    return sizes
 
 
 def neighbour_offsets(dim: int, squared_distances: Iterable[int]) -> np.ndarray:

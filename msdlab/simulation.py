@@ -101,10 +101,7 @@ class Simulation:
             elif isinstance(item, Constraint):
                 self.constraints.append(item)
             else:
-                raise TypeError(
-                    f"forces holds a {type(item).__name__}: neither a msdlab.Force (Gravity, "
-                    "SphereContact, ...) nor a msdlab.Constraint (Ground, Drag, Walls, ...)"
-                )
+                raise TypeError(_not_a_force(item))
             item.check(body)
         self.dynamics = Dynamics(body, field_forces, kernel=kernel)
         self.time = 0.0
@@ -258,7 +255,12 @@ class Simulation:
 
     # ------------------------------------------------------------------ helpers
     def _count_steps(self, steps: int | None, duration: float | None) -> int:
-        if (steps is None) == (duration is None):
+        if steps is None and duration is None:
+            raise ValueError(
+                "say how long to run: steps=... (a number of steps) or duration=... (in "
+                "seconds), e.g. sim.run(steps=1000) or sim.run(duration=2.0)"
+            )
+        if steps is not None and duration is not None:
             raise ValueError("give either steps=... or duration=... (in seconds), not both")
         if duration is not None:
             duration = float(duration)
@@ -315,6 +317,17 @@ class Simulation:
             f"<Simulation {self.body!r}, {self.integrator!r}, dt={self.dt:g} s, "
             f"t={self.time:g} s, forces={items}>"
         )
+
+
+def _not_a_force(item: object) -> str:
+    """Why ``item`` in ``forces`` is neither a force nor a constraint, and what to give."""
+    if isinstance(item, type) and issubclass(item, (Force, Constraint)):
+        example = item.example or f"msd.{item.__name__}(...)"
+        return f"{item.__name__} is a class; create one: {example}"
+    return (
+        f"forces holds a {type(item).__name__}: neither a msdlab.Force (Gravity, "
+        "SphereContact, ...) nor a msdlab.Constraint (Ground, Drag, Walls, ...)"
+    )
 
 
 def _as_list(forces: object) -> list:

@@ -70,6 +70,7 @@ class Ground(Constraint):
     """
 
     ledger_name = "ground"
+    example = "msd.Ground()"
 
     def __init__(
         self, height: float = 0.0, normal: Sequence[float] | None = None, friction: float = 0.0
@@ -142,6 +143,7 @@ class Drag(Constraint):
     """
 
     ledger_name = "drag"
+    example = "msd.Drag(0.5)"
 
     def __init__(self, rate: float) -> None:
         check_non_negative("drag rate", rate, "The drag rate is in 1/s.")
@@ -177,6 +179,7 @@ class Walls(Constraint):
     """
 
     ledger_name = "walls"
+    example = "msd.Walls((-1, -1, -1), (1, 1, 1))"
 
     def __init__(
         self, lower: Sequence[float], upper: Sequence[float], mode: str = "reflect"
@@ -271,6 +274,7 @@ class Grab(Constraint):
     """
 
     ledger_name = "hand"
+    example = "msd.Grab()"
 
     def __init__(self) -> None:
         self.particle: int | None = None

@@ -103,8 +103,6 @@ def test_force_of_wrong_dimension_and_unknown_force():
 
 def test_run_needs_steps_or_duration():
     sim = msd.Simulation(body_2d(), msd.Verlet(), 0.1)
-    with pytest.raises(ValueError, match="either steps"):
-        sim.run()
     with pytest.raises(ValueError, match="record_every"):
         sim.run(steps=3, record_every=0)
 
@@ -173,3 +171,62 @@ def test_numbers_in_messages_are_plain_not_numpy_reprs(make, plain):
     message = str(raised.value)
     assert plain in message
     assert "np." not in message and "array(" not in message
+
+
+def test_grid_stiffness_that_is_no_number_names_the_parameter_and_an_example():
+    with pytest.raises(ValueError) as error:
+        msd.Body.grid((3, 3, 3), stiffness="stiff")
+    message = str(error.value)
+    assert "stiffness must be a number, got 'stiff'" in message
+    assert "Body.grid((4, 4, 4), spacing=0.1, stiffness=100.0)" in message
+    msd.Body.grid((4, 4, 4), spacing=0.1, stiffness=100.0)  # the example works
+    with pytest.raises(ValueError, match=r"damping must be a number, got 'lots'.*damping=0\.1"):
+        msd.Body.grid((3, 3), damping="lots")
+
+
+@pytest.mark.parametrize("shape", [3, "abc", (3.5, 3), None])
+def test_grid_shape_that_is_not_sizes_says_one_size_per_axis(shape):
+    with pytest.raises(TypeError) as error:
+        msd.Body.grid(shape)
+    message = str(error.value)
+    assert f"grid shape must be 2 or 3 sizes, got {shape!r}" in message
+    assert "one size per axis, e.g. Body.grid((4, 4, 4)" in message
+    assert "not iterable" not in message
+
+
+@pytest.mark.parametrize("shape", [(3,), (2, 2, 2, 2), (3, 0, 3)])
+def test_grid_shape_of_wrong_length_or_empty_axis(shape):
+    with pytest.raises(ValueError, match=r"grid shape must be 2 or 3 sizes >= 1.*per axis"):
+        msd.Body.grid(shape)
+
+
+@pytest.mark.parametrize(
+    ("item", "example"),
+    [
+        (msd.Gravity, "Gravity is a class; create one: msd.Gravity((0, -9.81, 0))"),
+        (msd.Ground, "Ground is a class; create one: msd.Ground()"),
+        (msd.SphereContact, "SphereContact is a class; create one: msd.SphereContact(...)"),
+    ],
+)
+def test_a_force_class_instead_of_a_force_says_how_to_create_one(item, example):
+    with pytest.raises(TypeError) as error:
+        msd.Simulation(body_2d(), msd.Verlet(), forces=[item])
+    assert str(error.value) == example
+    assert "ABCMeta" not in str(error.value)
+
+
+def test_gravity_example_in_the_message_runs():
+    body = msd.Body.from_arrays([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]], [[0, 1]])
+    msd.Simulation(body, msd.Verlet(), forces=[msd.Gravity((0, -9.81, 0))]).step()
+
+
+def test_run_without_steps_or_duration_says_how_long_to_run():
+    sim = msd.Simulation(body_2d(), msd.Verlet(), dt=0.01)
+    with pytest.raises(ValueError) as error:
+        sim.run()
+    message = str(error.value)
+    assert "steps=..." in message and "duration=..." in message
+    assert "sim.run(steps=1000)" in message and "not both" not in message
+    with pytest.raises(ValueError, match="not both"):
+        sim.run(steps=3, duration=1.0)
+    assert sim.run(steps=3).positions.shape[0] == 4
