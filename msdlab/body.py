@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import math
-import operator
-from collections.abc import Callable, Iterator, Sequence
-from typing import Any, Generic, TypeVar
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from .bound import Rows
 from .errors import as_vectors, check_non_negative, check_positive, shown
 from .lattice import (
     GRID_EXAMPLE,
@@ -20,172 +19,138 @@ from .lattice import (
 )
 from .particle import Particle
 from .spring import Spring
-from .tracked import TrackedArray
 
-Item = TypeVar("Item", Particle, Spring)
 MASS_HINT = "To pin a particle use fixed=True instead of a zero mass."
-FIELDS = {  # the arrays of a body and their types: one row per particle / per spring
-    "particles": {"positions": float, "velocities": float, "masses": float, "fixed": bool},
-    "springs": {
-        "spring_a": np.int64,
-        "spring_b": np.int64,
-        "stiffness": float,
-        "rest_lengths": float,
-        "spring_damping": float,
-    },
+VALUE_HINTS = {  # the spring values and what a bad one is told
+    "stiffness": "Use k >= 0 (N/m).",
+    "rest_lengths": "It is in m.",
+    "spring_damping": "Use a dashpot coefficient c >= 0 (N·s/m).",
 }
-
-
-_SPRING_VALUES = ("stiffness", "rest_lengths", "spring_damping")
-_VIEWS = {*FIELDS["particles"], *FIELDS["springs"], "spring_values"}  # kept in the __dict__
+SPRING_ARRAYS = ("spring_a", "spring_b", *VALUE_HINTS)
 
 
 def _per_row(name: str, values: object, count: int, hint: str, zero: bool = True) -> np.ndarray:
-    """``values`` checked finite and >= 0 (> 0 unless ``zero``): one value or ``count``."""
+    """``values`` checked finite and >= 0 (> 0 unless ``zero``), as ``count`` floats."""
     array = check_non_negative(name, values, hint, zero=zero)
     if array.ndim and array.shape != (count,):
         raise ValueError(f"{name} needs one value or one per row ({count}), got {array.shape}")
-    return array
+    return np.broadcast_to(array, (count,)).copy()
 
 
-def _pin(body: Body, fixed: object, count: int) -> np.ndarray:
-    """The fixed mask (N,) to store; pinned particles stop (their velocity becomes zero)."""
-    mask = np.broadcast_to(np.asarray(fixed, dtype=bool), (count,))
-    body.velocities[mask] = 0.0
-    return mask
+def _pin(body: Body, mask: object) -> None:
+    body.fixed[...] = mask
+    body.velocities[body.fixed] = 0.0  # pinned particles stop
 
 
-class _Rows:
-    """A body array as an attribute: a view of the used rows of a buffer that grows.
+def _read_only(name: str) -> Callable[[Body, object], None]:
+    def refuse(body: Body, value: object) -> None:
+        raise AttributeError(f"body.{name} is read-only; add springs with body.add_springs(...)")
 
-    Reading ``body.<name>`` finds the view in the body's ``__dict__``, where
-    `Body` puts it whenever the rows change: the view is valid until the body
-    grows. Only the spring arrays of a grid body that keeps its springs per
-    offset (`Body.grid_springs`) are missing there; reading one lays them out
-    first. Assigning the whole array goes through ``check(body, value, rows)``;
-    without a check the array is read-only. Spring values are `TrackedArray`
-    views, so writes to them count in ``body.parameters_version``.
-    """
+    return refuse
 
-    def __init__(self, doc: str, check: Callable[[Body, Any, int], Any] | None = None) -> None:
-        self.__doc__, self.check = doc, check
 
-    def __set_name__(self, owner: type, name: str) -> None:
-        self.name = name
-        self.kind = "particles" if name in FIELDS["particles"] else "springs"
-
-    def __get__(self, body: Body | None, owner: type | None = None) -> Any:
-        if body is None:
-            return self
-        body.lay_out_springs()
-        return body.__dict__[self.name]
-
-    def view(self, body: Body) -> np.ndarray:
-        """The used rows of the body's buffer, as the attribute shows them."""
-        view = body._buffers[self.name][: body._size[self.kind]]
-        if self.check is None:
-            view.flags.writeable = False
-        elif self.kind == "springs":
-            return TrackedArray.of(view, body._spring_values_edited)
-        return view
-
-    def assign(self, body: Body, value: object) -> None:
-        """``body.<name> = value``: check the whole array and write it into the rows."""
-        if self.check is None:
-            raise AttributeError(f"body.{self.name} is read-only; add springs to change it")
-        rows = getattr(body, self.name)
-        rows[...] = self.check(body, value, len(rows))
+# `body.<name> = value`: a whole array, checked and written into the body's arrays
+_WHOLE: dict[str, Callable[[Body, object], None]] = {
+    "positions": lambda body, x: body.positions.__setitem__(
+        ..., as_vectors("positions", x, body.dim or 3, len(body))
+    ),
+    "velocities": lambda body, v: body.velocities.__setitem__(
+        ...,
+        np.where(body.fixed[:, None], 0.0, as_vectors("velocities", v, body.dim or 3, len(body))),
+    ),
+    "masses": lambda body, m: body.masses.__setitem__(
+        ..., _per_row("mass", m, len(body), MASS_HINT, zero=False)
+    ),
+    "fixed": _pin,
+    "stiffness": lambda body, k: body.set_springs(stiffness=k),
+    "rest_lengths": lambda body, rest: body.set_springs(rest_lengths=rest),
+    "spring_damping": lambda body, c: body.set_springs(spring_damping=c),
+    **{name: _read_only(name) for name in ("spring_a", "spring_b", "spring_values")},
+}
 
 
 class Body:
     """A mass-spring body in 2-D or 3-D (fixed by the first particle added).
 
-    The state lives in arrays, so the whole body is updated at once (writeable
-    views, valid until the body grows). ``particles[i]`` and ``springs[k]`` are
-    objects reading and writing the same rows.
+    The state is four arrays, read and written in place: ``positions`` (N, d) in m,
+    ``velocities`` (N, d) in m/s, ``masses`` (N,) in kg and ``fixed`` (N,). The springs
+    are read-only arrays (E,): ``spring_a``, ``spring_b``, ``stiffness`` (N/m),
+    ``rest_lengths`` (m), ``spring_damping`` (N·s/m); they change only through
+    `add_springs`, `set_springs` (or assigning a whole array), each of which adds one
+    to ``version``. A grid (`Body.grid`) keeps its springs per offset (`grid_springs`)
+    until `lay_out_springs` writes them out; ``particles[i]`` and ``springs[k]`` are
+    objects reading and writing one row.
     """
-
-    positions = _Rows(
-        "Positions (N, d) in m.", lambda body, x, n: as_vectors("positions", x, body.dim or 3, n)
-    )
-    velocities = _Rows(
-        "Velocities (N, d) in m/s; zero for fixed particles.",
-        lambda body, v, n: np.where(
-            body.fixed[:, None], 0.0, as_vectors("velocities", v, body.dim or 3, n)
-        ),
-    )
-    masses = _Rows(
-        "Masses (N,) in kg.", lambda body, m, n: _per_row("mass", m, n, MASS_HINT, zero=False)
-    )
-    fixed = _Rows("True for pinned particles (N,); pinning zeroes their velocity.", _pin)
-    spring_a = _Rows("First particle of each spring (E,), read-only.")
-    spring_b = _Rows("Second particle of each spring (E,), read-only.")
-    stiffness = _Rows(
-        "Spring stiffness k (E,) in N/m.",
-        lambda body, k, n: _per_row("stiffness", k, n, "Use k >= 0 (N/m)."),
-    )
-    rest_lengths = _Rows(
-        "Spring rest lengths l (E,) in m.",
-        lambda body, rest, n: _per_row("rest length", rest, n, "It is in m.", zero=False),
-    )
-    spring_damping = _Rows(
-        "Dashpot coefficient c along each spring (E,) in N·s/m.",
-        lambda body, c, n: _per_row("damping", c, n, "Use a dashpot coefficient c >= 0 (N·s/m)."),
-    )
-
-    spring_values = _Rows(
-        "Stiffness (N/m), rest lengths (m) and dashpots (N·s/m) (E,) as plain arrays to read. "
-        "Write through `stiffness`, `rest_lengths` and `spring_damping`, which count edits."
-    )
 
     def __init__(self, dim: int | None = None) -> None:
         if dim not in (None, 2, 3):
             raise ValueError(f"a body is 2-D or 3-D, got dim = {shown(dim)}")
         self.dim = dim
         self.grid_shape: tuple[int, ...] | None = None
-        self.topology_version = 0  # grows whenever particles or springs are added
-        self.parameters_version = 0  # grows whenever the spring values are edited
+        self.version = 0  # grows whenever the springs change: added or edited
         self.grid_springs: GridSprings | None = None  # `Body.grid`'s springs, until laid out
-        self._size = {"particles": 0, "springs": 0}
-        self._buffers: dict[str, np.ndarray] = {}
-        self._capacity = {"particles": 0, "springs": 0}
-        self._reserve("particles", 0)
-        self._reserve("springs", 0)
         self._incidence: tuple[int, np.ndarray, np.ndarray] | None = None
         self._new_state: tuple[np.ndarray, ...] = ()  # see `new_state`
+        width = dim or 3
+        self._keep(positions=np.zeros((0, width)), velocities=np.zeros((0, width)))
+        self._keep(masses=np.zeros(0), fixed=np.zeros(0, bool))
+        self._keep_springs(np.zeros(0, np.int64), np.zeros(0, np.int64), *np.zeros((3, 0)))
+
+    def _keep(self, **arrays: np.ndarray) -> None:
+        """Make ``arrays`` the body's attributes (past `__setattr__`'s checks)."""
+        self.__dict__.update(arrays)
+
+    def _keep_springs(self, *arrays: np.ndarray) -> None:
+        """Make the spring arrays (ends, stiffness, rest lengths, dashpots) the body's,
+        read-only."""
+        for array in arrays:
+            array.flags.writeable = False
+        self._keep(**dict(zip(SPRING_ARRAYS, arrays)), spring_values=arrays[2:])
+
+    def __setattr__(self, name: str, value: object) -> None:
+        """``body.masses = 2.0`` or ``body.stiffness = 50.0`` (whole arrays) are checked and
+        written into the body's arrays; the ends of the springs cannot be assigned."""
+        write = _WHOLE.get(name)
+        if write is None:
+            super().__setattr__(name, value)
+        else:
+            write(self, value)
+
+    def __getattr__(self, name: str) -> object:
+        """The ends and rest lengths of a grid's springs kept per offset: laid out first."""
+        laid_out = name in SPRING_ARRAYS or name == "spring_values"
+        if laid_out and self.__dict__.get("grid_springs") is not None:
+            self.lay_out_springs()
+            return self.__dict__[name]
+        raise AttributeError(f"'Body' object has no attribute {name!r}")
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        for name in SPRING_ARRAYS:
+            if name in state:
+                state[name].flags.writeable = False
 
     @property
     def n_particles(self) -> int:
-        return self._size["particles"]
+        return len(self.positions)
 
     @property
     def n_springs(self) -> int:
-        return self._size["springs"]
+        grid = self.grid_springs
+        return len(self.stiffness) if grid is None else grid.count
 
     def __len__(self) -> int:
-        return self.n_particles
-
-    def __setattr__(self, name: str, value: object) -> None:
-        """``body.masses = 2.0`` (a whole array) is checked and written into its rows."""
-        rows = getattr(type(self), name, None)
-        if isinstance(rows, _Rows):
-            rows.assign(self, value)
-        else:
-            super().__setattr__(name, value)
-
-    def _spring_values_edited(self) -> None:
-        """Count an in-place write to the spring values (see `tracked.TrackedArray`)."""
-        self.parameters_version += 1
+        return len(self.positions)
 
     @property
-    def particles(self) -> _Items[Particle]:
+    def particles(self) -> Rows[Particle]:
         """``particles[i]`` reads/writes particle i's rows of the arrays."""
-        return _Items(self, Particle, self.n_particles)
+        return Rows(self, Particle, self.n_particles)
 
     @property
-    def springs(self) -> _Items[Spring]:
+    def springs(self) -> Rows[Spring]:
         """``springs[k]`` reads/writes spring k's rows of the arrays."""
-        return _Items(self, Spring, self.n_springs)
+        return Rows(self, Spring, self.n_springs)
 
     # ----------------------------------------------------------------- building
     def add_particle(self, particle: Particle) -> int:
@@ -217,21 +182,20 @@ class Body:
                 f"this body is {self.dim}-D but the new particle has {dim} coordinates; "
                 "do not mix 2-D and 3-D particles in one body"
             )
-        count = len(positions)
+        count, first = len(positions), len(self)
         positions = as_vectors("positions", positions, dim, count)
-        velocities = 0.0 if velocities is None else as_vectors("velocities", velocities, dim, count)
+        velocities = np.zeros((count, dim)) if velocities is None else velocities
+        velocities = as_vectors("velocities", velocities, dim, count)
         fixed = np.broadcast_to(np.asarray(fixed, dtype=bool), (count,))
+        masses = _per_row("mass", masses, count, MASS_HINT, zero=False)
         if self.dim is None:
             self.dim = dim
-            self._reserve("particles", 0)  # the empty buffers, now with d columns
-        return self._append(
-            "particles",
-            count,
-            positions=positions,
-            velocities=np.where(fixed[:, None], 0.0, velocities),
-            masses=_per_row("mass", masses, count, MASS_HINT, zero=False),
-            fixed=fixed,
-        )
+            self._keep(positions=np.zeros((0, dim)), velocities=np.zeros((0, dim)))
+        velocities = np.where(fixed[:, None], 0.0, velocities)
+        new = {"positions": positions, "velocities": velocities, "masses": masses, "fixed": fixed}
+        self._keep(**{name: np.concatenate([getattr(self, name), new[name]]) for name in new})
+        self.version += 1
+        return np.arange(first, first + count)
 
     def add_spring(self, spring: Spring) -> int:
         """Add ``spring`` and return its index; the object then reads/writes this body."""
@@ -286,59 +250,82 @@ class Body:
                     f"position {self.positions[a[zero]].tolist()}; "
                     "move them apart or give rest_length > 0"
                 )
-        return self._append(
-            "springs",
-            count,
-            spring_a=a,
-            spring_b=b,
-            stiffness=Body.stiffness.check(self, stiffness, count),
-            rest_lengths=Body.rest_lengths.check(self, rest_lengths, count),
-            spring_damping=Body.spring_damping.check(self, damping, count),
+        values = _checked_values(count, stiffness, rest_lengths, damping)
+        self.lay_out_springs()
+        first = self.n_springs
+        new = (a.astype(np.int64), b.astype(np.int64), *values.values())
+        self._keep_springs(
+            *(np.concatenate([getattr(self, n), v]) for n, v in zip(SPRING_ARRAYS, new))
         )
+        self.version += 1
+        return np.arange(first, first + count)
 
-    def _append(self, kind: str, count: int, **columns: object) -> np.ndarray:
-        """Add ``count`` rows of ``kind`` holding ``columns``; return their indices."""
-        if kind == "springs":
-            self.lay_out_springs()
-        indices = self._write(kind, count, **columns)
-        self.topology_version += 1
-        return indices
+    def set_springs(self, springs: object = None, **values: object) -> None:
+        """Set ``stiffness`` (N/m), ``rest_lengths`` (m) and/or ``spring_damping`` (N·s/m) of
+        the springs ``springs`` (indices; default all), each one value or one per spring.
 
-    def _write(self, kind: str, count: int, **columns: object) -> np.ndarray:
-        """Write ``columns`` into the next ``count`` rows of ``kind``; return their indices."""
-        start = self._size[kind]
-        if start + count > self._capacity[kind]:
-            self._reserve(kind, max(start + count, 2 * start, 8))
-        for name, values in columns.items():
-            self._buffers[name][start : start + count] = values
-        self._size[kind] += count
-        self._show(kind)
-        return np.arange(start, start + count)
+        A grid keeps its springs per offset when every spring gets one value; an edit of
+        some springs, or per spring, lays them out first (`lay_out_springs`).
+        """
+        unknown = set(values) - set(VALUE_HINTS)
+        if unknown:
+            raise TypeError(f"set_springs sets {', '.join(VALUE_HINTS)}, not {sorted(unknown)}")
+        chosen = np.arange(self.n_springs)[slice(None) if springs is None else springs]
+        checked = {name: _checked_value(name, v, len(chosen)) for name, v in values.items()}
+        grid = self.grid_springs
+        one = {
+            name: float(v[0]) for name, v in checked.items() if len(chosen) and np.all(v == v[0])
+        }
+        if grid is not None and springs is None and len(one) == len(checked):
+            self._keep_grid(grid.with_values(**one))
+            return
+        self.lay_out_springs()
+        for name, value in checked.items():
+            array = getattr(self, name)
+            array.flags.writeable = True  # the body's own array, read-only to others
+            array[chosen] = value
+            array.flags.writeable = False
+        self.version += 1
 
     def lay_out_springs(self) -> None:
         """Write the springs of `grid_springs` into per-spring arrays (a no-op without).
 
-        Reading any spring array does this first; the springs keep their order
-        and values, so nothing changes for the kernels (no version grows).
+        The springs keep their order and values, so the kernels compute the same (and
+        ``version`` stays).
         """
         grid = self.grid_springs
         if grid is None:
             return
+        blocks = list(grid_pair_blocks(grid.shape, grid.offsets))
+        pairs, counts = np.concatenate(blocks), [len(block) for block in blocks]
+        self._keep_springs(
+            pairs[:, 0].copy(),
+            pairs[:, 1].copy(),
+            np.full(grid.count, grid.stiffness),
+            np.repeat(grid.rest_lengths, counts),
+            np.full(grid.count, grid.damping),
+        )
         self.grid_springs = None
-        self._size["springs"] = 0
-        self._reserve("springs", grid.count)  # exactly: no regrowth
-        values = {"stiffness": grid.stiffness, "spring_damping": grid.damping}
-        for rest, pairs in zip(grid.rest_lengths, grid_pair_blocks(grid.shape, grid.offsets)):
-            ends = {"spring_a": pairs[:, 0], "spring_b": pairs[:, 1]}
-            self._write("springs", len(pairs), rest_lengths=rest, **ends, **values)
+
+    def _keep_grid(self, grid: GridSprings) -> None:
+        """Keep the springs per offset (``grid``): one stiffness and dashpot for all springs,
+        read as broadcast arrays (no memory per spring); the ends and rest lengths come
+        when laid out (`__getattr__`)."""
+        for name in ("spring_a", "spring_b", "rest_lengths", "spring_values"):
+            self.__dict__.pop(name, None)
+        self._keep(
+            grid_springs=grid,
+            stiffness=np.broadcast_to(grid.stiffness, (grid.count,)),
+            spring_damping=np.broadcast_to(grid.damping, (grid.count,)),
+        )
+        self.version += 1
 
     def new_state(self) -> tuple[np.ndarray, np.ndarray]:
         """Empty arrays (N, d) for the next positions and velocities, for a kernel to write
-        a step's new state into: `store_state` then makes them the body's own, uncopied."""
-        shape = (self._size["particles"], self.dim or 3)
-        # straight into __dict__: `__setattr__` only checks body arrays, and this is every step
-        self.__dict__["_new_state"] = (np.empty(shape), np.empty(shape))
-        return self._new_state
+        a step's new state into; `store_state` then makes them the body's own, uncopied."""
+        new = (np.empty_like(self.positions), np.empty_like(self.velocities))
+        self.__dict__["_new_state"] = new  # every step: past `__setattr__`
+        return new
 
     def store_state(self, positions: np.ndarray, velocities: np.ndarray) -> None:
         """Make ``positions`` (m) and ``velocities`` (m/s), (N, d), the body's state.
@@ -346,58 +333,11 @@ class Body:
         The arrays of the last `new_state` become the body's own; others are copied
         in. Arrays read from the body before may then keep the old state.
         """
-        new, self.__dict__["_new_state"] = self._new_state, ()
-        adopt = new and positions is new[0] and velocities is new[1]
-        if adopt and len(positions) == self._size["particles"]:
-            self._buffers["positions"] = self.__dict__["positions"] = positions
-            self._buffers["velocities"] = self.__dict__["velocities"] = velocities
-            self._capacity["particles"] = self._size["particles"]  # adding particles regrows all
+        new, self.__dict__["_new_state"] = self._new_state, ()  # every step: past `__setattr__`
+        if new and positions is new[0] and velocities is new[1] and len(new[0]) == len(self):
+            self.__dict__.update(positions=positions, velocities=velocities)
         else:
-            self.positions[...] = positions
-            self.velocities[...] = velocities
-
-    def _keep_grid_springs(self, grid: GridSprings) -> None:
-        """Use ``grid``'s springs, kept per offset, as the body's (it has none yet)."""
-        self.grid_springs = grid
-        self._size["springs"] = grid.count
-        self.topology_version += 1
-        self._show("springs")
-
-    def _show(self, kind: str) -> None:
-        """Put the views of the used rows of ``kind`` (see `_Rows`) in the body's attributes;
-        a grid's springs kept per offset have none until they are laid out."""
-        if kind == "springs" and self.grid_springs is not None:
-            for name in (*FIELDS[kind], "spring_values"):
-                self.__dict__.pop(name, None)
-            return
-        for name in FIELDS[kind]:
-            self.__dict__[name] = getattr(Body, name).view(self)
-        if kind == "springs":  # the same rows as plain arrays, for kernels to read
-            used = self._size[kind]
-            self.__dict__["spring_values"] = tuple(
-                self._buffers[name][:used] for name in _SPRING_VALUES
-            )
-
-    def __getstate__(self) -> dict[str, Any]:
-        """The body without its views (they would be pickled as copies, not views)."""
-        return {name: value for name, value in self.__dict__.items() if name not in _VIEWS}
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        self.__dict__.update(state)
-        self._show("particles")
-        self._show("springs")
-
-    def _reserve(self, kind: str, capacity: int) -> None:
-        """Grow the buffers of ``kind`` to hold ``capacity`` rows (their used rows kept)."""
-        used = self._size[kind]
-        for name, dtype in FIELDS[kind].items():
-            columns = (self.dim or 3,) if name in ("positions", "velocities") else ()
-            grown = np.empty((capacity, *columns), dtype)  # rows past `used` are never read
-            if used:
-                grown[:used] = self._buffers[name][:used]
-            self._buffers[name] = grown
-        self._capacity[kind] = capacity
-        self._show(kind)
+            self.positions[...], self.velocities[...] = positions, velocities
 
     @classmethod
     def from_arrays(
@@ -434,7 +374,7 @@ class Body:
         ``neighbours`` are squared distances in grid units: 1 makes axis springs
         (rest length = spacing), 2 face diagonals (√2·spacing), 3 body diagonals
         (√3·spacing). The grid is at rest: every spring starts at its rest length.
-        The springs are kept per offset (`grid_springs`) until a spring array is read.
+        The springs are kept per offset (`grid_springs`) until laid out.
         """
         shape = grid_shape(shape)
         spacing = check_positive("spacing", spacing, "Grid spacing is in m and must be > 0.")
@@ -447,7 +387,7 @@ class Body:
         k = _per_row("stiffness", stiffness, 1, f"Use k >= 0 in N/m, e.g. {GRID_EXAMPLE}.")
         c = _per_row("damping", damping, 1, "Use a dashpot c >= 0 in N·s/m, e.g. damping=0.1.")
         rest = spacing * np.sqrt((offsets**2).sum(axis=1))
-        body._keep_grid_springs(GridSprings(shape, offsets, rest, float(k), float(c)))
+        body._keep_grid(GridSprings(shape, offsets, rest, float(k[0]), float(c[0])))
         body.grid_shape = shape
         return body
 
@@ -455,13 +395,11 @@ class Body:
     def copy(self) -> Body:
         """An independent copy of the body (state and springs)."""
         body = Body(self.dim)
-        particles = {name: getattr(self, name) for name in FIELDS["particles"]}
-        body._append("particles", self.n_particles, **particles)
+        body.add_particles(self.positions, self.velocities, self.masses, self.fixed)
         if self.grid_springs is None:
-            springs = {name: getattr(self, name) for name in FIELDS["springs"]}
-            body._append("springs", self.n_springs, **springs)
+            body._keep_springs(*(getattr(self, name).copy() for name in SPRING_ARRAYS))
         else:
-            body._keep_grid_springs(self.grid_springs)
+            body._keep_grid(self.grid_springs)
         body.grid_shape = self.grid_shape
         return body
 
@@ -483,12 +421,12 @@ class Body:
 
     def incident_springs(self) -> tuple[np.ndarray, np.ndarray]:
         """CSR lists of the springs touching each particle: ``springs[start[i]:start[i+1]]``."""
-        if self._incidence is None or self._incidence[0] != self.topology_version:
+        if self._incidence is None or self._incidence[0] != self.version:
             ends = np.concatenate([self.spring_a, self.spring_b])
             start = np.zeros(self.n_particles + 1, dtype=np.int64)
             np.cumsum(np.bincount(ends, minlength=self.n_particles), out=start[1:])
             springs = np.argsort(ends, kind="stable") % max(self.n_springs, 1)
-            self._incidence = (self.topology_version, start, springs)
+            self._incidence = (self.version, start, springs)
         return self._incidence[1], self._incidence[2]
 
     def springs_touching(self, particles: np.ndarray) -> np.ndarray:
@@ -506,6 +444,16 @@ class Body:
         return f"<Body {kind}: {self.n_particles} particles, {self.n_springs} springs{grid}>"
 
 
+def _checked_value(name: str, values: object, count: int) -> np.ndarray:
+    """Spring value ``name`` for ``count`` springs, checked (rest lengths > 0, others >= 0)."""
+    label = {"rest_lengths": "rest length", "spring_damping": "damping"}.get(name, name)
+    return _per_row(label, values, count, VALUE_HINTS[name], zero=name != "rest_lengths")
+
+
+def _checked_values(count: int, k: object, rest: object, c: object) -> dict[str, np.ndarray]:
+    return {name: _checked_value(name, v, count) for name, v in zip(VALUE_HINTS, (k, rest, c))}
+
+
 def rotation_matrix(angle_degrees: float, axis: Sequence[float] | None = None) -> np.ndarray:
     """Right-handed rotation by ``angle_degrees``: 2×2 in 2-D (no axis), 3×3 about ``axis``."""
     angle = math.radians(angle_degrees)
@@ -519,27 +467,3 @@ def rotation_matrix(angle_degrees: float, axis: Sequence[float] | None = None) -
     x, y, z = axis / norm
     cross = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
     return c * np.eye(3) + s * cross + (1 - c) * np.outer([x, y, z], [x, y, z])
-
-
-class _Items(Sequence, Generic[Item]):
-    """``body.particles`` / ``body.springs``: objects bound to rows of the body's arrays."""
-
-    def __init__(self, body: Body, kind: type[Item], count: int) -> None:
-        self._body, self._kind, self._count = body, kind, count
-
-    def __len__(self) -> int:
-        return self._count
-
-    def __getitem__(self, index: int) -> Item:  # type: ignore[override]
-        if isinstance(index, slice):
-            return [self[i] for i in range(*index.indices(self._count))]  # type: ignore[return-value]
-        position = operator.index(index)
-        if not -self._count <= position < self._count:
-            raise IndexError(
-                f"{self._kind.__name__.lower()} {index} does not exist: the body has "
-                f"{self._count} (indices 0 to {self._count - 1})"
-            )
-        return self._kind.row(self._body, position % self._count)
-
-    def __iter__(self) -> Iterator[Item]:
-        return (self[i] for i in range(self._count))

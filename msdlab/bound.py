@@ -7,11 +7,11 @@ that row and its `Field` attributes read and write the body's arrays.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+import operator
+from collections.abc import Callable, Iterator, Sequence
+from typing import Any, Generic, TypeVar
 
-if TYPE_CHECKING:
-    from .body import Body
+Item = TypeVar("Item", bound="Bound")
 
 
 class Field:
@@ -47,26 +47,30 @@ class Field:
         if item.body is None:
             item._own[self.name] = value
         else:
-            getattr(item.body, self.array)[item.index] = value
+            item.write(self.array, value)
 
 
 class Bound:
     """Base of the objects whose `Field` attributes are bound to row ``index`` of ``body``."""
 
     def __init__(self) -> None:
-        self.body: Body | None = None
+        self.body: Any = None  # the `msdlab.Body` it is bound to
         self.index = -1  # row in the body; -1 while not in one
         self._own: dict[str, Any] = {}
 
     @classmethod
-    def row(cls, body: Body, index: int) -> Any:
+    def row(cls, body: Any, index: int) -> Any:
         """An object of this class reading and writing row ``index`` of ``body``."""
         item = cls.__new__(cls)
         Bound.__init__(item)
         item.bind(body, index)
         return item
 
-    def bind(self, body: Body, index: int) -> None:
+    def write(self, array: str, value: Any) -> None:
+        """Write ``value`` into row ``index`` of the body's ``array``."""
+        getattr(self.body, array)[self.index] = value
+
+    def bind(self, body: Any, index: int) -> None:
         """Read and write row ``index`` of ``body`` from now on (own values are dropped)."""
         if self.body is not None:
             kind = type(self).__name__
@@ -74,3 +78,27 @@ class Bound:
                 f"this {kind.lower()} already belongs to a body; make a new {kind} for each body"
             )
         self.body, self.index, self._own = body, int(index), {}
+
+
+class Rows(Sequence, Generic[Item]):
+    """``body.particles`` / ``body.springs``: objects bound to rows of the body's arrays."""
+
+    def __init__(self, body: Any, kind: type[Item], count: int) -> None:
+        self._body, self._kind, self._count = body, kind, count
+
+    def __len__(self) -> int:
+        return self._count
+
+    def __getitem__(self, index: int) -> Item:  # type: ignore[override]
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(self._count))]  # type: ignore[return-value]
+        position = operator.index(index)
+        if not -self._count <= position < self._count:
+            raise IndexError(
+                f"{self._kind.__name__.lower()} {index} does not exist: the body has "
+                f"{self._count} (indices 0 to {self._count - 1})"
+            )
+        return self._kind.row(self._body, position % self._count)
+
+    def __iter__(self) -> Iterator[Item]:
+        return (self[i] for i in range(self._count))

@@ -13,7 +13,8 @@ from . import equations
 from .body import Body
 from .forces import Force
 from .jacobian import JacobianPattern
-from .spring_kernel import SpringKernel, Update, make_kernel
+from .kernels import NumpyKernel
+from .spring_kernel import SpringKernel, Update, kernel_left_to_msdlab, make_kernel
 
 
 def keep_acceleration(
@@ -52,12 +53,15 @@ class Dynamics:
         self.body = body
         self.forces = list(forces)
         self.springs: SpringKernel = make_kernel(kernel)
+        self.chosen = self.springs
+        # the kernel of a step while a debugger traces the program (`Simulation.step`)
+        self.readable = NumpyKernel() if kernel_left_to_msdlab(kernel) else None
         self.max_stretch = 0.0  # largest |d|/l seen in the last force evaluation
         self._last_pass: SpringPass | None = None  # of the last force evaluation
         self._pattern: JacobianPattern | None = None
-        self._dashpots = ((-1, -1), True)  # (body versions, whether any spring has a dashpot)
+        self._dashpots = (-1, True)  # (body version, whether any spring has a dashpot)
         # `equations.damping_work` (J) for the ledger: the kernel's compiled sum, if it has one
-        self.damping_work = getattr(self.springs, "damping_work", equations.damping_work)
+        self.damping_work = getattr(self.chosen, "damping_work", equations.damping_work)
 
     @property
     def kernel(self) -> str:
@@ -154,9 +158,8 @@ class Dynamics:
         body = self.body
         if body.grid_springs is not None:  # one dashpot for all, without laying springs out
             return body.grid_springs.damping != 0.0
-        versions = (body.topology_version, body.parameters_version)
-        if self._dashpots[0] != versions:
-            self._dashpots = (versions, bool(body.spring_values[2].any()))
+        if self._dashpots[0] != body.version:
+            self._dashpots = (body.version, bool(body.spring_damping.any()))
         return self._dashpots[1]
 
     def acceleration_of(
@@ -215,7 +218,7 @@ class Dynamics:
 
     def _spring_jacobians(self, x: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """∂F/∂x and ∂F/∂v of the springs, on their pattern (rebuilt when they change)."""
-        if self._pattern is None or self._pattern.topology_version != self.body.topology_version:
+        if self._pattern is None or self._pattern.version != self.body.version:
             self._pattern = JacobianPattern(self.body)
         return self.springs.jacobians(self.body, x, self._pattern)
 

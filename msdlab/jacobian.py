@@ -30,7 +30,7 @@ class JacobianPattern:
         diagonal = np.arange(n_dof, dtype=np.int64)
         keys = np.concatenate([rows * n_dof + cols, diagonal * (n_dof + 1)])
         unique, inverse = np.unique(keys, return_inverse=True)
-        self.topology_version = body.topology_version
+        self.version = body.version
         self.shape = (n_dof, n_dof)
         index = np.int32 if len(unique) < 2**31 else np.int64  # what scipy would convert to
         self.indices = (unique % max(n_dof, 1)).astype(index)

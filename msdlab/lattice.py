@@ -119,6 +119,27 @@ class GridSprings:
         """Number of springs, Σ over offsets of Π max(0, n - |o|)."""
         return grid_pair_count(self.shape, self.offsets)
 
+    def with_values(
+        self,
+        stiffness: float | None = None,
+        rest_lengths: float | None = None,
+        spring_damping: float | None = None,
+    ) -> GridSprings:
+        """These springs with one new stiffness (N/m), rest length (m) or dashpot (N·s/m)
+        for all (None keeps a value)."""
+        rest = (
+            self.rest_lengths
+            if rest_lengths is None
+            else np.full_like(self.rest_lengths, rest_lengths)
+        )
+        return GridSprings(
+            self.shape,
+            self.offsets,
+            rest,
+            self.stiffness if stiffness is None else stiffness,
+            self.damping if spring_damping is None else spring_damping,
+        )
+
     def values(self) -> np.ndarray:
         """Stiffness (N/m), rest length (m) and dashpot (N·s/m) of each offset (3, M)."""
         uniform = np.ones(len(self.offsets))

@@ -65,6 +65,10 @@ class Spring(Bound):
         self.stiffness, self.damping = stiffness, damping
         self._own["rest_length"] = None if rest_length is None else _rest_length(rest_length)
 
+    def write(self, array: str, value: float) -> None:
+        """Set this spring's value ``array`` in its body (`Body.set_springs`)."""
+        self.body.set_springs([self.index], **{array: value})
+
     def _ends(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         if self.body is None:
             raise RuntimeError("add the spring to a body first: body.add_spring(spring)")

@@ -96,6 +96,12 @@ def default_kernel() -> str:
     return "numpy" if sys.gettrace() is not None else "numba"
 
 
+def kernel_left_to_msdlab(name: str | None) -> bool:
+    """Whether a simulation asked for no kernel (``kernel=None`` and no ``MSDLAB_KERNEL``):
+    then each step runs on the numpy kernel while a debugger traces the program."""
+    return name is None and not os.environ.get("MSDLAB_KERNEL", "").strip()
+
+
 def checked_kernel_name(name: str, what: str) -> str:
     """``name`` if it is a kernel's name, else a ValueError naming ``what`` and the choices."""
     if name not in KERNELS:

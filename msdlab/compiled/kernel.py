@@ -66,10 +66,9 @@ class NumbaKernel:
     offset (`grid_stencil`); other bodies go through the edge loop, over the
     springs sorted by their ends (`_edge_list`), with one force buffer per
     extra thread. What is kept is rebuilt when the springs change
-    (``body.topology_version``) and re-checked when their values are edited
-    (``body.parameters_version``, counted by the body's tracked arrays), so
-    edits count at once. ``springs`` (indices) restricts a computation to some
-    springs, on one thread, in the body's order. `finite` and `damping_work` run
+    (``body.version``, which every edit of the springs counts). ``springs``
+    (indices) restricts a computation to some springs, on one thread, in the
+    body's order. `finite` and `damping_work` run
     on the threads for a body big enough to share out.
     """
 
@@ -128,8 +127,7 @@ class NumbaKernel:
             self._no_partial = np.zeros((0, *x.shape))
         none = self._no_partial
         if springs is None:
-            versions = (body.topology_version, body.parameters_version)
-            if (self._stencil_version, self._values_version) != versions:
+            if (self._stencil_version, self._values_version) != (body.version,) * 2:
                 self.grid_stencil(body)
             stencil = self._stencil if self._uniform else None
             if stencil is not None:
@@ -163,12 +161,11 @@ class NumbaKernel:
     def grid_stencil(self, body: Body) -> GridStencil | None:
         """The body's grid stencil if its forces can be gathered by offset now, else None.
 
-        The stencil is found once per topology (``body.topology_version``); that
-        each of its blocks has one stiffness, rest length and dashpot is checked
-        again whenever the values are edited (``body.parameters_version``), so
-        edits of single springs switch to the edge loop at once.
+        The stencil is found, and that each of its blocks has one stiffness, rest
+        length and dashpot checked, whenever the springs change (``body.version``),
+        so edits of single springs switch to the edge loop at once.
         """
-        if self._stencil_version != body.topology_version:
+        if self._stencil_version != body.version:
             self._stencil = grid_stencil(body)
             blocks = 0 if self._stencil is None else len(self._stencil.offsets)
             if self._stencil is not None:
@@ -180,17 +177,17 @@ class NumbaKernel:
                 rows_of = np.where(members >= 0, o2s + reach, no_spring)
                 self._triples = (triples, members, o2s, rows_of)
             self._stencil_values = np.zeros((3, blocks))
-            self._stencil_version = body.topology_version
+            self._stencil_version = body.version
             self._values_version = -1
         if self._stencil is None:
             return None
-        if body.parameters_version != self._values_version:
+        if body.version != self._values_version:
             if body.grid_springs is not None:  # one value per offset by construction
                 self._stencil_values[...], self._uniform = body.grid_springs.values(), True
             else:
                 values, starts = body.spring_values, self._stencil.starts
                 self._uniform = uniform_blocks(*values, starts, self._stencil_values)
-            self._values_version = body.parameters_version
+            self._values_version = body.version
             if self._uniform:
                 self._triple_values = triple_values(self._stencil_values, self._triples[1])
         return self._stencil if self._uniform else None
@@ -318,7 +315,7 @@ class NumbaKernel:
         `SPRING_CLASSES` distinct values the loop reads them per spring: the
         body's arrays, or copies in the sorted order.
         """
-        if self._version != body.topology_version:
+        if self._version != body.version:
             index = np.uint32 if body.n_particles < 2**32 else np.uint64
             order = np.lexsort((body.spring_b, body.spring_a))
             self._order = None if np.array_equal(order, np.arange(len(order))) else order
@@ -326,12 +323,12 @@ class NumbaKernel:
             if self._order is not None:
                 ends = tuple(end[order] for end in ends)
             self._a, self._b = (end.astype(index) for end in ends)
-            self._version = body.topology_version
+            self._version = body.version
             self._classes_version = -1
         values = body.spring_values
-        if body.parameters_version != self._classes_version:
+        if body.version != self._classes_version:
             self._classes = self._classify(values)
-            self._classes_version = body.parameters_version
+            self._classes_version = body.version
         if self._classes[0] is None and self._order is None:
             return self._a, self._b, None, *values
         return self._a, self._b, *self._classes

@@ -196,7 +196,7 @@ def spring_list_mistakes(
     one_sided = one_sided_acceleration(positions, springs, rest, stiffness)
     length = np.linalg.norm(positions[springs[:, 0]] - positions[springs[:, 1]], axis=1)
     unnormalised = spring_body(positions, springs, rest, 1.0)
-    unnormalised.stiffness[:] = stiffness * np.maximum(length, 1e-300)  # k|d| (l - |d|) d̂
+    unnormalised.stiffness = stiffness * np.maximum(length, 1e-300)  # k|d| (l - |d|) d̂
     count = np.bincount(springs.ravel(), minlength=len(positions)).astype(float)
     mistakes = {}
     constant = task_constant(task, "STIFFNESS")

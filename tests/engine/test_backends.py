@@ -42,7 +42,7 @@ def cloth(n: int = 9, spacing: float = 0.05) -> msd.Body:
     body = msd.Body.from_arrays(
         positions, np.vstack(pairs), masses=0.01, fixed=fixed, stiffness=np.concatenate(stiffness)
     )
-    body.spring_damping[:] = 0.02
+    body.spring_damping = 0.02
     return shaken(body, seed=1)
 
 
@@ -74,8 +74,8 @@ def damped(dim: int) -> msd.Body:
     """A grid whose springs each have their own stiffness and dashpot (some none)."""
     body = grid(dim)
     rng = np.random.default_rng(4)
-    body.stiffness[:] = rng.uniform(10.0, 50.0, body.n_springs)
-    body.spring_damping[:] = np.where(rng.random(body.n_springs) < 0.5, 0.3, 0.0)
+    body.stiffness = rng.uniform(10.0, 50.0, body.n_springs)
+    body.spring_damping = np.where(rng.random(body.n_springs) < 0.5, 0.3, 0.0)
     body.fixed[[0, 3]] = True
     body.velocities[[0, 3]] = 0.0
     return body

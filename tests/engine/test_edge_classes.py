@@ -58,7 +58,7 @@ def assert_close_to_numpy(body: msd.Body, kernel: NumbaKernel, springs=None) -> 
 
 def test_class_table_holds_each_springs_values() -> None:
     body = shuffled_body()
-    body.spring_damping[::4] = 0.3
+    body.set_springs(slice(None, None, 4), spring_damping=0.3)
     a, _, kinds, k, rest, c = NumbaKernel()._edge_list(body)
     assert kinds.dtype == np.uint8 and len(k) == 6  # 3 rest lengths, with and without dashpot
     assert np.all(np.diff(a.astype(np.int64)) >= 0)  # sorted by the first end
@@ -76,7 +76,7 @@ def test_wide_classes_and_no_classes_give_the_same_sums(
     if threaded:
         monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
     body = shuffled_body(1)
-    body.stiffness[:] = np.random.default_rng(1).integers(1, 301, body.n_springs) * 0.5
+    body.stiffness = np.random.default_rng(1).integers(1, 301, body.n_springs) * 0.5
     wide = NumbaKernel()
     assert wide._edge_list(body)[2].dtype == np.uint16
     assert_close_to_numpy(body, wide)
@@ -103,14 +103,13 @@ def test_past_the_limit_in_the_bodys_order(monkeypatch: pytest.MonkeyPatch) -> N
     kernel = NumbaKernel()
     _, _, kinds, k, _, _ = kernel._edge_list(body)
     assert kinds is None and np.shares_memory(k, body.spring_values[0])
-    held = body.stiffness
-    held[4] = 7.0  # seen without copying
+    body.set_springs([4], stiffness=7.0)
     assert_close_to_numpy(body, kernel)
 
 
-def test_reading_the_values_keeps_the_classes_and_writing_counts() -> None:
-    """Reading a spring array, or holding it, is no edit: the classes are kept. Writing
-    through it, in place or with numpy, counts at once (the body's tracked arrays)."""
+def test_reading_the_values_keeps_the_classes_and_editing_counts() -> None:
+    """Reading a spring array, or holding it, is no edit: the classes are kept. The arrays
+    are read-only; an edit goes through `Body.set_springs` (or a whole array) and counts."""
     body = sorted_body()
     kernel = NumbaKernel()
     classed = forces_by(kernel, body)
@@ -118,40 +117,40 @@ def test_reading_the_values_keeps_the_classes_and_writing_counts() -> None:
     held = body.rest_lengths
     assert kernel._edge_list(body)[2] is kinds
     assert_same(forces_by(kernel, body), classed)
+    with pytest.raises(ValueError, match="read-only"):
+        held[6] = 1.0
     for edit in (
-        lambda: held.__setitem__(6, held[6] * 1.1),
-        lambda: held.__imul__(1.01),
-        lambda: np.copyto(body.stiffness[3:5], 7.0),
-        lambda: np.multiply(body.spring_damping, 0.0, out=body.spring_damping),
+        lambda: body.set_springs([6], rest_lengths=held[6] * 1.1),
+        lambda: body.set_springs(rest_lengths=body.rest_lengths * 1.01),
+        lambda: body.set_springs(slice(3, 5), stiffness=7.0),
+        lambda: setattr(body, "spring_damping", 0.0),
     ):
-        version = body.parameters_version
+        version = body.version
         edit()
-        assert body.parameters_version > version
+        assert body.version == version + 1
         assert kernel._edge_list(body)[2] is not kinds
         kinds = kernel._edge_list(body)[2]
         assert_close_to_numpy(body, kernel)
-    version = body.parameters_version
-    _ = body.stiffness * 2.0, held.sum(), body.spring_values[0][3]
-    _ = np.unique(body.stiffness), np.sort(held), body.rest_lengths.copy().sort()  # copies
-    assert body.parameters_version == version
+    version = body.version
+    _ = body.stiffness * 2.0, held.sum(), body.spring_values[0][3], np.unique(body.stiffness)
+    assert body.version == version
 
 
 @pytest.mark.parametrize("threaded", [False, True])
-def test_held_view_edited_between_steps(threaded: bool, monkeypatch: pytest.MonkeyPatch) -> None:
-    """A view of the values kept by the user and written between steps counts at the next step,
-    on the classes and past their limit, as if the body had been built with the new values."""
+def test_springs_edited_between_steps(threaded: bool, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Springs edited between steps count at the next step, on the classes and past their
+    limit, as if the body had been built with the new values."""
     if threaded:
         monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
     for limit in (65_536, 4):
         monkeypatch.setattr("msdlab.compiled.kernel.SPRING_CLASSES", limit)
         body = shuffled_body(2)
         sim = msd.Simulation(body, msd.Verlet(0.01), dt=1e-3, kernel="numba")
-        held, rest, damping = body.stiffness, body.rest_lengths, body.spring_damping
         for step in range(3):
             sim.step()
-            held[step] = 90.0 + step  # a new class
-            rest[5 * step] *= 1.25
-            damping[7 * step] = 0.2
+            body.set_springs([step], stiffness=90.0 + step)  # a new class
+            body.set_springs([5 * step], rest_lengths=body.rest_lengths[5 * step] * 1.25)
+            body.set_springs([7 * step], spring_damping=0.2)
             fresh = NumbaKernel()
             assert_same(forces_by(sim.dynamics.springs, body), forces_by(fresh, body))
             assert_close_to_numpy(body, sim.dynamics.springs)
@@ -161,7 +160,7 @@ def test_held_view_edited_between_steps(threaded: bool, monkeypatch: pytest.Monk
 
 def test_springs_subset_in_the_bodys_order() -> None:
     body = shuffled_body(4)
-    body.spring_damping[::3] = 0.4
+    body.set_springs(slice(None, None, 3), spring_damping=0.4)
     kernel = NumbaKernel()
     forces_by(kernel, body)  # the sorted list and classes are built, and must not be used
     touching = body.springs_touching(np.array([3, 8, 40]))

@@ -59,7 +59,7 @@ def test_gravity_in_the_update_loop_is_gravity_as_a_force(integrator, kernel):
         body, contact = ball_over_net()
         body.masses[:] = np.linspace(0.5, 2.0, len(body))
         body.fixed[[0, 3]] = True
-        body.spring_damping[:] = 0.3
+        body.spring_damping = 0.3
         sim = msd.Simulation(body, integrator(), dt=1e-3, forces=[contact, gravity, msd.Ground()])
         sim.run(steps=300)
         runs.append((body.positions.copy(), body.velocities.copy()))

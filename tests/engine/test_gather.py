@@ -146,7 +146,7 @@ def test_edited_spring_values_switch_to_the_edge_loop(how: str) -> None:
     assert kernel.grid_stencil(body) is not None
     held = body.stiffness
     if how == "array":
-        body.stiffness[17] = 90.0
+        body.set_springs([17], stiffness=90.0)
     elif how == "held view":
         held[17] = 90.0
     else:
@@ -155,7 +155,7 @@ def test_edited_spring_values_switch_to_the_edge_loop(how: str) -> None:
     assert_agree(body, kernel)  # the edit counts at once
     held[17] = 40.0
     assert kernel.grid_stencil(body) is not None
-    body.spring_damping[:] = 0.5  # uniform again: gathered, dashpots included
+    body.spring_damping = 0.5  # uniform again: gathered, dashpots included
     assert kernel.grid_stencil(body) is not None
     assert_agree(body, kernel)
 
@@ -201,14 +201,14 @@ def test_shuffled_springs_sorted_for_the_edge_loop(
     body = msd.Body.from_arrays(
         grid.positions, pairs, velocities=grid.velocities, stiffness=grid.stiffness[order]
     )
-    body.spring_damping[::3] = 0.4
+    body.set_springs(slice(None, None, 3), spring_damping=0.4)
     kernel = NumbaKernel()
     assert kernel.grid_stencil(body) is None
     assert_agree(body, kernel)
     held = body.stiffness
     held[5] = 123.0  # through a kept view
     assert_agree(body, kernel)
-    body.rest_lengths[7] *= 1.5
+    body.set_springs([7], rest_lengths=body.rest_lengths[7] * 1.5)
     assert_agree(body, kernel)
     touching = body.springs_touching(np.array([3, 8]))
     assert kernel.elastic_energy(body, body.positions, touching) == pytest.approx(

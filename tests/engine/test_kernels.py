@@ -22,9 +22,9 @@ def deformed_body(dim: int, seed: int = 0) -> msd.Body:
     body = msd.Body.grid(shape, spacing=0.1, stiffness=30.0, neighbours=neighbours)
     body.positions[:] += rng.normal(scale=0.02, size=body.positions.shape)
     body.velocities[:] = rng.normal(size=body.positions.shape)
-    body.stiffness[:] = rng.uniform(10.0, 50.0, body.n_springs)
+    body.stiffness = rng.uniform(10.0, 50.0, body.n_springs)
     body.masses[:] = rng.uniform(0.5, 2.0, len(body))
-    body.spring_damping[:] = np.where(rng.random(body.n_springs) < 0.5, 0.3, 0.0)
+    body.spring_damping = np.where(rng.random(body.n_springs) < 0.5, 0.3, 0.0)
     body.fixed[[0, 3]] = True
     return body
 
@@ -156,7 +156,7 @@ def test_kernel_follows_topology_and_parameter_changes() -> None:
     dynamics = Dynamics(body)
     x, v = body.positions, body.velocities
     dynamics.force(x, v)
-    body.stiffness[:] *= 2.0  # edits of parameters count at once
+    body.stiffness = body.stiffness * 2.0  # edits of parameters count at once
     body.add_springs([[0, len(body) - 1]])  # and new springs
     x, v = body.positions, body.velocities
     expected, _, _ = per_spring(body)

@@ -13,7 +13,7 @@ from msdlab.dynamics import Dynamics
 
 def grid() -> msd.Body:
     body = msd.Body.grid((4, 3, 3), spacing=0.1, stiffness=40.0, neighbours=(1, 2, 3))
-    body.spring_damping[::2] = 0.2
+    body.set_springs(slice(None, None, 2), spring_damping=0.2)
     body.velocities[:] = np.random.default_rng(0).normal(size=body.positions.shape)
     body.fixed[0] = True
     return body

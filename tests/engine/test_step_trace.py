@@ -5,6 +5,8 @@ that summed their forces."""
 
 from __future__ import annotations
 
+import os
+import subprocess
 import sys
 from pathlib import Path
 
@@ -90,3 +92,67 @@ def test_the_ledger_books_the_dashpots_from_the_pass_over_the_springs(kernel: st
     expected = sim.dynamics.springs.spring_forces(body, x, v, np.zeros_like(x)).power * sim.dt
     assert sim.dissipated["dashpot"] - before == pytest.approx(expected, rel=1e-12)
     assert expected > 0.0
+
+
+PDB_SCRIPT = """
+import msdlab as msd
+cube = msd.Body.grid((4, 4, 4), spacing=0.1, stiffness=500.0, neighbours=(1, 2))
+sim = msd.Simulation(cube, msd.Verlet(0.01), dt=1e-3, forces=[msd.Gravity((0, -9.81, 0))])
+sim.step()
+print("kernel before:", sim.dynamics.kernel)
+breakpoint()
+sim.step()
+"""
+
+
+def test_a_breakpoint_set_after_building_stops_in_spring_force(tmp_path: Path) -> None:
+    """``breakpoint()`` after the simulation is built and has stepped on the compiled
+    kernel: a breakpoint set there in `equations.spring_force` stops at the next step."""
+    script = tmp_path / "debug_me.py"
+    script.write_text(PDB_SCRIPT)
+    commands = (
+        "import msdlab.equations\nbreak msdlab.equations.spring_force\ncontinue\nwhere\nquit\n"
+    )
+    env = {key: value for key, value in os.environ.items() if key != "MSDLAB_KERNEL"}
+    env["PYTHONBREAKPOINT"] = "pdb.set_trace"
+    done = subprocess.run(
+        [sys.executable, str(script)],
+        input=commands,
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=600,
+    )
+    assert "kernel before: numba" in done.stdout, done.stdout + done.stderr
+    stop = done.stdout.split("kernel before: numba", 1)[1]
+    assert "equations.py" in stop and "spring_force()" in stop, done.stdout
+    assert "simulation.py" in stop  # the stop is inside sim.step()
+
+
+def test_a_step_traced_after_building_runs_the_readable_equations(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """While a trace function is set (what a debugger does), a simulation that asked for no
+    kernel steps on the numpy kernel; untraced again, on the one it chose."""
+    monkeypatch.delenv("MSDLAB_KERNEL")
+    cube = msd.Body.grid((4, 4, 4), spacing=0.1, stiffness=500.0, neighbours=(1, 2))
+    sim = msd.Simulation(cube, msd.Verlet(0.01), dt=1e-3, forces=[msd.Gravity((0, -9.81, 0))])
+    chosen = sim.dynamics.kernel
+    called: set[str] = set()
+
+    def tracer(frame, event: str, argument: object) -> None:
+        if event == "call":
+            called.add(f"{Path(frame.f_code.co_filename).name}:{frame.f_code.co_name}")
+
+    pinned = msd.Simulation(cube.copy(), msd.Verlet(0.01), dt=1e-3, kernel="numba")
+    sys.settrace(tracer)
+    try:
+        sim.step()
+        pinned.step()
+    finally:
+        sys.settrace(None)
+    assert sim.dynamics.kernel == "numpy"
+    assert "equations.py:spring_force" in called and "integrators.py:update" in called
+    assert pinned.dynamics.kernel == "numba"  # asked for: kept under a debugger
+    sim.step()
+    assert sim.dynamics.kernel == chosen
