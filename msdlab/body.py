@@ -296,8 +296,8 @@ class Body:
         grid = self.grid_springs
         if grid is None:
             return
-        blocks = list(grid_pair_blocks(grid.shape, grid.offsets))
-        pairs, counts = np.concatenate(blocks), [len(block) for block in blocks]
+        blocks = [np.zeros((0, 2), np.int64), *grid_pair_blocks(grid.shape, grid.offsets)]
+        pairs, counts = np.concatenate(blocks), [len(block) for block in blocks[1:]]
         self._keep_springs(
             pairs[:, 0].copy(),
             pairs[:, 1].copy(),
