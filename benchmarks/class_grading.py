@@ -26,7 +26,7 @@ import time
 from pathlib import Path
 
 from msdlab.course import PROJECT_ROOT
-from msdlab.instructor import processes
+from msdlab.instructor.judging import processes
 
 ENDLESS = "\ndef particle_count(n: int = N) -> int:\n    while True:\n        pass\n"
 POLL_SECONDS = 0.1

@@ -3,7 +3,7 @@
 The checks compare a submission with references that do not depend on it (the
 engine's run of the same experiment, a predicted stable dt). `cached` keeps such
 a number or array in the folder named by ``$MSDLAB_REFERENCE_CACHE``, which
-`msdlab.instructor.grading.grade_all` creates for one run (readable only by the
+`msdlab.instructor.judging.grading.grade_all` creates for one run (readable only by the
 grader, not by the sandboxed submissions); the next submission's judge reads it
 back bit for bit. Without the variable (``msdlab check``, ``pytest --impl``,
 ``msdlab validate``) the function simply runs.

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from msdlab.instructor.sandbox import RemoteImplementation
+from msdlab.instructor.judging.sandbox import RemoteImplementation
 
 
 @pytest.fixture(scope="module")

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from msdlab.instructor.sandbox import ArgumentChanged, RemoteImplementation
+from msdlab.instructor.judging.sandbox import ArgumentChanged, RemoteImplementation
 
 MUTATING = """
 import numpy as np

@@ -16,11 +16,11 @@ import pytest
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
 from msdlab.course.report import MISTAKE_SENTENCE, CheckReport, CheckResult
-from msdlab.instructor import class_report
-from msdlab.instructor.class_report import CheckOutcome, ClassRow
-from msdlab.instructor.gradebook import Gradebook
-from msdlab.instructor.grading import Grade
 from msdlab.instructor.intake import Entry
+from msdlab.instructor.judging.grading import Grade
+from msdlab.instructor.outputs import class_report
+from msdlab.instructor.outputs.class_report import CheckOutcome, ClassRow
+from msdlab.instructor.points.gradebook import Gradebook
 
 SIGN = "the springs push where they should pull"
 LAYER = "counting one layer (n²)"

@@ -10,7 +10,10 @@ import pytest
 
 from msdlab.course import PROJECT_ROOT, own_numbers
 from msdlab.course.report import CheckReport
-from msdlab.instructor import copied_numbers, feedback, grading, templates
+from msdlab.instructor import templates
+from msdlab.instructor.intake import copied_numbers
+from msdlab.instructor.judging import grading
+from msdlab.instructor.outputs import feedback
 
 ROSTER = ("alice", "bob", "carol", "dave", "erin", "frank")
 

@@ -10,8 +10,10 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from msdlab.cli import main
-from msdlab.instructor import csv_files, gradebook, intake, similarity
-from msdlab.instructor.grading import Grade
+from msdlab.instructor import intake
+from msdlab.instructor.judging.grading import Grade
+from msdlab.instructor.outputs import csv_files, similarity
+from msdlab.instructor.points import gradebook
 
 HOSTILE_IDS = ["'=x", "'bob", "''", "=HYPERLINK(\"http://x\",\"y\")", "@SUM(1)", "+1", "-x",
                "\tx", "\uff1dcmd", "'", "plain"]  # fmt: skip

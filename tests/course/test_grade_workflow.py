@@ -26,9 +26,11 @@ import pytest
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT, reference_cache
 from msdlab.course.report import CheckReport, CheckResult
-from msdlab.instructor import csv_files, feedback, gradebook, gradebook_db, intake, render
-from msdlab.instructor.final_points import Terms
-from msdlab.instructor.grading import Grade
+from msdlab.instructor import intake
+from msdlab.instructor.judging.grading import Grade
+from msdlab.instructor.outputs import csv_files, feedback, render
+from msdlab.instructor.points import gradebook, gradebook_db
+from msdlab.instructor.rules.final_points import Terms
 
 SOLUTIONS = PROJECT_ROOT / "solutions"
 CHECKS = PROJECT_ROOT / "tests" / "tasks"

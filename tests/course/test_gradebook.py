@@ -15,8 +15,10 @@ import pytest
 
 from msdlab.cli import main
 from msdlab.course.report import CheckReport, CheckResult
-from msdlab.instructor import csv_files, gradebook, gradebook_db, grading, render
-from msdlab.instructor.final_points import Terms
+from msdlab.instructor.judging import grading
+from msdlab.instructor.outputs import csv_files, render
+from msdlab.instructor.points import gradebook, gradebook_db
+from msdlab.instructor.rules.final_points import Terms
 
 CHECKS = [
     CheckResult(
@@ -134,7 +136,7 @@ def test_two_runs_writing_one_gradebook_lose_no_row(tmp_path):
 
 HOLD = textwrap.dedent("""
     import sys
-    from msdlab.instructor import grading
+    from msdlab.instructor.judging import grading
     with grading.reserved_uids(1) as uids:
         print(uids[0], flush=True)
         sys.stdin.read()

@@ -15,8 +15,9 @@ import pytest
 
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
-from msdlab.instructor import gradebook_db, grading, sandbox
-from msdlab.instructor.judges import ForkedJudges
+from msdlab.instructor.judging import grading, sandbox
+from msdlab.instructor.judging.judges import ForkedJudges
+from msdlab.instructor.points import gradebook_db
 
 SOLUTIONS = PROJECT_ROOT / "solutions"
 CHECKS = PROJECT_ROOT / "tests" / "tasks"

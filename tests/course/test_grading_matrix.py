@@ -26,8 +26,8 @@ import pytest
 
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT, TASKS, own_numbers
-from msdlab.instructor import sandbox
-from msdlab.instructor.gradescope import METADATA, ROOT_VARIABLE
+from msdlab.instructor.judging import sandbox
+from msdlab.instructor.judging.gradescope import METADATA, ROOT_VARIABLE
 
 MODES = ("namespace", "process")
 FORMS = ("folder", "zip", "git", "gradescope")

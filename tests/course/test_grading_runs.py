@@ -19,7 +19,8 @@ import pytest
 
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
-from msdlab.instructor import gradebook_db, processes, sandbox
+from msdlab.instructor.judging import processes, sandbox
+from msdlab.instructor.points import gradebook_db
 
 SOLUTIONS = PROJECT_ROOT / "solutions"
 TEMPLATE = PROJECT_ROOT / "assignments"

@@ -20,7 +20,7 @@ import pytest
 
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
-from msdlab.instructor import sandbox, sandbox_child
+from msdlab.instructor.judging import sandbox, sandbox_child
 
 CHECKS = PROJECT_ROOT / "tests" / "tasks"
 MARKER = "msdlab-hostile-helper"
@@ -174,7 +174,7 @@ def test_a_python_environment_under_tmp_stays_visible_in_the_sandbox(tmp_path):
         )
         sites = [str(PROJECT_ROOT), *sys.path[1:]]
         code = (
-            f"import sys; sys.path[:0] = {sites!r}; from msdlab.instructor import sandbox; "
+            f"import sys; sys.path[:0] = {sites!r}; from msdlab.instructor.judging import sandbox; "
             "print(sandbox.isolation_problem())"
         )
         result = subprocess.run(

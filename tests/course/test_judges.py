@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from msdlab.course import runner
-from msdlab.instructor.judges import ForkedJudges
+from msdlab.instructor.judging.judges import ForkedJudges
 
 CHECKS = """
 import os

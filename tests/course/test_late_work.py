@@ -11,10 +11,17 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from msdlab.cli import main
-from msdlab.instructor import gradebook, intake
-from msdlab.instructor.grading import Grade
-from msdlab.instructor.late import LatePolicy, format_points, parse_due, read_extensions, time_zone
-from msdlab.instructor.problems import InstructorFileError
+from msdlab.instructor import intake
+from msdlab.instructor.judging.grading import Grade
+from msdlab.instructor.points import gradebook
+from msdlab.instructor.rules.late import (
+    LatePolicy,
+    format_points,
+    parse_due,
+    read_extensions,
+    time_zone,
+)
+from msdlab.instructor.rules.problems import InstructorFileError
 
 POLICY = LatePolicy.parse("grace=15m,penalty=10%/day,cap=50%,cutoff=7d")
 points = st.fractions(min_value=0, max_value=100, max_denominator=4)

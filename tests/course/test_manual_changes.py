@@ -14,10 +14,10 @@ from hypothesis import strategies as st
 
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
-from msdlab.instructor import adjustments, final_points
-from msdlab.instructor.final_points import Terms
 from msdlab.instructor.intake import HandIn
-from msdlab.instructor.late import LatePolicy
+from msdlab.instructor.rules import adjustments, final_points
+from msdlab.instructor.rules.final_points import Terms
+from msdlab.instructor.rules.late import LatePolicy
 
 DUE = datetime(2027, 3, 1, 23, 59, tzinfo=timezone.utc)
 NUMBERS = ("points", "late_penalty", "adjustment", "total")

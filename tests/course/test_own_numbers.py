@@ -18,7 +18,8 @@ from modules import module_at
 
 from msdlab.course import PROJECT_ROOT, oracles, own_numbers
 from msdlab.course.report import CheckReport
-from msdlab.instructor import grading, release, templates
+from msdlab.instructor import release, templates
+from msdlab.instructor.judging import grading
 
 CHECKS = PROJECT_ROOT / "tests" / "tasks"
 TEMPLATE_1 = (PROJECT_ROOT / "assignments" / "task1.py").read_text(encoding="utf-8")

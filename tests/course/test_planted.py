@@ -23,7 +23,8 @@ from modules import module_at
 
 from msdlab.course import PROJECT_ROOT, TASKS, delegation
 from msdlab.course.report import CheckReport
-from msdlab.instructor import grading, trivial, validate
+from msdlab.instructor import trivial, validate
+from msdlab.instructor.judging import grading
 
 CHECKS = PROJECT_ROOT / "tests" / "tasks"
 SOLUTIONS = PROJECT_ROOT / "solutions"

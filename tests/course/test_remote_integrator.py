@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab.instructor.sandbox import RemoteImplementation
+from msdlab.instructor.judging.sandbox import RemoteImplementation
 
 INTEGRATORS = """
 import msdlab as msd

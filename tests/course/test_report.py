@@ -6,8 +6,8 @@ from __future__ import annotations
 import re
 
 from msdlab.course.report import MISTAKE_SENTENCE, CheckReport, CheckResult
-from msdlab.instructor import feedback
-from msdlab.instructor.grading import Grade
+from msdlab.instructor.judging.grading import Grade
+from msdlab.instructor.outputs import feedback
 
 LAMBDA_IGNORED = "λ is ignored: this is eq. (1.3)"
 

@@ -20,9 +20,9 @@ from modules import module_at
 
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT, TASKS
-from msdlab.instructor.csv_files import restored
-from msdlab.instructor.grading import MAX_FILE_BYTES
-from msdlab.instructor.similarity_report import IN_FULL, TABLE_ROWS
+from msdlab.instructor.judging.grading import MAX_FILE_BYTES
+from msdlab.instructor.outputs.csv_files import restored
+from msdlab.instructor.outputs.similarity_report import IN_FULL, TABLE_ROWS
 
 
 def _copies():

@@ -8,7 +8,7 @@ import threading
 import numpy as np
 import pytest
 
-from msdlab.instructor import wire
+from msdlab.instructor.judging import wire
 
 
 def test_a_reader_returns_each_message_whole_however_its_bytes_arrive():

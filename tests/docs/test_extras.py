@@ -20,7 +20,8 @@ import pytest
 from packaging.requirements import Requirement
 from packaging.utils import canonicalize_name
 
-from msdlab.instructor import gradescope, release
+from msdlab.instructor import release
+from msdlab.instructor.judging import gradescope
 
 tomllib = pytest.importorskip("tomllib", reason="reads pyproject.toml with Python 3.11's tomllib")
 
@@ -130,7 +131,7 @@ def test_the_grade_extra_holds_what_the_checks_import():
     and every module the course's checks import."""
     checks = ROOT / "tests" / "tasks"
     local = {path.stem for path in checks.glob("*.py")}
-    modules = ["msdlab.course.pytest_plugin", "msdlab.instructor.pytest_sandbox"]
+    modules = ["msdlab.course.pytest_plugin", "msdlab.instructor.judging.pytest_sandbox"]
     for path in sorted(checks.glob("*.py")):
         modules += sorted(top_level_imports(path) - set(sys.stdlib_module_names) - local)
     error = import_error(modules, required_closure(extra_requirements("grade")))

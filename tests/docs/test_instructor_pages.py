@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 from msdlab.cli import build_parser
-from msdlab.instructor import gradescope, intake
+from msdlab.instructor import intake
+from msdlab.instructor.judging import gradescope
 
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"

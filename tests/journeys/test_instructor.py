@@ -15,7 +15,7 @@ import pytest
 from browser import CHROMIUM, jupyterlab_server, launch, run_notebook, wait_until
 
 from msdlab.course import PROJECT_ROOT
-from msdlab.instructor import sandbox
+from msdlab.instructor.judging import sandbox
 
 NO_EQUAL_AND_OPPOSITE = ("a[second] -= f", "a[second] += f")  # task 2: j feels no force
 # grading as it normally runs: each submission in its bubblewrap sandbox, where there is one

@@ -15,7 +15,7 @@ from pathlib import Path
 from modules import module_at
 
 from msdlab.course import PROJECT_ROOT
-from msdlab.instructor import sandbox
+from msdlab.instructor.judging import sandbox
 
 SOLUTIONS = PROJECT_ROOT / "solutions"
 CHECKS = PROJECT_ROOT / "tests" / "tasks"

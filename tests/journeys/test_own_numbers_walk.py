@@ -24,8 +24,9 @@ import pytest
 from harness import ROOT, Session, quick_start
 
 from msdlab.course import own_numbers
-from msdlab.instructor import sandbox, templates
-from msdlab.instructor.gradescope import METADATA, ROOT_VARIABLE
+from msdlab.instructor import templates
+from msdlab.instructor.judging import sandbox
+from msdlab.instructor.judging.gradescope import METADATA, ROOT_VARIABLE
 
 pytestmark = [
     pytest.mark.timeout(1800),

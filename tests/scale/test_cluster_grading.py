@@ -16,8 +16,9 @@ import pytest
 
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT, own_numbers
-from msdlab.instructor import grading, intake
-from msdlab.instructor.cluster_grading import grade_all_on_cluster
+from msdlab.instructor import intake
+from msdlab.instructor.judging import grading
+from msdlab.instructor.judging.cluster_grading import grade_all_on_cluster
 
 Client = pytest.importorskip(
     "dask.distributed", reason="needs the extra: pip install -e '.[cluster]'"

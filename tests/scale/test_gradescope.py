@@ -17,7 +17,7 @@ import pytest
 
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT, own_numbers
-from msdlab.instructor.gradescope import METADATA, ROOT_VARIABLE
+from msdlab.instructor.judging.gradescope import METADATA, ROOT_VARIABLE
 
 HOSTILE = """
 import os, sys

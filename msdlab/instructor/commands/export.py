@@ -13,7 +13,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .. import export
+from ..outputs import export
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

@@ -50,22 +50,13 @@ from tqdm.auto import tqdm
 
 from ...analysis.cluster import parse_cluster
 from ...course import PROJECT_ROOT, TASKS, own_numbers
-from .. import (
-    adjustments,
-    class_report,
-    copied_numbers,
-    feedback,
-    final_points,
-    gradebook,
-    gradebook_db,
-    grading,
-    intake,
-    problems,
-    render,
-    sandbox,
-    term_options,
-)
-from ..cluster_grading import grade_all_on_cluster
+from .. import intake
+from ..intake import copied_numbers
+from ..judging import grading, sandbox
+from ..judging.cluster_grading import grade_all_on_cluster
+from ..outputs import class_report, feedback, render
+from ..points import gradebook, gradebook_db
+from ..rules import adjustments, final_points, problems, term_options
 from . import similarity
 
 

@@ -21,7 +21,7 @@ import argparse
 from pathlib import Path
 
 from ...course import PROJECT_ROOT, own_numbers
-from ..gradescope import HIDDEN_VISIBILITIES, ROSTER_IDS, Settings, build
+from ..judging.gradescope import HIDDEN_VISIBILITIES, ROSTER_IDS, Settings, build
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

@@ -23,7 +23,7 @@ from ...course import PROJECT_ROOT
 from .. import intake
 
 if TYPE_CHECKING:  # copydetect, which similarity imports, is optional
-    from ..similarity import Pair
+    from ..outputs.similarity import Pair
 
 TEMPLATES = PROJECT_ROOT / "assignments"
 THRESHOLD = 0.5  # similarity from which a pair is flagged, by default
@@ -105,7 +105,7 @@ def write_report(
         raise ValueError(f"--threshold is a similarity between 0 and 1, got {threshold}")
     if not template.is_dir():
         raise FileNotFoundError(f"no template folder at {template}; give --template DIR")
-    from .. import similarity, similarity_report
+    from ..outputs import similarity, similarity_report
 
     texts, left_out = {}, list(left_out_before or [])
     for student, folder in folders.items():

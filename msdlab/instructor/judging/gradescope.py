@@ -2,7 +2,7 @@
 
 `build` writes the zip: ``setup.sh`` installs msdlab from the zip itself with its
 ``grade`` extra (what the checks import) from the package index; ``run_autograder`` runs
-``python3 -m msdlab.instructor.gradescope``, which grades the student's task
+``python3 -m msdlab.instructor.judging.gradescope``, which grades the student's task
 files (at the top of ``/autograder/submission`` or in its ``assignments/``, taken in by `intake`)
 with the instructor's checks, hidden ones included, by the same `grading.grade`
 as ``msdlab grade``, and writes ``/autograder/results/results.json`` in
@@ -35,9 +35,10 @@ from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from ..course import own_numbers
-from ..course.report import CheckResult
-from . import grading, intake
+from ...course import own_numbers
+from ...course.report import CheckResult
+from .. import intake
+from . import grading
 
 CONFIG = "msdlab-autograder.json"
 HIDDEN_VISIBILITIES = ("after_published", "hidden")
@@ -61,7 +62,8 @@ PACKAGES=("./msdlab[{GRADE_EXTRA}]")
 RUN_AUTOGRADER = f"""\
 #!/usr/bin/env bash
 # Gradescope runs this for each submission: grade it into results/results.json.
-exec "${{PYTHON:-python3}}" -m msdlab.instructor.gradescope "${{{ROOT_VARIABLE}:-/autograder}}"
+exec "${{PYTHON:-python3}}" -m msdlab.instructor.judging.gradescope \\
+  "${{{ROOT_VARIABLE}:-/autograder}}"
 """
 
 
@@ -197,8 +199,8 @@ def roster_id(metadata: Path, field: str) -> str | None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m msdlab.instructor.gradescope [ROOT]``, what ``run_autograder`` calls."""
-    parser = argparse.ArgumentParser(prog="python -m msdlab.instructor.gradescope")
+    """``python -m msdlab.instructor.judging.gradescope [ROOT]``, what ``run_autograder`` calls."""
+    parser = argparse.ArgumentParser(prog="python -m msdlab.instructor.judging.gradescope")
     parser.add_argument("root", type=Path, nargs="?", default=Path("/autograder"))
     content = run_autograder(parser.parse_args(argv).root)
     print(content["output"])

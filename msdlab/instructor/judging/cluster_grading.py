@@ -15,7 +15,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from ..analysis import cluster
+from ...analysis import cluster
 from . import grading
 
 

@@ -30,9 +30,9 @@ import numpy as np
 from copydetect import CodeFingerprint, compare_files
 from copydetect.utils import find_fingerprint_overlap, get_copied_slices
 
-from ..course import TASKS
+from ...course import TASKS
+from ..judging.grading import MAX_FILE_BYTES
 from . import csv_files
-from .grading import MAX_FILE_BYTES
 
 NOISE = 25
 """Shortest run of reduced code (characters) that counts as a match (copydetect's noise_t)."""

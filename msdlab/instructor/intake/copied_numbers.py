@@ -15,7 +15,7 @@ import ast
 from collections.abc import Iterable
 from pathlib import Path
 
-from ..course import own_numbers
+from ...course import own_numbers
 
 TASK_FILE = "task1.py"
 MAX_BYTES = 1_000_000  # a larger task file is left to the grader, which refuses it

@@ -1,11 +1,11 @@
 """The sandboxed side of grading: imports a submission and answers calls over pipes.
 
-Run by `msdlab.instructor.sandbox` as ``python -I -S sandbox_child.py CONFIG_JSON``.
+Run by `msdlab.instructor.judging.sandbox` as ``python -I -S sandbox_child.py CONFIG_JSON``.
 It imports the trusted libraries first, then installs an audit hook that keeps
 the submission inside its folders (no reading outside the allowed roots, no
 writing outside its scratch folder, no processes, sockets, signals or ctypes),
 then serves requests: import a task, get an attribute, call something. Every
-answer is plain data (see `msdlab.instructor.wire`) or a reference to an object
+answer is plain data (see `msdlab.instructor.judging.wire`) or a reference to an object
 kept here, so nothing the submission builds ever runs in the grader.
 """
 
@@ -34,7 +34,7 @@ def main(config: dict[str, Any]) -> None:
 
     import msdlab  # noqa: F401
     from msdlab.course import delegation
-    from msdlab.instructor import wire
+    from msdlab.instructor.judging import wire
 
     _load_engine()
     delegation.install()  # before the submission is imported: see msdlab.course.delegation

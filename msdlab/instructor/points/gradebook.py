@@ -18,13 +18,13 @@ from __future__ import annotations
 import hashlib
 from pathlib import Path
 
-from ..course import TASKS
-from ..course.report import CheckReport
-from .csv_files import read_csv, write_csv
-from .feedback import scrub
-from .final_points import COLUMNS as FINAL_COLUMNS
-from .grading import Grade
-from .intake import MAX_POINTS_ID, Entry, escaped
+from ...course import TASKS
+from ...course.report import CheckReport
+from ..intake import MAX_POINTS_ID, Entry, escaped
+from ..judging.grading import Grade
+from ..outputs.csv_files import read_csv, write_csv
+from ..outputs.feedback import scrub
+from ..rules.final_points import COLUMNS as FINAL_COLUMNS
 
 FIRST = ["id", "source", *(f"task{t}" for t in TASKS), *FINAL_COLUMNS, "total"]
 LAST = ["notes", "fingerprint"]

@@ -1,6 +1,6 @@
 """pytest plugin that runs the implementation under test in the grading sandbox.
 
-Loaded by `msdlab.instructor.grading` with ``-p msdlab.instructor.pytest_sandbox``
+Loaded by `msdlab.instructor.judging.grading` with ``-p msdlab.instructor.judging.pytest_sandbox``
 (the student bundle has no such plugin). ``--sandbox`` makes the course plugin's
 ``implementation`` fixture a `RemoteImplementation`: the checks see only the data the
 sandboxed submission returns.
@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from ..course import TASKS, loader
+from ...course import TASKS, loader
 from .sandbox import RemoteImplementation
 
 _REMOTE = pytest.StashKey[RemoteImplementation]()

@@ -39,12 +39,14 @@ from typing import Any
 
 import numpy as np
 
-from ..course.delegation import DelegationRefused
-from ..integrators import Integrator
+from ...course.delegation import DelegationRefused
+from ...integrators import Integrator
 from . import processes, wire
 
 CHILD = Path(__file__).with_name("sandbox_child.py")
-PACKAGE = Path(__file__).resolve().parents[1]
+PACKAGE = Path(__file__).resolve().parents[2]
+CHILD_IN_PACKAGE = CHILD.resolve().relative_to(PACKAGE).as_posix()
+"""The child's path inside the msdlab package (``instructor/judging/sandbox_child.py``)."""
 CALLBACK_NAMES = frozenset({"acceleration", "force", "masses", "free"})
 STARTUP_SECONDS = 60.0  # the interpreter and numpy/scipy must load, even on a busy machine
 ISOLATION_LEVELS = ("namespace", "process")
@@ -299,7 +301,7 @@ class SandboxProcess:
                 str(self.scratch / "lib"),
             )
         package = f"{library}/msdlab"  # the guard resolves the link to where it really is
-        child = f"{package}/instructor/{CHILD.name}"
+        child = f"{package}/{CHILD_IN_PACKAGE}"
         config = {
             "folder": folder,
             "scratch": scratch,

@@ -3,7 +3,7 @@
 ``msdlab grade --out grades.csv`` keeps its record in ``grades.db`` (`beside`). Each
 submission's result is committed, in one transaction, as soon as it is graded; the
 grades file, the feedback files, the summary and the exports are views rendered from
-this database (`msdlab.instructor.render`), so they can be rebuilt at any time and always
+this database (`msdlab.instructor.outputs.render`), so they can be rebuilt at any time and always
 cover the whole class. Two runs may write into one database at once (WAL journal, a busy
 timeout): each commit is whole, and neither loses the other's rows.
 
@@ -48,9 +48,9 @@ from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
 
-from ..course import TASKS
-from ..course.report import CheckReport, CheckResult
-from .final_points import COLUMNS as FINAL_COLUMNS
+from ...course import TASKS
+from ...course.report import CheckReport, CheckResult
+from ..rules.final_points import COLUMNS as FINAL_COLUMNS
 
 SCHEMA_VERSION = 1
 GRADED, NOT_GRADED, ABSENT, GRADER_FAILED = "graded", "not graded", "absent", "grader failed"

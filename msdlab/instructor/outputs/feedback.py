@@ -17,14 +17,14 @@ import statistics
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from ..course import TASKS
-from ..course.report import CheckResult, without_mistake
-from .gradebook_db import ABSENT, GRADER_FAILED
-from .grading import Grade
+from ...course import TASKS
+from ...course.report import CheckResult, without_mistake
+from ..judging.grading import Grade
+from ..points.gradebook_db import ABSENT, GRADER_FAILED
 
 if TYPE_CHECKING:  # the gradebook uses `scrub`
-    from .gradebook import Gradebook
-    from .gradebook_db import Record
+    from ..points.gradebook import Gradebook
+    from ..points.gradebook_db import Record
 
 _TEMPORARY = re.compile(
     r"[^\s'\"()]*msdlab-(?:grade|intake|sandbox|check)-[^/\s'\"()]*((?:/[^/\s'\"():,;]+)*)"

@@ -23,12 +23,12 @@ import os
 import sys
 from pathlib import Path
 
-from ..course import TASKS
-from . import adjustments, final_points, problems
+from ...course import TASKS
+from ..intake import escaped, unescaped
+from ..points.gradebook import Gradebook
+from ..rules import adjustments, final_points, problems
+from ..rules.final_points import Terms
 from .csv_files import write_csv
-from .final_points import Terms
-from .gradebook import Gradebook
-from .intake import escaped, unescaped
 
 FORMATS = ("canvas", "moodle", "csv")
 ALIASES = {

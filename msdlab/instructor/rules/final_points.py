@@ -19,9 +19,9 @@ from datetime import datetime
 from fractions import Fraction
 from pathlib import Path
 
-from ..course import TASKS
+from ...course import TASKS
+from ..intake import HandIn, file_stem
 from .adjustments import Change
-from .intake import HandIn, file_stem
 from .late import LatePolicy, format_points
 from .problems import Problem
 

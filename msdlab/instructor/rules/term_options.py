@@ -11,8 +11,9 @@ from datetime import datetime, timezone
 from fractions import Fraction
 from pathlib import Path
 
-from ..course import TASKS, manifest
-from . import adjustments, final_points, intake, late, release
+from ...course import TASKS, manifest
+from .. import intake, release
+from . import adjustments, final_points, late
 from .final_points import Terms
 from .problems import InstructorFileError, Problem
 

@@ -32,7 +32,7 @@ from fractions import Fraction
 from pathlib import Path
 from zoneinfo import ZoneInfo, ZoneInfoNotFoundError
 
-from .csv_files import read_table, too_many_fields
+from ..outputs.csv_files import read_table, too_many_fields
 from .problems import Problem, raise_refused
 
 MAX_DURATION = timedelta(days=366)

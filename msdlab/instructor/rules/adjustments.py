@@ -30,8 +30,8 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
 
-from ..course import TASKS
-from .csv_files import read_table, too_many_fields
+from ...course import TASKS
+from ..outputs.csv_files import read_table, too_many_fields
 from .late import format_points
 from .problems import Problem, raise_refused
 

@@ -26,11 +26,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ..course import TASKS
-from ..course.report import MISTAKE_SENTENCE, CheckResult
-from .gradebook import Gradebook, check_column
-from .grading import Grade
-from .intake.times import STUDENT, UNREADABLE
+from ...course import TASKS
+from ...course.report import MISTAKE_SENTENCE, CheckResult
+from ..intake.times import STUDENT, UNREADABLE
+from ..judging.grading import Grade
+from ..points.gradebook import Gradebook, check_column
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

@@ -28,12 +28,12 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..analysis import cluster
-from ..course import TASKS, reference_cache, runner
-from ..course.report import CheckReport
-from ..course.runner import CheckRun
+from ...analysis import cluster
+from ...course import TASKS, reference_cache, runner
+from ...course.report import CheckReport
+from ...course.runner import CheckRun
+from ..intake import MAX_FILE_BYTES
 from . import processes
-from .intake import MAX_FILE_BYTES
 from .judges import ForkedJudges
 from .sandbox import INFRASTRUCTURE_FAILURES, overloaded
 
@@ -149,7 +149,7 @@ def grade(
             report_path,
             hidden=True,
             verbose=True,  # the last error pytest shows says why a judge gave no report
-            plugins=(*runner.PLUGINS, "msdlab.instructor.pytest_sandbox"),
+            plugins=(*runner.PLUGINS, "msdlab.instructor.judging.pytest_sandbox"),
             options=(
                 "--sandbox", "--sandbox-timeout", str(call_timeout),
                 "--sandbox-memory", str(memory_mb), "--sandbox-task-timeout", str(task_timeout),

@@ -18,12 +18,15 @@ import os
 import sqlite3
 from pathlib import Path
 
-from ..course import TASKS
-from ..course.report import CheckReport
-from . import adjustments, class_report, feedback, final_points, gradebook_db, intake
-from .gradebook import Gradebook, check_column
-from .gradebook_db import GRADED, GRADER_FAILED, Record
-from .grading import Grade
+from ...course import TASKS
+from ...course.report import CheckReport
+from .. import intake
+from ..judging.grading import Grade
+from ..points import gradebook_db
+from ..points.gradebook import Gradebook, check_column
+from ..points.gradebook_db import GRADED, GRADER_FAILED, Record
+from ..rules import adjustments, final_points
+from . import class_report, feedback
 
 
 def render(
