@@ -133,12 +133,14 @@ def test_every_submission_is_graded(graded):
 
 
 def test_tampering_with_numpy_pytest_files_and_output_changes_nothing(graded):
-    """Same wrong answer, with and without tampering: the same points, check by check."""
+    """Same wrong answer, with and without tampering: tampering earns nothing, check by check.
+    (Its patches of numpy and the builtins stay in the submission's own process, where the
+    engine's calls it makes may fail too: it can cost the tamperer, never the grader.)"""
     wrong, tamperer = graded["wrong"], graded["tamperer"]
-    assert points(tamperer) == points(wrong)
-    assert wrong.points(1) < graded["honest"].points(1)
-    outcome = {c.nodeid: c.outcome for c in wrong.report.checks}
-    assert {c.nodeid: c.outcome for c in tamperer.report.checks} == outcome
+    assert all(t <= w for t, w in zip(points(tamperer), points(wrong)))
+    assert tamperer.points(1) == wrong.points(1) < graded["honest"].points(1)
+    failed = {c.nodeid for c in wrong.report.checks if c.outcome != "passed"}
+    assert failed <= {c.nodeid for c in tamperer.report.checks if c.outcome != "passed"}
     assert Path.home().exists() and CHECKS.exists()
 
 

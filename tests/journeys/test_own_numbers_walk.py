@@ -67,7 +67,7 @@ def test_the_readme_works_as_written_on_the_systems_python(bundle, student):
     assert student.venv == bundle / ".venv"
     assert "animation:" in typed[1].output, typed[1]
     check = typed[-1]
-    assert check.status == 1 and "to do:" in check.output, check
+    assert check.status == 1 and "to do in assignments/" in check.output, check
     alice = own_numbers.numbers(ALICE)
     assert f"with your own numbers (student {ALICE})" in check.output, check
     assert f"y0 = ORIGIN[1] = {alice.bottom}" in check.output
