@@ -12,8 +12,16 @@
 const LEVELS = 64;
 const PICK_RADIUS = 25; // px: how near the mouse a particle must be to be taken
 const HISTORY = 600; // points of the energy plot
+const HELD_COLOUR = "#e8a317"; // the ring round the particle in hand
 // the ledger's entries of energy put in (booked negative), shown as the work done
 const PUT_IN = { hand: "hand's work", driven: "driven particles' work" };
+/** The colour of each energy bar: one of its own for every energy in the body, every
+ * mechanism that takes energy out and the work put in (red for a mechanism not listed);
+ * the hand's work has the colour of the ring drawn round the particle in hand. */
+const BAR_COLOURS = { kinetic: "#2ca02c", elastic: "#1f77b4", gravitational: "#9467bd",
+  "other potential": "#bcbd22", dashpot: "#8c564b", integrator: "#7f7f7f", ground: "#e377c2",
+  viscous: "#17becf", drag: "#d62728", walls: "#393b79", "hand's work": HELD_COLOUR,
+  "driven particles' work": "#ff7f0e", total: "#333" };
 const DENSE = 3000; // springs from which lines are written as pixels (`Pixels`)
 const SURFACE_ONLY = 30000; // springs from which a 3-D body is drawn by its surface
 const QUEUED = 6; // states kept waiting at most: older ones are dropped (6 frames late at most)
@@ -278,7 +286,7 @@ class Painter {
 
   drawHeld(g, held) {
     if (held === null) return;
-    g.strokeStyle = "#e8a317";
+    g.strokeStyle = HELD_COLOUR;
     g.lineWidth = 3;
     g.beginPath();
     g.arc(this.screen[2 * held], this.screen[2 * held + 1], 8, 0, 2 * Math.PI);
@@ -418,8 +426,7 @@ class EnergyPanel {
     const entries = [...Object.entries(this.bars), ["total", this.total ?? 0]];
     const top = Math.max(1e-12, ...entries.map(([, v]) => Math.abs(v)));
     const barHeight = 300 / Math.max(entries.length, 1);
-    const colours = { kinetic: "#2ca02c", elastic: "#1f77b4", gravitational: "#9467bd",
-      total: "#333" };
+    const colours = BAR_COLOURS;
     g.font = "11px sans-serif";
     entries.forEach(([name, value], i) => {
       const y = 8 + i * barHeight, w = (Math.abs(value) / top) * (width - 20);

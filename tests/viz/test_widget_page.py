@@ -117,9 +117,22 @@ class Kernel:
 @pytest.fixture
 def widget_page():
     """(page, kernel) with the widget of a spring-mass drawn."""
+    yield from opened(spring_mass())
+
+
+@pytest.fixture
+def widget_page_in_air():
+    """The same with the spring-mass in air drag (3/s)."""
+    simulation = spring_mass()
+    yield from opened(msd.Simulation(simulation.body, msd.Verlet(), dt=1e-3,
+                                     forces=[*simulation.forces, msd.Drag(3.0)]))  # fmt: skip
+
+
+def opened(simulation: msd.Simulation):
+    """(page, kernel) with the widget of ``simulation`` drawn, until the test is done."""
     from playwright.sync_api import sync_playwright
 
-    view = LiveView(spring_mass())
+    view = LiveView(simulation)
     page_text = PAGE.replace("MODULE", frontend.ESM.read_text()).replace(
         "BYTES_NAMES", repr(list(BYTES))
     )
@@ -281,3 +294,33 @@ def test_every_control_has_a_name_a_screen_reader_says(widget_page):
     assert controls.count() >= 15  # run, step, reset, speed, 4 sliders, 5 tools, 2 + 4 + 2 more
     for name in ("one step (s)", "back to the start (r)", "stiffness k", "gravity |g|"):
         assert page.get_by_label(name, exact=True).count() == 1
+
+
+BAR_PIXELS = """() => { const c = document.querySelector('.msdlab-energy');
+const names = [...Object.keys(JSON.parse(c.dataset.bars)), "total"];
+const height = 300 / names.length, g = c.getContext('2d');
+return Object.fromEntries(names.map((name, i) => [name,
+  Array.from(g.getImageData(11, Math.round(8 + i * height + 13 + (height - 18) / 2), 1, 1)
+    .data.slice(0, 3))])); }"""
+
+
+def test_the_hands_work_has_a_bar_of_its_own_colour(widget_page_in_air, tmp_path):
+    """Dragged, then let go in air drag, the hand's work and the drag's share are two bars in
+    two colours: the hand's the colour of the ring round the particle in hand."""
+    page, kernel = widget_page_in_air
+    box = page.locator(".msdlab-canvas").bounding_box()
+    screen = np.array(page.evaluate("() => Array.from(window.msdlabViews[0].painter.screen)"))
+    start = np.array([box["x"] + 1 + float(screen[2]), box["y"] + 1 + float(screen[3])])
+    page.mouse.move(*start)
+    page.mouse.down()
+    for angle in np.linspace(0.0, 3 * np.pi, 60):  # one and a half circles: it ends lifted
+        page.mouse.move(*(start + 40.0 * np.array([np.sin(angle), 1 - np.cos(angle)])))
+        kernel.frames()
+    page.mouse.up()
+    kernel.frames(60)  # let go, it swings in the air: the drag takes its share
+    page.locator(".msdlab-energy").screenshot(path=tmp_path / "bars.png")
+    colours = page.evaluate(BAR_PIXELS)
+    assert colours["hand's work"] == [0xE8, 0xA3, 0x17]  # the held particle's ring
+    assert colours["drag"] == [0xD6, 0x27, 0x28]
+    others = [colour for name, colour in colours.items() if name != "hand's work"]
+    assert colours["hand's work"] not in others
