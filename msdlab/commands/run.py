@@ -10,29 +10,21 @@ import argparse
 import ast
 from pathlib import Path
 
+from .. import integrators
 from ..errors import SimulationDiverged
-from ..integrators import (
-    RK4,
-    ExplicitEuler,
-    ImplicitEuler,
-    Integrator,
-    SymplecticEuler,
-    VelocityVerlet,
-    Verlet,
-)
 from ..scenes import SCENES, Scene, get_scene, sweep
 from ..scenes.trampoline import EXPERIMENTS, experiment_table, run_experiment
 from ..simulation import Simulation, Trajectory
 from .first_run import start_engine
 from .progress import count_bar, step_bar
 
-INTEGRATORS: dict[str, type[Integrator]] = {
-    "explicit-euler": ExplicitEuler,
-    "symplectic-euler": SymplecticEuler,
-    "verlet": Verlet,
-    "velocity-verlet": VelocityVerlet,
-    "rk4": RK4,
-    "implicit-euler": ImplicitEuler,
+INTEGRATORS: dict[str, type[integrators.Integrator]] = {
+    "explicit-euler": integrators.ExplicitEuler,
+    "symplectic-euler": integrators.SymplecticEuler,
+    "verlet": integrators.Verlet,
+    "velocity-verlet": integrators.VelocityVerlet,
+    "rk4": integrators.RK4,
+    "implicit-euler": integrators.ImplicitEuler,
 }
 
 

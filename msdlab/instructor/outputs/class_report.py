@@ -31,6 +31,7 @@ from ...course.report import MISTAKE_SENTENCE, CheckResult
 from ..intake.times import STUDENT, UNREADABLE
 from ..judging.grading import Grade
 from ..points.gradebook import Gradebook, check_column
+from .html_page import write_page
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -262,13 +263,7 @@ def write_html(rows: Sequence[ClassRow], maximum: dict[str, str], path: Path) ->
         "<h2>Not graded</h2>",
         _list([f"{r.id}: {r.notes or 'no reason recorded'}" for r in rows if not r.graded], "none"),
     ]
-    page = (
-        '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
-        f"<title>The class at a glance</title><style>{STYLE}</style></head><body>\n"
-        + "\n".join(part for part in body if part)
-        + "\n</body></html>\n"
-    )
-    path.write_text(page, encoding="utf-8")
+    write_page(path, "The class at a glance", STYLE, body)
 
 
 STYLE = """

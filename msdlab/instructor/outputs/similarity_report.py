@@ -13,6 +13,7 @@ import html
 import itertools
 from pathlib import Path
 
+from .html_page import write_page
 from .similarity import MIN_MATCHED, NOISE, TASK_FILES, FileMatch, Pair, Passage
 
 IN_FULL = 10
@@ -67,13 +68,7 @@ def write_html(
         _left_out(left_out),
         *(_in_full(number, pair, threshold) for number, pair in enumerate(in_full, 1)),
     ]
-    page = (
-        '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
-        f"<title>Similarity report</title><style>{STYLE}{_colour_rules()}</style></head><body>\n"
-        + "\n".join(part for part in body if part)
-        + "\n</body></html>\n"
-    )
-    path.write_text(page, encoding="utf-8")
+    write_page(path, "Similarity report", STYLE + _colour_rules(), body)
 
 
 def _colour_rules() -> str:

@@ -1,0 +1,18 @@
+"""A standalone HTML page for the instructor's reports: one file, its style inline."""
+
+from __future__ import annotations
+
+import html
+from collections.abc import Iterable
+from pathlib import Path
+
+
+def write_page(path: Path, title: str, style: str, parts: Iterable[str]) -> None:
+    """Write ``parts`` (HTML fragments; empty ones left out) as one UTF-8 page."""
+    page = (
+        '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+        f"<title>{html.escape(title)}</title><style>{style}</style></head><body>\n"
+        + "\n".join(part for part in parts if part)
+        + "\n</body></html>\n"
+    )
+    path.write_text(page, encoding="utf-8")
