@@ -218,3 +218,14 @@ def test_who_controls_the_hand_in_time_decides_whether_it_is_verified(row, liste
     assert (class_report.unverified(due | row) is not None) == listed
     if row.get("handed_in_control") != "unreadable":  # without a due date the time is moot
         assert class_report.unverified(row) is None
+
+
+@pytest.mark.parametrize("student", ["$\\frac{1}{0$", "a$b", "x_{1}$^$"])
+def test_a_student_id_is_drawn_as_typed_not_as_mathtext(tmp_path, student):
+    book = Gradebook()
+    grade = Grade(student, report_of("bo"))
+    book.record(grade, Entry(grade.submission, tmp_path, tmp_path), "print", detail=True)
+    figure = class_report.heatmap(class_report.rows_of(book, [grade]))
+    figure.savefig(tmp_path / "map.png")  # a mathtext parse would fail here
+    labels = [label.get_text() for label in figure.axes[0].get_xticklabels()]
+    assert labels == [student]

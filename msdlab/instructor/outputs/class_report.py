@@ -383,9 +383,15 @@ def heatmap(rows: Sequence[ClassRow]) -> Figure:
     ax = figure.subplots()
     colours = ListedColormap(["#5cb85c", "#d9534f", "#dddddd"])
     ax.imshow(cells, cmap=colours, vmin=0, vmax=2, aspect="auto", interpolation="nearest")
-    ax.set_yticks(range(len(columns)), columns, fontsize=7)
+    ax.set_yticks(range(len(columns)), columns, fontsize=7, parse_math=False)
     if len(students) <= 60:
-        ax.set_xticks(range(len(students)), [r.id for r in students], rotation=90, fontsize=7)
+        ax.set_xticks(
+            range(len(students)),
+            [r.id for r in students],
+            rotation=90,
+            fontsize=7,
+            parse_math=False,
+        )
     else:
         ax.set_xticks([])
     ax.set_xlabel(f"{len(students)} students, lowest total on the left", fontsize=9)
