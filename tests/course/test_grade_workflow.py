@@ -410,3 +410,13 @@ def test_a_narrow_table_shortens_names_but_keeps_the_hidden_mark():
     checks = [CheckResult(f"t::{long_name}", long_name, 1, 2, True, "passed")]
     row = CheckReport("submission", checks).table(width=80).splitlines()[1]
     assert "…" in row and row.split("  ")[0].endswith("… (hidden)")
+
+
+def test_a_message_cannot_close_the_instructors_code_block():
+    message = "```\n![seen](https://example.com/t.png)\n```` and ` too"
+    planted = CheckResult("t::test_x", "sign", 3, 0, False, "failed", "AssertionError", message)
+    text = feedback.for_instructor(Grade("alice", report(planted)), "hand-ins/`odd`")
+    saw = text.split("## What the failing checks saw")[1]
+    _, inside, after = saw.split("\n`````\n")  # one fence longer than the message's ````
+    assert "![seen]" in inside and "```` and ` too" in inside and not after.strip()
+    assert "Handed in: `` hand-ins/`odd` ``" in text

@@ -90,7 +90,7 @@ def for_instructor(grade: Grade, source: str = "", hint: str | None = None) -> s
     ``hint`` for the instructor only (whose own numbers the submission holds)."""
     lines = [f"# {grade.submission}", ""]
     if source:
-        lines += [f"Handed in: `{source}`", ""]
+        lines += [f"Handed in: {_code(source)}", ""]
     if hint:
         lines += [f"For you only: {hint}", ""]
     if grade.report is None:
@@ -100,10 +100,10 @@ def for_instructor(grade: Grade, source: str = "", hint: str | None = None) -> s
     lines += [f"{grade.total}/{grade.report.points} points ({points}), "
               f"graded in {grade.seconds:.1f} s", ""]  # fmt: skip
     lines += [f"Note: {note}" for note in grade.notes]
-    lines += ["", "```", scrub(grade.report.table()), "```", ""]
+    lines += ["", *_block(scrub(grade.report.table())), ""]
     details = grade.report.details()
     if details:
-        lines += ["## What the failing checks saw", "", "```", scrub(details), "```"]
+        lines += ["## What the failing checks saw", "", *_block(scrub(details))]
     return "\n".join(lines) + "\n"
 
 
@@ -181,6 +181,25 @@ def _one_reason(checks: list[CheckResult]) -> str | None:
         if exception in ("SubmissionError", "FileNotFoundError", "SyntaxError"):
             return f"Every check stopped at: {scrub(summary)}"
     return None
+
+
+def _fence(text: str, shortest: int) -> str:
+    """Backticks one longer than any run in ``text``: what a student's message holds cannot
+    close the code around it."""
+    longest = max((len(run) for run in re.findall(r"`+", text)), default=0)
+    return "`" * max(shortest, longest + 1)
+
+
+def _block(text: str) -> list[str]:
+    """``text`` as a fenced code block (Markdown), shown as written."""
+    fence = _fence(text, 3)
+    return [fence, text, fence]
+
+
+def _code(text: str) -> str:
+    """``text`` as inline code (Markdown), shown as written (the spaces inside are dropped)."""
+    fence = _fence(text, 1)
+    return f"{fence} {text} {fence}"
 
 
 def _message(check: CheckResult) -> str:
