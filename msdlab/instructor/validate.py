@@ -142,7 +142,9 @@ class TaskReport:
 
 # ---------------------------------------------------------------------------- running checks
 def collect_checks(checks: Path, task: int) -> list[Check]:
-    """The graded checks of ``task`` in the folder ``checks`` (public and hidden)."""
+    """The graded checks of ``task`` in the folder ``checks`` (public and hidden), under the
+    validation's hypothesis profile (loaded first: a check's ``@settings`` copies it)."""
+    _hypothesis_profile()
     found = []
     folder = str(Path(checks).resolve())
     if folder not in sys.path:
@@ -173,7 +175,6 @@ def run_checks(
     """Each check's `Outcome` on ``module`` (a task module loaded from ``folder``), called
     in this process with the fixtures the course's pytest plugin gives (`check_arguments`:
     the template's own numbers), its refusal of delegation and a time limit."""
-    _hypothesis_profile()
     outcomes: dict[str, Outcome] = {}
     for check in checks:
         try:

@@ -3,6 +3,8 @@ blocks are killed by checks named in the report (a small sample here; all of the
 
 from __future__ import annotations
 
+import subprocess
+import sys
 import textwrap
 
 import pytest
@@ -93,3 +95,21 @@ def test_the_report_names_lone_kills_and_survivors_with_their_reasons(tmp_path):
 def test_validate_command_refuses_an_unknown_task(capsys):
     assert main(["validate", "7"]) != 0
     assert "no task 7" in capsys.readouterr().err
+
+
+def test_the_checks_run_without_hypothesis_deadlines():
+    """A check's own ``@settings(max_examples=…)`` keeps validation's profile, also outside
+    pytest (``msdlab validate``): a mutant slow on a loaded machine fails its check, not
+    hypothesis's 200 ms deadline."""
+    folder = str(PROJECT_ROOT / "tests" / "tasks")
+    deadlines = subprocess.run(
+        [sys.executable, "-c", textwrap.dedent(f"""
+            from msdlab.instructor import validate
+            for task in (1, 2, 3):
+                for check in validate.collect_checks({folder!r}, task):
+                    if hasattr(check.function, "hypothesis"):
+                        print(check.name, check.function._hypothesis_internal_use_settings.deadline)
+            """)],
+        capture_output=True, text=True, check=True,
+    ).stdout.splitlines()  # fmt: skip
+    assert len(deadlines) >= 3 and all(line.endswith(" None") for line in deadlines), deadlines

@@ -21,7 +21,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
-from harness import ROOT, Session, quick_start
+from harness import ROOT, Session, Typed, quick_start
 
 from msdlab.course import own_numbers
 from msdlab.instructor import templates
@@ -49,9 +49,16 @@ def home(tmp_path_factory, shell) -> Path:
 
 
 @pytest.fixture(scope="module")
-def student(home) -> Session:
-    """Alice's terminal: the system's Python until the README's first line."""
-    return Session()
+def followed(bundle) -> tuple[Session, list[Typed]]:
+    """Alice's terminal on the system's Python, after she typed the release README's
+    Quick start there, and what each line printed."""
+    student = Session()
+    return student, [student.type(line, bundle) for line in quick_start(bundle / "README.md")]
+
+
+@pytest.fixture(scope="module")
+def student(followed) -> Session:
+    return followed[0]
 
 
 @pytest.fixture(scope="module")
@@ -59,10 +66,9 @@ def bundle(home) -> Path:
     return home / "release" / ALICE
 
 
-def test_the_readme_works_as_written_on_the_systems_python(bundle, student):
-    lines = quick_start(bundle / "README.md")
+def test_the_readme_works_as_written_on_the_systems_python(bundle, followed):
+    lines, (student, typed) = quick_start(bundle / "README.md"), followed
     assert lines[0] == "python3 -m venv .venv && . .venv/bin/activate", lines
-    typed = [student.type(line, bundle) for line in lines]
     assert all(done.status == 0 for done in typed[:-1]), typed
     assert student.venv == bundle / ".venv"
     assert "animation:" in typed[1].output, typed[1]
@@ -119,22 +125,27 @@ def expected_floor_step(own: own_numbers.Numbers) -> int:
     return step
 
 
-def test_her_finished_work_gets_every_public_point(bundle, student):
-    """Her answers: the reference solutions, task 1's in her own template."""
+@pytest.fixture(scope="module")
+def finished(bundle, followed) -> Path:
+    """Her answers in her bundle: the reference solutions, task 1's in her own template."""
     alice = own_numbers.numbers(ALICE)
     for path in sorted((ROOT / "solutions").glob("task*.py")):
         task = templates.task_number(path)
         text = own_numbers.personalised(task, path.read_text(), alice)
         (bundle / "assignments" / path.name).write_text(text)
-    check = student.type("msdlab check", bundle)
+    return bundle
+
+
+def test_her_finished_work_gets_every_public_point(finished, student):
+    check = student.type("msdlab check", finished)
     assert check.status == 0, check
 
 
 @pytest.fixture(scope="module")
-def handed_in(home, bundle) -> Path:
+def handed_in(home, finished) -> Path:
     """``class/``: alice's work as she hands it in, and bob's: her task 1 copied."""
     room = home / "class"
-    shutil.copytree(bundle / "assignments", room / ALICE / "assignments",
+    shutil.copytree(finished / "assignments", room / ALICE / "assignments",
                     ignore=shutil.ignore_patterns("__pycache__"))  # fmt: skip
     shutil.copytree(room / ALICE / "assignments", room / BOB / "assignments")
     (room / BOB / "assignments" / own_numbers.STUDENT_FILE).write_text(json.dumps({"id": BOB}))
