@@ -18,9 +18,10 @@ GRADES.db beside the CSV as soon as it is graded; the CSV (id, source, task1 ...
 task5, points, the late work columns, total, notes; per check with --detail; the
 first row holds the maximum points), the feedback (--feedback DIR: DIR/students/ID.md
 to hand out, DIR/instructor/ID.md with everything, DIR/summary.md) and the class at
-a glance (GRADES.class.html) are rendered from it over the whole class; --render
-writes them again without grading. --due, --late-policy and --extensions charge
-late work; the changes in GRADES.adjustments.csv beside the CSV
+a glance (GRADES.class.html) are rendered from it over the whole class at the end of
+the run (or at its interrupt); --render writes them again without grading. --due,
+--late-policy and --extensions charge late work; the changes in GRADES.adjustments.csv
+beside the CSV
 (id,task,change,reason[,note: private]) are applied at every rendering. These
 options and files are checked whole before anything is graded: every mistake is
 named with its line and the fix. A submission graded again
@@ -179,7 +180,7 @@ def run(args: argparse.Namespace) -> int:
         except KeyboardInterrupt:
             signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second Ctrl-C: the views get out
             gradebook_db.end_run(connection, run_number, "interrupted")
-            session.render(final=True)
+            session.render()
             print(session.interrupted(), file=sys.stderr)
             return 130
     finally:
@@ -267,7 +268,7 @@ class Session:
             started = time.monotonic()
             grades = self._grade_todo(checks)
             gradebook_db.end_run(self.connection, run_number, "finished")
-            self.render(final=True)
+            self.render()
             if args.similarity:
                 folders = {i: e.folder for i, e in self.entries.items() if e.problem is None}
                 similarity.write_report(
@@ -351,11 +352,11 @@ class Session:
         )
 
     def _progress(self, grade: grading.Grade, done: int, count: int) -> None:
-        """Commit ``grade`` at once, bring the views up to date and say so."""
+        """Commit ``grade`` at once and say so (the views are rendered once, at the end of
+        the run or at its interrupt, over the whole class)."""
         entry = self.entries[grade.submission]
         self._commit(shown(grade, entry), _status(grade), grade, self._hint(grade))
         self.graded.append(grade)
-        self.render()
         width = max(len(identifier) for identifier in self.entries)
         if grade.graded:
             result = f"{grade.total}/{grade.report.points} points"
@@ -396,11 +397,11 @@ class Session:
         )  # fmt: skip
         gradebook_db.record(self.connection, result, self.run_number)
 
-    def render(self, final: bool = False) -> list[gradebook_db.Record]:
-        """Write the views over the whole class (``final``: the class report's page too)."""
+    def render(self) -> list[gradebook_db.Record]:
+        """Write the views over the whole class, the class report's page included."""
         args = self.args
         return render.render(
-            self.connection, args.out, self.terms, args.feedback, args.detail, page=final
+            self.connection, args.out, self.terms, args.feedback, args.detail, page=True
         )
 
     def interrupted(self) -> str:

@@ -2,8 +2,9 @@
 
 A judge starts its sandboxes in sessions of their own, so killing the judge's process
 group leaves them running; `kill_tree` ends a process with every descendant it has.
-`cpu_of` is the processor time some processes have used (what a submission's time
-budget is charged).
+`cpu_of` is the processor time some processes have used; `ProcessorClock` reads it for
+the same processes again and again (what a submission's time budget is charged, before
+and after every call into it).
 """
 
 from __future__ import annotations
@@ -59,6 +60,39 @@ def cpu_of(pids: list[int]) -> float:
         if fields is not None:
             total += int(fields[11]) + int(fields[12])  # utime, stime
     return total / TICKS
+
+
+class ProcessorClock:
+    """The processor time (user and system, seconds) of a fixed set of processes, read
+    through their ``/proc/PID/stat`` files held open: a reading costs one ``pread`` per
+    process instead of opening a file by its path. A process that has ended (and been
+    reaped) counts no more, as in `cpu_of`; a new process with its id is never read."""
+
+    def __init__(self, pids: list[int]) -> None:
+        self.pids = list(pids)
+        self._files: list[int] = []
+        for pid in self.pids:
+            with contextlib.suppress(OSError):
+                self._files.append(os.open(f"/proc/{pid}/stat", os.O_RDONLY | os.O_CLOEXEC))
+
+    def seconds(self) -> float:
+        """Processor seconds the processes still running have used so far."""
+        ticks = 0
+        for handle in self._files:
+            try:
+                text = os.pread(handle, 4096, 0)
+            except OSError:  # ended: its file reads "no such process"
+                continue
+            fields = text[text.rfind(b")") + 2 :].split()
+            ticks += int(fields[11]) + int(fields[12])  # utime, stime
+        return ticks / TICKS
+
+    def close(self) -> None:
+        """Close the files (the clock reads nothing after)."""
+        for handle in self._files:
+            with contextlib.suppress(OSError):
+                os.close(handle)
+        self._files = []
 
 
 class Running:

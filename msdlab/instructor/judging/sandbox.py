@@ -256,7 +256,7 @@ class SandboxProcess:
         self.refused_task: int | None = None  # whose engine answers the submission may not use
         self._deadline, self._limit = 0.0, timeout  # of the answer being waited for
         self._clock = CallClock(lambda: 0.0, None)  # the time the current call is charged
-        self._members: list[int] | None = None  # the child's processes, found at first need
+        self._clock_of_child: processes.ProcessorClock | None = None  # found at first need
 
     @property
     def isolation(self) -> str:
@@ -334,7 +334,6 @@ class SandboxProcess:
             )
         os.close(to_child)
         os.close(from_child)
-        self._members = None
         self.exports.clear()
         self.members.clear()
 
@@ -345,6 +344,9 @@ class SandboxProcess:
             with contextlib.suppress(ProcessLookupError, PermissionError):
                 os.killpg(self.process.pid, signal.SIGKILL)
             self.process.wait()
+            if self._clock_of_child is not None:
+                self._clock_of_child.close()
+                self._clock_of_child = None
             for fd in (self._send_fd, self._recv_fd):
                 with contextlib.suppress(OSError):
                     os.close(fd)
@@ -413,9 +415,13 @@ class SandboxProcess:
         """Processor seconds the child's processes have used (found once per start)."""
         if self.process is None:
             return 0.0
-        if self._members is None or (len(self._members) == 1 and self.strong):
-            self._members = processes.descendants(self.process.pid)  # bubblewrap's child too
-        return processes.cpu_of(self._members)
+        clock = self._clock_of_child
+        if clock is None or (len(clock.pids) == 1 and self.strong):  # bubblewrap's child too
+            if clock is not None:
+                clock.close()
+            clock = processes.ProcessorClock(processes.descendants(self.process.pid))
+            self._clock_of_child = clock
+        return clock.seconds()
 
     def _used_up(self) -> str:
         return (
