@@ -1,4 +1,5 @@
-"""``msdlab export``: the grades as Canvas, Moodle and plain CSV files, read back."""
+"""``msdlab export``: the grades as Canvas, Moodle and plain CSV files, read back; from the
+gradebook, or from the grades file of a course graded before it."""
 
 from __future__ import annotations
 
@@ -8,6 +9,10 @@ from pathlib import Path
 import pytest
 
 from msdlab.cli import main
+from msdlab.course.report import CheckReport, CheckResult
+from msdlab.instructor.outputs import render
+from msdlab.instructor.points import gradebook_db
+from msdlab.instructor.rules.final_points import Terms
 
 GRADES = """id,source,task1,task2,task3,task4,task5,points,due,handed_in,handed_in_from,late,\
 late_penalty,adjustment,total,notes,fingerprint
@@ -108,3 +113,73 @@ def test_a_mistake_in_the_changes_stops_the_export_as_it_stops_grading(grades, c
         assert status == 0 and "warning:" in printed and "'carol'" in printed
     else:
         assert status == 2 and says in printed and not out.exists()
+
+
+def _graded(identifier: str, passed: int) -> gradebook_db.Result:
+    """A graded submission of two 5-point checks of task 1, ``passed`` of them passed."""
+    checks = [
+        CheckResult(f"t::c{n}", f"c{n}", 1, 5, False, "passed" if n < passed else "failed")
+        for n in range(2)
+    ]
+    report = CheckReport(identifier, checks)
+    return gradebook_db.Result(identifier, f"/class/{identifier}", "graded", [], report, "f")
+
+
+@pytest.fixture
+def gradebook(tmp_path: Path) -> Path:
+    """A class in the gradebook, its grades file rendered, then a student graded again and a
+    late one committed by a run stopped before it rendered (the grades file is behind)."""
+    out = tmp_path / "grades.csv"
+    connection = gradebook_db.connect(gradebook_db.beside(out))
+    try:
+        for identifier, passed in (("alice", 2), ("bob", 0)):
+            gradebook_db.record(connection, _graded(identifier, passed), None)
+        render.render(connection, out, Terms())
+        gradebook_db.record(connection, _graded("bob", 1), None)
+        gradebook_db.record(connection, _graded("carol", 2), None)
+    finally:
+        connection.close()
+    (tmp_path / "grades.adjustments.csv").write_text(
+        "id,task,change,reason\nalice,,-1,late report\n"
+    )
+    return out
+
+
+def test_the_export_reads_the_gradebook_not_a_grades_file_left_behind(gradebook):
+    assert {row["id"]: row["total"] for row in export_plain(gradebook)} == {
+        "alice": "9", "bob": "5", "carol": "10",
+    }  # fmt: skip
+    assert {row["id"]: row["total"] for row in csv.DictReader(gradebook.open())} == {
+        "(max points)": "10", "alice": "10", "bob": "0",
+    }  # fmt: skip
+
+
+def test_the_gradebook_and_the_grades_file_rendered_from_it_export_the_same(gradebook):
+    assert main(["grade", "--out", str(gradebook), "--render"]) == 0
+    from_database = export_plain(gradebook)
+    gradebook_db.beside(gradebook).unlink()  # a course graded before the gradebook
+    assert export_plain(gradebook) == from_database
+
+
+def test_the_gradebook_may_be_named_and_a_missing_one_is_named(gradebook, capsys):
+    out = ["--format", "csv", "--out", str(gradebook.parent / "x.csv")]
+    assert main(["export", str(gradebook_db.beside(gradebook)), *out]) == 0
+    gradebook_db.beside(gradebook).unlink()
+    gradebook.unlink()
+    assert main(["export", str(gradebook), *out]) == 2
+    said = capsys.readouterr().err
+    assert f"no grades at {gradebook} nor a gradebook {gradebook_db.beside(gradebook)}" in said
+
+
+def test_a_planted_file_in_the_gradebook_s_place_is_refused_by_name(gradebook, capsys):
+    gradebook_db.beside(gradebook).write_text("id,total\nalice,95\n")
+    out = ["--format", "csv", "--out", str(gradebook.parent / "x.csv")]
+    assert main(["export", str(gradebook), *out]) == 2
+    assert "grades.db is not a gradebook msdlab can read" in capsys.readouterr().err
+    assert not (gradebook.parent / "x.csv").exists()
+
+
+def export_plain(grades: Path) -> list[dict[str, str]]:
+    out = grades.parent / "out" / "plain.csv"
+    assert main(["export", str(grades), "--format", "csv", "--out", str(out)]) == 0
+    return list(csv.DictReader(out.open(encoding="utf-8")))

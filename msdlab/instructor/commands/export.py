@@ -1,10 +1,11 @@
 """``msdlab export GRADES --roster ROSTER --format canvas --out FILE``: the grades for an LMS.
 
-Reads the grades file ``msdlab grade`` wrote (final totals: late penalties and manual
-changes included) and a roster whose first line names its columns (id, name, email,
-sis_id, ...), and writes the grades in the form Canvas or Moodle imports, or as a plain
-CSV with the roster's columns kept. No line of the file is a summary, except Canvas's
-own "Points Possible" line.
+Reads the grades ``msdlab grade`` recorded in the gradebook GRADES.db beside the grades
+file GRADES (GRADES may name either; for a course graded before that database, the grades
+file itself), final totals with late penalties and manual changes, and a roster whose
+first line names its columns (id, name, email, sis_id, ...), and writes the grades in the
+form Canvas or Moodle imports, or as a plain CSV with the roster's columns kept. No line
+of the file is a summary, except Canvas's own "Points Possible" line.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import sys
 from pathlib import Path
 
 from ..outputs import export
+from ..points import gradebook_db
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -23,7 +25,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("grades", type=Path, metavar="GRADES", help="the CSV msdlab grade wrote")
+    parser.add_argument(
+        "grades", type=Path, metavar="GRADES", help="the grades file msdlab grade --out wrote"
+    )
     parser.add_argument(
         "--roster", type=Path, help="CSV with a header: id, name, email, sis_id, ..."
     )
@@ -38,12 +42,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if not args.grades.is_file():
-        raise FileNotFoundError(f"no grades file at {args.grades}; give the CSV msdlab grade wrote")
+    grades = args.grades.with_suffix(".csv") if args.grades.suffix == ".db" else args.grades
+    if not grades.is_file() and not gradebook_db.beside(grades).is_file():
+        raise FileNotFoundError(
+            f"no grades at {grades} nor a gradebook {gradebook_db.beside(grades)}; give the "
+            "grades file msdlab grade --out wrote"
+        )
     if args.roster is None and args.form != "csv":
         raise ValueError(f"--format {args.form} needs --roster FILE (names and ids for the LMS)")
     roster = export.read_roster(args.roster) if args.roster else None
-    lines = export.table(args.grades, roster, args.form, args.assignment, args.out)
+    lines = export.table(grades, roster, args.form, args.assignment, args.out)
     export.write(lines, args.out)
     students = len(lines) - (2 if args.form == "canvas" else 1)
     print(f"{students} students written to {args.out} ({args.form})", file=sys.stderr)

@@ -1,5 +1,9 @@
 """The class's grades in the form a learning management system imports.
 
+The grades are read from the gradebook ``grades.db`` beside the grades file named (the
+record of every grading run, a run stopped before it rendered its views included), or,
+for a course graded before that database, from the grades file itself.
+
 The roster is a CSV whose first line names its columns: ``id`` (the grades' id) and any
 of ``name``, ``email``, ``sis_id``, ``sis_login_id``, ``section``, ``canvas_id``; other
 columns (``folder``, say) are kept in the ``csv`` format. The same file can be the
@@ -25,9 +29,11 @@ from pathlib import Path
 
 from ...course import TASKS
 from ..intake import escaped, unescaped
+from ..points import gradebook_db
 from ..points.gradebook import Gradebook
 from ..rules import adjustments, final_points, problems
 from ..rules.final_points import Terms
+from . import render
 from .csv_files import write_csv
 
 FORMATS = ("canvas", "moodle", "csv")
@@ -84,7 +90,7 @@ def settled(grades: Path) -> Gradebook:
     """The grades file ``grades`` with every row's total settled as ``msdlab grade`` settles
     it (`final_points.settle`): the manual changes written since the last run count, and a
     mistake in them stops the export as it stops grading."""
-    book = Gradebook.load(grades)
+    book = class_of(grades)
     if not book.rows:
         raise ValueError(f"{grades} holds no grades; run msdlab grade --out {grades} first")
     path = adjustments.beside(grades)
@@ -94,6 +100,17 @@ def settled(grades: Path) -> Gradebook:
     problems.settle(found + adjustments.against_class(changes, str(path), maximum, set(book.rows)))
     final_points.settle(book.rows, Terms(changes=adjustments.by_student(changes)))
     return book
+
+
+def class_of(grades: Path) -> Gradebook:
+    """The class's rows as ``msdlab grade`` last settled them: from the gradebook beside
+    ``grades`` if it holds any, else from the grades file ``grades`` (an older course's)."""
+    if gradebook_db.beside(grades).is_file():
+        records = gradebook_db.read_class(grades)
+        if records:
+            rows = {record.id: render.row_of(record) for record in records}
+            return render.grades_file(records, rows, detail=False)
+    return Gradebook.load(grades)
 
 
 def _warn_unmatched(book: Gradebook, people: list[dict[str, str]], grades: Path) -> None:

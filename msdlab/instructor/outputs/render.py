@@ -42,7 +42,7 @@ def render(
     pictures); the gradebook's records, settled."""
     with gradebook_db.transaction(connection):
         records = gradebook_db.read_records(connection)
-        rows = {record.id: _row(record) for record in records}
+        rows = {record.id: row_of(record) for record in records}
         explained = final_points.settle(rows, terms)
         for record in records:
             row = rows[record.id]
@@ -64,7 +64,7 @@ def render(
     return records
 
 
-def _row(record: Record) -> dict[str, str]:
+def row_of(record: Record) -> dict[str, str]:
     """The grades file's row of ``record``, before the term's rules are applied (the late
     columns of the last settling kept: a run without ``--due`` charges no new penalty)."""
     row = {"id": record.id, "source": record.source}
