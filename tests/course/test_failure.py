@@ -2,7 +2,9 @@
 
 from pathlib import Path
 
-from msdlab.course import failure
+import pytest
+
+from msdlab.course import failure, report
 
 
 def raising_task_file(folder: Path) -> BaseException:
@@ -38,3 +40,31 @@ def test_the_failing_input_plainly():
     )
     assert failure.failing_inputs(every) == "it fails whatever the input (tried first: seed = 0)"
     assert failure.failing_inputs("You can add @seed(1) to this test") == ""
+
+
+def test_the_line_of_a_sandboxed_task_file_that_raised(serve_task):
+    """Run in the grader's sandbox, an error names the line of the submission as a check run
+    in one process does (the file by its name in the submission), and a to-do its function
+    without the code."""
+    remote = serve_task(
+        "task5.py",
+        """\
+        class DampedVerlet:
+            def __init__(self, damping):
+                raise NotImplementedError("Task 5: store the damping.")
+
+        def push(x):
+            return x + [1, 2]
+        """,
+    )
+    with pytest.raises(NotImplementedError) as to_do:
+        remote.task(5).DampedVerlet(0.1)
+    assert str(to_do.value).endswith("\nin your code: task5.py, line 3, in DampedVerlet.__init__")
+    assert report.to_do(str(to_do.value)) == (
+        "to do in task5.py, DampedVerlet.__init__: store the damping."
+    )
+    with pytest.raises(TypeError) as error:
+        remote.task(5).push(None)
+    assert str(error.value).endswith(
+        "\nin your code: task5.py, line 6, in push\n    return x + [1, 2]"
+    )

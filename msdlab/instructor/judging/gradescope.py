@@ -229,11 +229,14 @@ def _possible(grade: grading.Grade, task: int) -> int:
 
 
 def _output(check: CheckResult) -> str:
-    """What the student reads: nothing for a pass, else the summary, then the full message."""
+    """What the student reads: nothing for a pass, else the summary (a to-do says the file and
+    function to write, and what), then the full message where it says more."""
     if check.passed:
         return ""
     full = check.message.strip()
-    return check.summary if not full or full == check.summary else f"{check.summary}\n\n{full}"
+    if check.exception == "NotImplementedError" or not full or full == check.summary:
+        return check.summary
+    return f"{check.summary}\n\n{full}"
 
 
 if __name__ == "__main__":

@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from ...course.delegation import DelegationRefused
+from ...course.report import WHERE
 from ...integrators import Integrator
 from . import processes, wire
 
@@ -576,10 +577,11 @@ class ArgumentChanged(AssertionError):
 
 
 def _raise(error: dict) -> None:
-    """Raise the submission's error here: built-in types keep their type, others are wrapped."""
+    """Raise the submission's error here: built-in types keep their type, others are wrapped.
+    Its message ends with the line of the submission that raised it, as a check run in one
+    process says it (`msdlab.course.failure.raised_in`; a to-do without its code)."""
     name, message = str(error.get("type")), str(error.get("message"))
-    where = str(error.get("traceback") or "")
-    text = message + (f"\n(in the submission)\n{where.rstrip()}" if where else "")
+    text = message + _raised_in(error, code=name != "NotImplementedError")
     if name == "DelegationRefused":  # the same failure as in one process
         raise DelegationRefused(message)
     kind = getattr(builtins, name, None)
@@ -590,6 +592,15 @@ def _raise(error: dict) -> None:
     ):
         raise kind(text)
     raise SubmissionRaised(f"{name}: {text}")
+
+
+def _raised_in(error: dict, code: bool) -> str:
+    """'\nin your code: task2.py, line 51, in spring_acceleration' and (with ``code``) the
+    line's code, from the child's description of an error; '' without one."""
+    if not error.get("file"):
+        return ""
+    where = f"\n{WHERE}{error['file']}, line {error.get('line')}, in {error.get('function')}"
+    return where + (f"\n    {error['code']}" if code and error.get("code") else "")
 
 
 class RemoteObject:

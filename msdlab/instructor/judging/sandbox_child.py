@@ -12,6 +12,7 @@ kept here, so nothing the submission builds ever runs in the grader.
 from __future__ import annotations
 
 import json
+import linecache
 import os
 import sys
 import traceback
@@ -345,13 +346,33 @@ def _changed_arguments(before: dict[str, Any], args: tuple, kwargs: dict) -> dic
 
 
 def _describe(error: BaseException, folder: str) -> dict:
-    frames = [f for f in traceback.extract_tb(error.__traceback__) if f.filename.startswith(folder)]
-    where = "".join(traceback.format_list(frames[-5:]))
+    """The error's type and message, and where in the submission's files it was raised."""
     if isinstance(error, SystemExit):
         message = f"the submission called sys.exit({error.code!r})"
     else:
         message = str(error)
-    return {"type": type(error).__name__, "message": message[:4000], "traceback": where[:4000]}
+    described = {"type": type(error).__name__, "message": message[:4000]}
+    return described | _raised_in(error, folder)
+
+
+def _raised_in(error: BaseException, folder: str) -> dict:
+    """The innermost line of the submission's files in ``error``'s traceback: its file (from
+    ``folder``), line, function (a method with its class) and code; {} where there is none."""
+    frames = [
+        (frame, line)
+        for frame, line in traceback.walk_tb(error.__traceback__)
+        if frame.f_code.co_filename.startswith(folder)
+    ]
+    if not frames:
+        return {}
+    frame, line = frames[-1]
+    path = frame.f_code.co_filename
+    return {
+        "file": os.path.relpath(path, folder),
+        "line": line,
+        "function": getattr(frame.f_code, "co_qualname", frame.f_code.co_name),  # 3.11+
+        "code": linecache.getline(path, line).strip(),
+    }
 
 
 if __name__ == "__main__":
