@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -33,6 +35,86 @@ def springs_of(body):
     return np.stack([body.spring_a, body.spring_b], axis=1), body.rest_lengths.copy()
 
 
+DEGREES_AS_RADIANS = (
+    "radians where degrees are given: the angle is in degrees, θ = np.radians(angle_degrees)"
+)
+LEFT_HANDED = "a left-handed turn (the transpose): flip the sign of the sin terms"
+
+
+def matrix_mistakes(axis, angle):
+    """Matrices (3, 3) that typical mistakes in rotation_matrix(axis, angle) give, by cause."""
+    expected = msd.rotation_matrix(angle, axis)
+    theta, n = np.radians(angle), np.asarray(axis, dtype=float)
+    unit = n / np.linalg.norm(n)
+    return {
+        LEFT_HANDED: expected.T,
+        DEGREES_AS_RADIANS: msd.rotation_matrix(np.degrees(angle), axis),
+        "the axis is not normalised: divide it by its length first": (
+            np.cos(theta) * np.eye(3)
+            + np.sin(theta) * np.cross(np.eye(3), n)
+            + (1 - np.cos(theta)) * np.outer(n, n)
+        ),
+        "Rodrigues' formula with the unit axis n lacks its (1 - cos θ) n nᵀ term": (
+            np.cos(theta) * np.eye(3) + np.sin(theta) * np.cross(np.eye(3), unit)
+        ),
+    }
+
+
+@functools.lru_cache(maxsize=16)  # per task module: the checks of one submission ask often
+def matrix_mistake(task3):
+    """The typical mistake the student's rotation_matrix is recognised as (a turn by 30° about
+    the axis (1, -2, 0.5): every mistake gives another matrix), or None.
+
+    The checks of rotation_matrix, and of rotate_layout and drop_rotated_cube (which use it),
+    name it as their cause, so the report names the one mistake once.
+    """
+    axis, angle = (1.0, -2.0, 0.5), 30.0
+    try:
+        got = np.asarray(task3.rotation_matrix(axis, angle), dtype=float)
+    except Exception:  # the checks say what is wrong
+        return None
+    if got.shape != (3, 3) or np.allclose(got, msd.rotation_matrix(angle, axis), atol=1e-12):
+        return None
+    return matching_variant(got, matrix_mistakes(axis, angle), rtol=1e-9)
+
+
+def layout_mistakes(grid, axis, angle):
+    """Positions that typical mistakes in rotate_layout(grid, axis, angle) give, by cause."""
+    rotation = msd.rotation_matrix(angle, axis)
+    centroid = grid.reshape(-1, 3).mean(axis=0)
+    return {
+        "rotating about the origin instead of the centroid: subtract the mean position "
+        "first and add it back": grid @ rotation.T,
+        "x @ R rotates by -angle; row vectors need x @ R.T": (
+            (grid - centroid) @ rotation + centroid
+        ),
+        "the angle argument is ignored (always 45°)": (
+            (grid - centroid) @ msd.rotation_matrix(45.0, axis).T + centroid
+        ),
+        "the mean of all coordinates (points.mean()) taken as the centroid: rotate every "
+        "position p to R (p - c) + c, c the centroid, the mean position points.mean(axis=0)": (
+            (grid - grid.mean()) @ rotation.T + grid.mean()
+        ),
+    }
+
+
+@functools.lru_cache(maxsize=16)
+def layout_mistake(task3):
+    """The typical mistake the student's rotate_layout is recognised as (a 3 × 4 × 2 grid turned
+    -30° about (1, 1, 0)), that of its rotation_matrix where that is wrong, or None."""
+    grid = oracles.template_positions((3, 4, 2), 0.1, (-1.0, 1.5, -1.0))
+    axis, angle = (1.0, 1.0, 0.0), -30.0
+    try:
+        got = np.asarray(task3.rotate_layout(grid.copy(), axis, angle), dtype=float)
+    except Exception:  # the checks say what is wrong
+        return None
+    centroid = grid.reshape(-1, 3).mean(axis=0)
+    right = (grid - centroid) @ msd.rotation_matrix(angle, axis).T + centroid
+    if got.shape != grid.shape or relative_error(got, right) < 1e-12:
+        return None
+    return matching_variant(got, layout_mistakes(grid, axis, angle)) or matrix_mistake(task3)
+
+
 def matrix_at_fault(task3, axis, angle):
     """Why rotate_layout may be wrong because rotation_matrix is, or None."""
     try:
@@ -45,7 +127,11 @@ def matrix_at_fault(task3, axis, angle):
 
 
 def rotation_at_fault(task3):
-    """Why drop_rotated_cube may be wrong because of another function of the task, or None."""
+    """Why drop_rotated_cube may be wrong because of another function of the task (the mistake
+    recognised in it, `layout_mistake`, where there is one), or None."""
+    recognised = layout_mistake(task3)
+    if recognised:
+        return recognised
     grid = oracles.template_positions((2, 3, 2), 0.5, (0.0, 1.0, 0.0))
     try:
         got = np.asarray(task3.rotate_layout(grid.copy(), (0.0, 0.0, 1.0), 45.0), dtype=float)
@@ -75,26 +161,16 @@ def test_rotation_matrix_right_handed(task3):
         np.allclose(quarter @ x, y, atol=1e-12),
         saw=f"rotation_matrix((0, 0, 1), 90) turns the x axis into {vec(quarter @ x)}; a "
         "right-handed quarter turn about z takes x to y",
-        cause="the transpose (a left-handed turn: the sign of the sin terms) or radians "
+        cause=matrix_mistake(task3)
+        or "the transpose (a left-handed turn: the sign of the sin terms) or radians "
         "where degrees are given (use np.radians)",
     )
     for axis in AXES:
         for angle in (30.0, -58.3, 180.0):
             got = as_array(task3.rotation_matrix(axis, angle), "rotation_matrix", (3, 3))
             expected = msd.rotation_matrix(angle, axis)
-            mistake = matching_variant(
-                got,
-                {
-                    "a left-handed turn (the transpose): flip the sign of the sin terms": (
-                        expected.T
-                    ),
-                    "the axis is not normalised: divide it by its length first": (
-                        np.cos(np.radians(angle)) * np.eye(3)
-                        + np.sin(np.radians(angle)) * np.cross(np.eye(3), np.asarray(axis))
-                        + (1 - np.cos(np.radians(angle))) * np.outer(axis, axis)
-                    ),
-                },
-                rtol=1e-9,
+            mistake = matrix_mistake(task3) or matching_variant(
+                got, matrix_mistakes(axis, angle), rtol=1e-9
             )
             expect(
                 np.allclose(got, expected, atol=1e-12),
@@ -115,19 +191,7 @@ def test_rotate_layout_turns_about_centroid(task3):
         got = as_array(task3.rotate_layout(grid.copy(), axis, angle), "rotate_layout", grid.shape)
         centroid = grid.reshape(-1, 3).mean(axis=0)
         expected = (grid - centroid) @ msd.rotation_matrix(angle, axis).T + centroid
-        mistake = matching_variant(
-            got,
-            {
-                "rotating about the origin instead of the centroid: subtract the mean "
-                "position first and add it back": grid @ msd.rotation_matrix(angle, axis).T,
-                "x @ R rotates by -angle; row vectors need x @ R.T": (
-                    (grid - centroid) @ msd.rotation_matrix(angle, axis) + centroid
-                ),
-                "the angle argument is ignored (always 45°)": (
-                    (grid - centroid) @ msd.rotation_matrix(45.0, axis).T + centroid
-                ),
-            },
-        )
+        mistake = layout_mistake(task3) or matching_variant(got, layout_mistakes(grid, axis, angle))
         moved = got.reshape(-1, 3).mean(axis=0) - centroid
         expect(
             relative_error(got, expected) < 1e-12,
@@ -140,29 +204,47 @@ def test_rotate_layout_turns_about_centroid(task3):
         )
 
 
+def sum_mistakes(x, springs, rest, stiffness, task3):
+    """Accelerations that typical mistakes in spring_acceleration give, by cause."""
+    expected = oracles.spring_acceleration(oracles.spring_body(x, springs, rest, stiffness), x)
+    last_wins = np.zeros_like(x)
+    f = oracles.force_of_each_spring(x, springs, rest, stiffness)
+    last_wins[springs[:, 0]] += f  # repeated indices: only one spring per particle counts
+    last_wins[springs[:, 1]] -= f
+    return {
+        "a[i] += f with repeated indices keeps only one spring per particle; use "
+        "np.add.at or np.bincount (or a loop) to add every spring": last_wins,
+        "the sign of (l - |x_i - x_j|) or of the direction x_i - x_j": -expected,
+        **oracles.spring_list_mistakes(x, springs, rest, stiffness, task3),
+    }
+
+
+@functools.lru_cache(maxsize=16)
+def sum_mistake(task3):
+    """The typical mistake the student's spring_acceleration is recognised as (a deformed
+    3 × 4 × 2 jelly with 1, √2, √3 springs and k = 0.7, no template's number), or None."""
+    rng = np.random.default_rng(13)
+    body = jelly(stiffness=0.7)
+    x = body.positions + 0.05 * rng.standard_normal(body.positions.shape)
+    springs, rest = springs_of(body)
+    try:
+        got = np.asarray(task3.spring_acceleration(x.copy(), springs, rest, 0.7), dtype=float)
+    except Exception:  # the checks say what is wrong
+        return None
+    if got.shape != x.shape or relative_error(got, oracles.spring_acceleration(body, x)) < 1e-9:
+        return None
+    return matching_variant(got, sum_mistakes(x, springs, rest, 0.7, task3))
+
+
 def compare_with_engine(task3, got, body, x, what):
     expected = oracles.spring_acceleration(body, x)
     error = relative_error(got, expected)
     if error < 1e-9:
         return
     springs, rest = springs_of(body)
-    stiffness = body.stiffness[0]
-    last_wins = np.zeros_like(x)
-    f = oracles.force_of_each_spring(x, springs, rest, stiffness)
-    last_wins[springs[:, 0]] += f  # repeated indices: only one spring per particle counts
-    last_wins[springs[:, 1]] -= f
     worst = int(np.argmax(np.linalg.norm(got - expected, axis=1)))
-    mistake = matching_variant(
-        got,
-        {
-            "a[i] += f with repeated indices keeps only one spring per particle; use "
-            "np.add.at or np.bincount (or a loop) to add every spring": last_wins,
-            "the sign of (l - |x_i - x_j|) or of the direction x_i - x_j": -expected,
-            "-f_ij is never added to particle j": oracles.one_sided_acceleration(
-                x, springs, rest, stiffness
-            ),
-            **oracles.spring_list_mistakes(x, springs, rest, stiffness, task3),
-        },
+    mistake = sum_mistake(task3) or matching_variant(
+        got, sum_mistakes(x, springs, rest, body.stiffness[0], task3)
     )
     expect(
         False,
@@ -198,7 +280,8 @@ def test_same_physics_in_any_orientation(task3, seed):
     expect(
         np.max(np.abs(a_rest)) < 1e-9,
         saw=f"a rotated body at rest feels accelerations up to {num(np.max(np.abs(a_rest)))}",
-        cause="a rest length or a force direction that depends on the coordinate axes",
+        cause=sum_mistake(task3)
+        or "a rest length or a force direction that depends on the coordinate axes",
     )
     x = body.positions + 0.05 * rng.standard_normal(body.positions.shape)
     a = student_acceleration(task3, x, springs, rest, 0.5)
@@ -209,7 +292,8 @@ def test_same_physics_in_any_orientation(task3, seed):
         error < 1e-9,
         saw=f"rotating a deformed body changes its accelerations by {percent(error)} beyond "
         "the rotation itself: the physics depends on the orientation",
-        cause="using coordinate axes instead of the spring direction x_i - x_j",
+        cause=sum_mistake(task3)
+        or "using coordinate axes instead of the spring direction x_i - x_j",
     )
 
 
@@ -228,12 +312,12 @@ def test_no_net_force_or_torque(task3):
     expect(
         np.linalg.norm(net) <= 1e-9 * scale * len(x),
         saw=f"the springs give the body a net acceleration {vec(net)} (each ~{num(scale)})",
-        cause="the reaction -f_ij on particle j is missing or added twice",
+        cause=sum_mistake(task3) or "the reaction -f_ij on particle j is missing or added twice",
     )
     expect(
         np.linalg.norm(torque) <= 1e-9 * scale * len(x),
         saw=f"the springs give the body a net torque {vec(torque)}",
-        cause="forces not along the spring direction x_i - x_j",
+        cause=sum_mistake(task3) or "forces not along the spring direction x_i - x_j",
     )
 
 

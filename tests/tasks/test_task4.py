@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 import pytest
 
 from msdlab.course import oracles
-from msdlab.course.feedback import as_array, expect, num, percent
+from msdlab.course.feedback import Recognised, as_array, expect, matching_variant, num, percent
 
 pytestmark = pytest.mark.task4
 
@@ -38,8 +39,112 @@ def student_springs(task4, shape, spacing, neighbours):
     return springs.astype(np.int64), rest
 
 
+TWICE = "both i→j and j→i listed (a spring counted twice doubles its force)"
+EVERY_KIND = (
+    "neighbours of every kind (axis, face- and body-diagonal), not only those that were "
+    "asked for with squared_distances"
+)
+LENGTHS = {1: "axis (spacing)", 2: "face-diagonal (spacing·√2)", 3: "body-diagonal (spacing·√3)"}
+
+
+@functools.lru_cache(maxsize=16)  # per task module: the checks of one submission ask often
+def springs_mistake(task4):
+    """The typical mistake the student's grid_springs (and the neighbour_offsets it uses) is
+    recognised as, or None: the springs of a 2 × 3 × 4 grid of spacing 0.3 (no template's
+    number) with all neighbours and with axis neighbours only are exactly what the mistake
+    gives, and no other's.
+
+    Every check of the springs and of what is built from them (the cube, the cost) names it
+    as its cause, so the report names the one mistake once.
+    """
+    shape, spacing = (2, 3, 4), 0.3
+    try:
+        every = student_springs(task4, shape, spacing, (1, 2, 3))
+        axis = student_springs(task4, shape, spacing, (1,))
+    except Exception:  # the checks say what is wrong
+        return None
+    found = sorted(tuple(sorted(p)) for p in every[0].tolist())
+    return pairs_mistake(found, shape, axis[0]) or rest_mistake(every, shape, spacing)
+
+
+def pairs_mistake(found, shape, axis_springs):
+    """The mistake whose springs are ``found`` (sorted pairs, all neighbours asked for) and
+    ``axis_springs`` (axis neighbours asked for) of a ``shape`` grid, or None."""
+    expected, _ = engine_pairs(shape, (1, 2, 3))
+    twice = sorted(2 * [tuple(sorted(p)) for p in expected])
+    if found == twice:
+        return Recognised(TWICE)
+    for kept in ((1,), (2,), (3,), (1, 2), (1, 3), (2, 3)):
+        pairs, _ = engine_pairs(shape, kept)
+        if found == sorted(tuple(sorted(p)) for p in pairs):
+            missing = [n for n in (1, 2, 3) if n not in kept]
+            names = " and ".join(LENGTHS[n] for n in missing)
+            return Recognised(
+                f"none of squared length {' or '.join(map(str, missing))} was kept: the "
+                f"{names} neighbours are missing"
+            )
+    c_to_f = np.ravel_multi_index(np.unravel_index(np.arange(np.prod(shape)), shape), shape,
+                                  order="F")  # fmt: skip
+    if found == sorted(tuple(sorted(c_to_f[list(p)].tolist())) for p in expected):
+        return Recognised("C order mixed up: particle (i, j, k) is row (i·ny + j)·nz + k")
+    axis = {frozenset(p) for p in axis_springs.tolist()}
+    if axis == set(expected) and len(axis_springs) == len(expected):
+        return Recognised(EVERY_KIND)
+    return None
+
+
+def rest_mistake(springs_and_rest, shape, spacing):
+    """The mistake whose rest lengths are these, for the right springs of a ``shape`` grid of
+    ``spacing``, or None."""
+    springs, rest = springs_and_rest
+    positions = oracles.template_positions(shape, spacing, (0.0, 0.0, 0.0)).reshape(-1, 3)
+    distance = np.linalg.norm(positions[springs[:, 0]] - positions[springs[:, 1]], axis=1)
+    if distance.shape != rest.shape or np.allclose(rest, distance, rtol=1e-12):
+        return None
+    squared = np.round((distance / spacing) ** 2)
+    mistakes = {
+        "rest lengths spacing·(squared length), without the root: a face-diagonal spring is "
+        "spacing·√2 long at rest, a body-diagonal one spacing·√3": spacing * squared,
+        "one rest length, the spacing, for every spring: a face-diagonal spring is "
+        "spacing·√2 long at rest, a body-diagonal one spacing·√3": np.full_like(rest, spacing),
+        "rest lengths in grid units (1, √2, √3), not times the spacing": np.sqrt(squared),
+    }
+    found = matching_variant(rest, mistakes, rtol=1e-9)
+    scale = rest / distance
+    if found is None and np.allclose(scale, scale[0], rtol=1e-9):
+        return Recognised(
+            "rest lengths for another spacing (a constant such as 2/N), not spacing·√(squared "
+            "length) with the spacing given"
+        )
+    return found
+
+
+@functools.lru_cache(maxsize=16)
+def cube_mistake(task4):
+    """The mistake recognised in drop_rotated_cube, or None: the same ratio whatever
+    squared_distances (the springs of every kind, or axis springs only, are built), where the
+    student's grid_springs has no mistake of its own."""
+    if springs_mistake(task4):
+        return None
+    try:
+        axis_only = float(task4.drop_rotated_cube((0.0, 0.0, 1.0), 45.0, (1,)))
+        every = float(task4.drop_rotated_cube((0.0, 0.0, 1.0), 45.0, (1, 2, 3)))
+    except Exception:  # the checks say what is wrong
+        return None
+    if axis_only != every:
+        return None
+    return Recognised(
+        "drop_rotated_cube ignores squared_distances: build the cube with "
+        "grid_springs(..., squared_distances), the springs asked for"
+    )
+
+
 def springs_at_fault(task4):
-    """Why drop_rotated_cube may be wrong because of grid_springs, or None."""
+    """Why drop_rotated_cube may be wrong because of grid_springs, or of the springs it
+    builds (the mistake recognised there, where there is one), or None."""
+    recognised = springs_mistake(task4) or cube_mistake(task4)
+    if recognised:
+        return recognised
     expected, body = engine_pairs((2, 2, 3), (1, 2, 3))
     try:
         springs, rest = student_springs(task4, (2, 2, 3), 1.0, (1, 2, 3))
@@ -68,7 +173,8 @@ def test_neighbour_offsets_26(task4):
         expect(
             offsets.ndim == 2 and offsets.shape[1:] == (3,),
             saw=f"neighbour_offsets({wanted}) has shape {offsets.shape}, expected (M, 3)",
-            cause="no offsets at all: none of squared length "
+            cause=springs_mistake(task4)
+            or "no offsets at all: none of squared length "
             f"{' or '.join(map(str, wanted))} was kept (e.g. a test that leaves out the body "
             "diagonals)"
             if offsets.size == 0
@@ -84,6 +190,7 @@ def test_neighbour_offsets_26(task4):
             cause = "only one of o and -o (both directions are neighbours)"
         else:
             cause = "offsets listed twice, or some of them missing"
+        cause = springs_mistake(task4) or cause
         expect(
             len(offsets) == len(unique) == count and lengths == sorted(wanted),
             saw=f"neighbour_offsets({wanted}) gives {len(offsets)} offsets ({len(unique)} "
@@ -112,7 +219,8 @@ def test_grid_springs_each_pair_once(task4):
             saw=f"for {kinds} springs of a {SHAPE} grid you give {len(springs)} springs, "
             f"{len(expected)} expected: {len(missing)} missing, {len(extra)} that are not "
             f"neighbour pairs, {repeated} listed twice (e.g. particles {example})",
-            cause=every_kind_cause(springs, neighbours)
+            cause=springs_mistake(task4)
+            or every_kind_cause(springs, neighbours)
             or pairs_cause(missing, extra, repeated, len(springs), len(expected)),
         )
 
@@ -122,17 +230,14 @@ def every_kind_cause(springs, neighbours):
     every, _ = engine_pairs(SHAPE, (1, 2, 3))
     given = {frozenset(p) for p in springs.tolist()}
     if tuple(neighbours) != (1, 2, 3) and given == every:
-        return (
-            "springs of every kind (axis, face- and body-diagonal), not only those that "
-            "were asked for with squared_distances"
-        )
+        return EVERY_KIND
     return None
 
 
 def pairs_cause(missing, extra, repeated, given, expected):
     """The usual cause of a wrong list of grid springs."""
     if repeated or (given == 2 * expected and not missing):
-        return "both i→j and j→i listed (a spring counted twice doubles its force)"
+        return TWICE
     if missing and not extra:
         return (
             "springs missing at the border: each offset joins every particle whose "
@@ -156,7 +261,8 @@ def test_rest_lengths_unstressed(task4):
         f"{int(np.sum(springs[:, 0] == springs[:, 1]))} of them joining a particle to itself, "
         f"where the {SHAPE} grid has {len(expected)}: a body without real springs is "
         "unstressed trivially, so this earns no point",
-        cause="springs missing, listed twice, or spring ends left at zero",
+        cause=springs_mistake(task4)
+        or "springs missing, listed twice, or spring ends left at zero",
     )
     expect(
         np.all((springs >= 0) & (springs < len(positions))),
@@ -172,7 +278,7 @@ def test_rest_lengths_unstressed(task4):
         f"{num(distance[worst])} but has rest length {num(rest[worst])}: the body at rest is "
         f"pre-stressed (with k = {stiffness} that spring pulls or pushes with "
         f"{num(stiffness * abs(rest[worst] - distance[worst]))})",
-        cause=rest_length_cause(rest, distance, spacing),
+        cause=springs_mistake(task4) or rest_length_cause(rest, distance, spacing),
     )
 
 
@@ -222,9 +328,12 @@ def test_step_cost_reports_springs_and_time(task4, own_numbers):
             springs == expected,
             saw=f"step_cost({n}, {neighbours}) counts {springs} springs, a {n}³ grid has "
             f"{expected}",
-            cause="springs counted twice"
-            if springs == 2 * expected
-            else "the wrong neighbours, or a grid other than n³ (is n ignored?)",
+            cause=springs_mistake(task4)
+            or (
+                "springs counted twice"
+                if springs == 2 * expected
+                else "the wrong neighbours, or a grid other than n³ (is n ignored?)"
+            ),
         )
         expect(
             math.isfinite(seconds) and 0 < seconds < 1.0,

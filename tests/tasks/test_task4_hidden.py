@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from test_task4 import springs_at_fault, springs_mistake
 
 from msdlab.course import oracles
 from msdlab.course.feedback import as_array, expect, num, percent
@@ -56,6 +57,7 @@ def test_any_grid_shape_and_neighbours(task4, shape, neighbours, spacing):
         )
     else:
         cause = "a loop bound or border test that only works for some grid sizes"
+    cause = springs_mistake(task4) or cause
     expect(
         len(found) == len(expected) and set(found) == expected,
         saw=f"for a {shape} grid with neighbours {neighbours}: {len(found)} springs given, "
@@ -67,10 +69,13 @@ def test_any_grid_shape_and_neighbours(task4, shape, neighbours, spacing):
         np.allclose(rest, distance, rtol=1e-9),
         saw=f"rest lengths differ from the distances at rest by up to "
         f"{num(np.max(np.abs(rest - distance), initial=0.0))}",
-        cause="rest lengths not scaled by the spacing"
-        if np.allclose(rest, distance / spacing, rtol=1e-9)
-        else "rest lengths that are not spacing·√(squared length) of each spring (the "
-        "distance at rest)",
+        cause=springs_mistake(task4)
+        or (
+            "rest lengths not scaled by the spacing"
+            if np.allclose(rest, distance / spacing, rtol=1e-9)
+            else "rest lengths that are not spacing·√(squared length) of each spring (the "
+            "distance at rest)"
+        ),
     )
 
 
@@ -84,7 +89,7 @@ def test_cube_tilted_about_x_holds(task4):
         got > 0.9 and abs(got - expected) < 0.1,
         saw=f"tilted 30° about x the flatness ratio is {num(got)} (the experiment gives "
         f"{num(expected)})",
-        cause="missing diagonal springs",
+        cause=springs_at_fault(task4) or "missing diagonal springs",
     )
     for axis, angle in (((1.0, 0.0, 0.0), 30.0), ((0.0, 0.0, 1.0), 45.0)):
         got = float(task4.drop_rotated_cube(axis, angle, (1, 2, 3)))
@@ -93,7 +98,8 @@ def test_cube_tilted_about_x_holds(task4):
             abs(got - expected) <= SAME_EXPERIMENT,
             saw=f"with 26 neighbours, tilted {angle}° about {axis}, the flatness ratio is "
             f"{num(got, 8)}; the experiment as described gives {num(expected, 8)}",
-            cause="a different experiment: check the spacing, the rotation, the lift to "
+            cause=springs_at_fault(task4)
+            or "a different experiment: check the spacing, the rotation, the lift to "
             "y = LIFT, the number of steps, dt, gravity and the floor",
         )
 
@@ -106,13 +112,15 @@ def test_drop_rotated_cube_runs_the_steps_asked_for(task4):
         abs(still - 1.0) < 0.01,
         saw=f"drop_rotated_cube(..., steps=1) = {num(still)}: in a single step the cube "
         "cannot change its shape that much",
-        cause="the number of steps is ignored (run `steps` steps, not a fixed number)",
+        cause=springs_at_fault(task4)
+        or "the number of steps is ignored (run `steps` steps, not a fixed number)",
     )
     folded = float(task4.drop_rotated_cube((0.0, 0.0, 1.0), 45.0, (1,)))
     expect(
         folded < 0.3,
         saw=f"with all its steps the tilted cube with axis springs only kept {percent(folded)} "
         "of its thickness, as after one step: it should fold flat",
-        cause="a ratio that does not come from the run (run `steps` steps and measure the "
+        cause=springs_at_fault(task4)
+        or "a ratio that does not come from the run (run `steps` steps and measure the "
         "flatness of the cube they leave)",
     )
