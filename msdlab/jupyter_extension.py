@@ -12,6 +12,8 @@ arrive in pairs and unevenly. The extension swaps the kernel websocket connectio
 A course notebook marked to be kept without outputs (`msdlab.course.notebook_file`) is
 saved without them under its own name (`save_as_kept`), so running one in a checkout of
 the course leaves git's copy unchanged; a copy saved under another name keeps its outputs.
+Every course notebook, the students' too, is saved with its language described as it
+ships (no Python version that the kernel adds), so a save changes only what the user did.
 
 The package installs ``msdlab/jupyter-config/msdlab.json`` as
 ``<sys.prefix>/etc/jupyter/jupyter_server_config.d/msdlab.json`` (editable installs
@@ -27,7 +29,7 @@ from typing import Any
 
 from jupyter_server.services.kernels.connection.channels import ZMQChannelsWebsocketConnection
 
-from .course.notebook_file import as_kept, marked_name, unmarked
+from .course.notebook_file import as_kept, is_marked, language_as_shipped, marked_name, unmarked
 
 SETTING = "kernel_websocket_connection_class"
 
@@ -47,11 +49,15 @@ def _jupyter_server_extension_points() -> list[dict[str, str]]:
 
 
 def save_as_kept(model: dict[str, Any], path: str = "", **_: Any) -> None:
-    """Jupyter's pre-save hook: a course notebook saved as the file it is marked for is
-    written without its outputs; saved as another file (``path``, from the server's root),
-    it loses the mark and keeps them."""
+    """Jupyter's pre-save hook: a course notebook saved as the file it is marked to be kept
+    as is written without its outputs; saved as another file (``path``, from the server's
+    root), it loses the mark and keeps them. A course notebook's language is described as
+    it ships."""
     notebook = model.get("content") or {}
-    name = marked_name(notebook) if model.get("type") == "notebook" else None
+    if model.get("type") != "notebook" or not is_marked(notebook):
+        return
+    language_as_shipped(notebook)
+    name = marked_name(notebook)
     if name is None:
         return
     if name == PurePosixPath(path).name:

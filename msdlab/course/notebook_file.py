@@ -5,12 +5,16 @@ its own file name (``"msdlab": {"save_outputs": false, "file": "task2.ipynb"}``)
 msdlab's Jupyter server extension writes a marked notebook in the same form whenever
 Jupyter saves it under that name (`as_kept`), so running it in a checkout leaves the file
 as git has it; saved under another name (a copy to keep one's outputs), it drops the mark.
-The student release drops the mark too (`unmarked`): there a notebook keeps its outputs,
-as in any Jupyter.
+The student release marks its notebooks to keep their outputs
+(``"msdlab": {"save_outputs": true, "file": "task2.ipynb"}``, `for_students`), as in any
+Jupyter. Every marked notebook is saved with the language described as it ships
+(`language_as_shipped`): a kernel adds the version of the Python that runs it, which would
+change the file on its first save and differs from machine to machine.
 """
 
 from __future__ import annotations
 
+import json
 from typing import Any
 
 # The notebook metadata build.py writes: the kernel ``python3`` that ipykernel installs in
@@ -51,6 +55,25 @@ def as_kept(notebook: dict[str, Any], name: str) -> None:
         if cell["cell_type"] == "code":
             cell["outputs"] = []
             cell["execution_count"] = None
+
+
+def for_students(notebook: dict[str, Any], name: str) -> None:
+    """Mark ``notebook`` (as JSON, in place) as the students' copy of the course notebook
+    ``name``: saved with its outputs, and with the language described as it ships."""
+    notebook.setdefault("metadata", {})["msdlab"] = {"save_outputs": True, "file": name}
+
+
+def is_marked(notebook: dict[str, Any]) -> bool:
+    """Whether ``notebook`` (as JSON) is a course notebook: the checkout's or the students'."""
+    return isinstance(notebook.get("metadata", {}).get("msdlab"), dict)
+
+
+def language_as_shipped(notebook: dict[str, Any]) -> None:
+    """The notebook's language described as the course ships it (in place): a Python kernel's
+    description without the version of the Python that ran it; another language is left."""
+    metadata = notebook.get("metadata", {})
+    if (metadata.get("language_info") or {}).get("name") == METADATA["language_info"]["name"]:
+        metadata["language_info"] = json.loads(json.dumps(METADATA["language_info"]))
 
 
 def unmarked(notebook: dict[str, Any]) -> None:

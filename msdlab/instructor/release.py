@@ -1,7 +1,7 @@
 """The student release: the engine, the templates, the notebooks and the public checks.
 
 `build` copies what ships (see `release_rules`) into a new folder, the notebooks
-without outputs and unmarked (their outputs are saved), writes the students'
+without outputs and marked as the students' (their outputs are saved), writes the students'
 README, ``.gitignore``, pyproject and the points manifest (what the hidden
 checks, which do not ship, are worth), and refuses to finish if any line of a solution block
 turns up anywhere in the bundle.
@@ -219,12 +219,12 @@ def write_points(checks: Path, path: Path) -> None:
 def _write_for_students(source: Path, target: Path, own: own_numbers.Numbers) -> None:
     """Copy a notebook without outputs or execution counts (a run in the checkout shows the
     solutions'), its cells made from its source (``src/NAME.py`` beside it) with the
-    student's numbers ``own``, unmarked: the students' Jupyter saves their outputs
-    (`notebook_file`)."""
+    student's numbers ``own``, marked as the students' copy: their Jupyter saves their
+    outputs, and no metadata of its own (`notebook_file`)."""
     notebook = json.loads(source.read_text(encoding="utf-8"))
     cells = source.parent / "src" / f"{source.stem}.py"
     if cells.is_file():
         notebook["cells"] = notebook_source.notebook_cells(cells, own)
     notebook_file.as_kept(notebook, source.name)
-    notebook_file.unmarked(notebook)
+    notebook_file.for_students(notebook, source.name)
     target.write_text(json.dumps(notebook, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")

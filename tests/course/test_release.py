@@ -38,7 +38,8 @@ def test_bundle_has_engine_templates_public_checks_and_no_answers(bundle):
 
 
 def test_notebooks_ship_without_outputs_and_save_the_students(bundle):
-    """No outputs of the solutions; unmarked, so the students' Jupyter saves their outputs."""
+    """No outputs of the solutions; marked as the students', so their Jupyter saves their
+    outputs."""
     notebooks = sorted((bundle / "notebooks").glob("*.ipynb"))
     if not (PROJECT_ROOT / "notebooks").is_dir():
         pytest.skip("the course has no notebooks yet")
@@ -47,7 +48,8 @@ def test_notebooks_ship_without_outputs_and_save_the_students(bundle):
         notebook = json.loads(path.read_text())
         code = [c for c in notebook["cells"] if c["cell_type"] == "code"]
         assert all(c.get("outputs", []) == [] for c in code), path
-        assert "msdlab" not in notebook["metadata"], path
+        mark = {"save_outputs": True, "file": path.name}
+        assert notebook["metadata"]["msdlab"] == mark, path
 
 
 def test_a_solution_line_anywhere_stops_the_release(tmp_path):

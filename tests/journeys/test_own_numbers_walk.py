@@ -87,7 +87,7 @@ def test_her_task_file_and_notebook_show_her_numbers(bundle):
     notebook = json.loads((bundle / "notebooks" / "task1.ipynb").read_text())
     text = "\n".join(cell["source"] for cell in notebook["cells"])
     assert f"(0, {alice.gravity}, 0)" in text and "(0, -0.001, 0)" not in text
-    assert "msdlab" not in notebook["metadata"]  # her Jupyter keeps her outputs
+    assert notebook["metadata"]["msdlab"]["save_outputs"] is True  # her Jupyter keeps them
 
 
 def test_the_notebook_runs_on_the_kernel_it_names_with_her_numbers(bundle, student):

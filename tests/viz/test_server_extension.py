@@ -14,6 +14,7 @@ from jupyter_server.services.contents.filemanager import FileContentsManager
 from jupyter_server.services.kernels.connection.channels import ZMQChannelsWebsocketConnection
 
 from msdlab import jupyter_extension
+from msdlab.course import notebook_file
 from msdlab.jupyter_extension import SETTING, NoDelayConnection
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -135,3 +136,56 @@ def test_other_notebooks_keep_their_outputs(tmp_path):
         cell.get("outputs") for cell in run["cells"]
     ]
     assert any(cell.get("outputs") for cell in saved["cells"])
+
+
+def for_students(kept: dict, name: str) -> dict:
+    """The notebook ``kept`` as the student release ships it (`release._write_for_students`)."""
+    notebook = json.loads(json.dumps(kept))
+    notebook_file.as_kept(notebook, name)
+    notebook_file.for_students(notebook, name)
+    return notebook
+
+
+def test_a_students_notebook_run_and_saved_keeps_its_outputs_and_its_metadata(tmp_path):
+    """In the release: the run's outputs are saved, the metadata as shipped (the kernel's
+    Python version is not written), and saved again nothing changes."""
+    shipped = for_students(
+        json.loads((ROOT / "notebooks" / "task2.ipynb").read_text()), "task2.ipynb"
+    )
+    ran = after_a_run(
+        shipped, json.loads((ROOT / "docs" / "notebooks" / "task2.ipynb").read_text())
+    )
+    outputs = [cell.get("outputs") for cell in ran["cells"]]
+    saved = save(tmp_path, "task2.ipynb", ran)
+    assert json.loads(saved)["metadata"] == shipped["metadata"]
+    assert [cell.get("outputs") for cell in json.loads(saved)["cells"]] == outputs
+    again = json.loads(saved)
+    again["metadata"]["language_info"]["version"] = sys.version.split()[0]  # from the kernel
+    assert save(tmp_path, "task2.ipynb", again) == saved
+
+
+def test_a_notebook_of_another_language_keeps_its_description(tmp_path):
+    shipped = for_students(json.loads((ROOT / "notebooks" / "task2.ipynb").read_text()), "x.ipynb")
+    shipped["metadata"]["language_info"] = {"name": "R", "version": "4.4.1"}
+    saved = json.loads(save(tmp_path, "x.ipynb", shipped))
+    assert saved["metadata"]["language_info"] == {"name": "R", "version": "4.4.1"}
+
+
+def test_the_shipped_metadata_is_what_the_kernel_says_but_its_python_version():
+    """The kernel the notebooks name is ipykernel's python3 as this environment has it, and
+    its description of the language is the notebooks' but for the version of its Python."""
+    kernelspec = pytest.importorskip("jupyter_client.kernelspec")
+    from jupyter_client.manager import start_new_kernel
+
+    spec = kernelspec.KernelSpecManager().get_kernel_spec("python3")
+    named = notebook_file.METADATA["kernelspec"]
+    assert (spec.display_name, spec.language) == (named["display_name"], named["language"])
+    manager, client = start_new_kernel(kernel_name="python3")
+    try:
+        reply = client.kernel_info(reply=True, timeout=60)
+    finally:
+        client.stop_channels()
+        manager.shutdown_kernel(now=True)
+    described = reply["content"]["language_info"]
+    assert described.pop("version") == ".".join(map(str, sys.version_info[:3]))
+    assert described == notebook_file.METADATA["language_info"]
