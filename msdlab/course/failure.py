@@ -68,19 +68,21 @@ def failing_inputs(note: str) -> str:
 
 def _arguments(text: str) -> dict[str, tuple[str, bool]]:
     """name -> (value, whether Hypothesis says any other value fails too), from the lines
-    ``name=value,  # comment`` of a note; the task modules are left out."""
+    ``name=value,  # comment`` of a note (a value over several lines, such as a tuple whose
+    parts carry comments of their own, joined without them); the task modules are left out."""
     found: dict[str, list[str]] = {}
+    any_value: dict[str, bool] = {}
     for line in text.strip().splitlines():
-        start = re.match(r"\s*(\w+)=(.*)$", line)
+        code, _, comment = line.partition("  #")
+        start = re.match(r"\s*(\w+)=(.*)$", code)
         if start:
-            found[start[1]] = [start[2]]
-        elif found:
-            found[list(found)[-1]].append(line.strip())
+            found[start[1]] = [start[2].strip()]
+            any_value[start[1]] = ANY_VALUE.lstrip("# ") in comment
+        elif found and code.strip() and not code.strip().startswith("#"):
+            found[list(found)[-1]].append(code.strip())
     arguments = {}
     for name, lines in found.items():
-        value = " ".join(lines)
-        any_value = ANY_VALUE in value
-        value = value.split("  #", 1)[0].strip().rstrip(",")
+        value = " ".join(lines).strip().rstrip(",").replace("( ", "(").replace(", )", ")")
         if not value.startswith("<task module"):
-            arguments[name] = (value, any_value)
+            arguments[name] = (value, any_value[name])
     return arguments

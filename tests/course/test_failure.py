@@ -42,6 +42,20 @@ def test_the_failing_input_plainly():
     assert failure.failing_inputs("You can add @seed(1) to this test") == ""
 
 
+def test_a_tuple_over_several_lines_is_one_input():
+    """Hypothesis writes a tuple whose parts may vary on lines of their own, each with its
+    comment; the student reads the tuple."""
+    note = (
+        "Failing test case: f(\n    # The test always failed when commented parts were varied "
+        "together.\n    shape=(\n        1,  # or any other generated value\n        1,  # or "
+        "any other generated value\n        2,\n    ),\n    spacing=1.0,  # or any other "
+        "generated value\n)"
+    )
+    assert (
+        failure.failing_inputs(note) == "the inputs that failed: shape = (1, 1, 2), spacing = 1.0"
+    )
+
+
 def test_the_line_of_a_sandboxed_task_file_that_raised(serve_task):
     """Run in the grader's sandbox, an error names the line of the submission as a check run
     in one process does (the file by its name in the submission), and a to-do its function
