@@ -33,7 +33,7 @@ class StepState:
     time: float  # time at the end of the step (s)
     dt: float  # step (s)
     energy_of: Callable[[np.ndarray], float]  # energy (J) involving these particles now
-    kernel: SpringKernel | None = None  # the simulation's kernel: its compiled loops, if any
+    kernel: SpringKernel  # the step's backend (its `ground_clamp`)
 
 
 class Constraint(ABC):

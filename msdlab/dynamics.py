@@ -13,8 +13,9 @@ from . import equations
 from .body import Body
 from .forces import Force
 from .jacobian import JacobianPattern
+from .kernel_results import Update
 from .kernels import NumpyKernel
-from .spring_kernel import SpringKernel, Update, kernel_left_to_msdlab, make_kernel
+from .spring_kernel import SpringKernel, kernel_left_to_msdlab, make_kernel
 
 
 def keep_acceleration(
@@ -60,8 +61,6 @@ class Dynamics:
         self._last_pass: SpringPass | None = None  # of the last force evaluation
         self._pattern: JacobianPattern | None = None
         self._dashpots = (-1, True)  # (body version, whether any spring has a dashpot)
-        # `equations.damping_work` (J) for the ledger: the kernel's compiled sum, if it has one
-        self.damping_work = getattr(self.chosen, "damping_work", equations.damping_work)
 
     @property
     def kernel(self) -> str:
@@ -96,22 +95,8 @@ class Dynamics:
     def acceleration(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Acceleration of each particle (N, d) in m/s², a = (F + m·g)/m: F the spring,
         dashpot and other forces, g the uniform fields (gravity, `Force.uniform_acceleration`);
-        zero for fixed particles. A kernel with a fused `SpringKernel.advance` computes it
-        in its compiled loop (`keep_acceleration`)."""
-        if getattr(self.springs, "advance", None) is not None:
-            return self.advance(keep_acceleration, x, v, 0.0)[0]
-        total, field = np.zeros_like(x), np.zeros(x.shape[1])
-        self._spring_pass(x, v, total)
-        for force in self.forces:
-            g = force.uniform_acceleration(self.body)
-            if g is None:
-                force.add_to(self.body, x, v, total)
-            else:
-                field += g
-        masses = self.body.masses[:, None]
-        if field.any():
-            total += masses * field
-        return equations.acceleration(total, masses, ~self.body.fixed[:, None])
+        zero for fixed particles. The backend's `advance` with `keep_acceleration`."""
+        return self.advance(keep_acceleration, x, v, 0.0)[0]
 
     def advance(
         self, update: Update, x: np.ndarray, v: np.ndarray, dt: float, *coefficients: float
@@ -119,13 +104,10 @@ class Dynamics:
         """``update(x, v, a, dt, *coefficients)`` with a = `acceleration` (x, v): one step.
 
         ``update`` is a function of arrays or numbers (like `integrators.Verlet.update`)
-        returning the new (x, v). A kernel with a fused `SpringKernel.advance` (the
-        numba kernel) runs the springs' pass, a and the update together, compiled into
-        one loop; otherwise this is the update on whole arrays.
+        returning the new (x, v). The backend's `SpringKernel.advance` runs it: the numpy
+        backend on whole arrays, the numba backend compiled into one loop with the springs'
+        pass and a. The uniform fields go in as g, the other forces as an array.
         """
-        fused = getattr(self.springs, "advance", None)
-        if fused is None:
-            return update(x, v, self.acceleration(x, v), dt, *coefficients)
         field, others = np.zeros(x.shape[1]), None  # Σ g (m/s²); the other forces (N)
         for force in self.forces:
             g = force.uniform_acceleration(self.body)
@@ -134,7 +116,7 @@ class Dynamics:
                 continue
             others = np.zeros_like(x) if others is None else others
             force.add_to(self.body, x, v, others)
-        step = fused(update, self.body, x, v, field, dt, coefficients, others)
+        step = self.springs.advance(update, self.body, x, v, field, dt, coefficients, others)
         self.max_stretch = step.stretch
         self._last_pass = SpringPass(weakref.ref(x), weakref.ref(v), step.power)
         return step.x, step.v

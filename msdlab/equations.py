@@ -93,6 +93,31 @@ def contact_work(
     return 0.5 * float(np.einsum("i,ij,ij->", masses, kick, v_before + v_after))
 
 
+def ground_contact(
+    mass: float,
+    landing: float,
+    moved: float,
+    before: float,
+    tangential_squared: float,
+    dt: float,
+    keep: float,
+) -> tuple[float, float]:
+    """The ground's kick on a particle put back on its plane: the new normal speed (m/s) and
+    the energy (J) the ground removed in the step.
+
+    The particle ended the step with normal velocity ``landing`` v·n and tangential speed²
+    ``tangential_squared`` |v_t|² (m²/s²), started it with normal velocity ``before``
+    v_old·n, and really moved ``moved`` (x - x_old)·n (m) along n. Its normal speed becomes
+    ṡ = moved/dt, what position Verlet implies (no bounce, no sticking), and its tangential
+    velocity is kept times ``keep`` = 1 - friction. Removed: friction's loss
+    (1 - keep²)·½ m |v_t|² minus the contact's work ½ m (ṡ - v·n)(v·n_old + ṡ)
+    (`contact_work` of the kick ṡ - v·n).
+    """
+    normal_speed = moved / dt
+    work = 0.5 * mass * (normal_speed - landing) * (before + normal_speed)
+    return normal_speed, 0.5 * (1.0 - keep * keep) * mass * tangential_squared - work
+
+
 def damping_work(
     masses: np.ndarray, v_before: np.ndarray, v_after: np.ndarray, factor: float
 ) -> float:

@@ -1,7 +1,8 @@
-"""What a spring kernel returns, by name (`spring_kernel.SpringKernel`)."""
+"""What a backend returns, by name, and what it is given (`spring_kernel.SpringKernel`)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
@@ -29,3 +30,8 @@ class Advanced(NamedTuple):
     v: np.ndarray  # velocities (N, d) in m/s
     stretch: float
     power: float
+
+
+# An integrator's update ``update(x, v, a, dt, *coefficients) -> (x_new, v_new)``, a function
+# of numbers or whole arrays (like `integrators.Verlet.update`).
+Update = Callable[..., tuple[np.ndarray, np.ndarray]]

@@ -1,12 +1,12 @@
-"""The numpy spring kernel: forces (eq. 1.1-1.2), energy, dashpot power and Jacobians of all
-springs, on whole arrays.
+"""The numpy backend: forces (eq. 1.1-1.2), energy, dashpot power and Jacobians of all
+springs, a step's update, and the ground's clamp, on whole arrays.
 
-`NumpyKernel` is the readable reference of the kernel interface
+`NumpyKernel` is the readable reference of the backend contract
 (`spring_kernel.SpringKernel`): the functions of this module, which apply
 `msdlab.equations` to the (E, d) arrays of all springs at once. Every other
-backend is tested against it, method by method. The numba kernel
+backend is tested against it, method by method. The numba backend
 (`msdlab.compiled.NumbaKernel`, the default) applies the same equations one
-spring at a time in compiled loops.
+spring or particle at a time in compiled loops.
 
 Every function takes the spring arrays of a `Body` (``a``, ``b`` particle indices,
 ``k`` stiffness, ``rest`` rest lengths, ``c`` dashpot coefficients) and computes,
@@ -20,7 +20,7 @@ import numpy as np
 from . import equations
 from .body import Body
 from .jacobian import JacobianPattern
-from .kernel_results import Jacobians, SpringSums
+from .kernel_results import Advanced, Jacobians, SpringSums, Update
 
 
 def spring_vectors(body: Body, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -116,15 +116,74 @@ def finite(x: np.ndarray, v: np.ndarray) -> bool:
     return bool(np.isfinite(x).all() and np.isfinite(v).all())
 
 
-class NumpyKernel:
-    """The readable kernel (`spring_kernel.SpringKernel`): the functions above on whole arrays.
+def advance(
+    update: Update,
+    body: Body,
+    x: np.ndarray,
+    v: np.ndarray,
+    field: np.ndarray,
+    dt: float,
+    coefficients: tuple[float, ...],
+    forces: np.ndarray | None = None,
+) -> Advanced:
+    """``update(x, v, a, dt, *coefficients)`` on whole arrays, a = (F + m·g)/m (0 if fixed):
+    F the spring forces plus ``forces`` (N, d) if given, g = ``field`` (d,) in m/s²."""
+    total = np.zeros_like(x)
+    sums = add_spring_forces(body, x, v, total)
+    total = total if forces is None else total + forces
+    masses = body.masses[:, None]
+    if field.any():
+        total += masses * field
+    a = equations.acceleration(total, masses, ~body.fixed[:, None])
+    return Advanced(*update(x, v, a, dt, *coefficients), *sums)
 
-    It has no fused `advance`: `Dynamics` computes a = F/m and runs the update on
-    whole arrays, which is what an integrator's formula reads as.
+
+def ground_clamp(
+    x: np.ndarray,
+    v: np.ndarray,
+    x_old: np.ndarray,
+    v_old: np.ndarray,
+    masses: np.ndarray,
+    fixed: np.ndarray,
+    normal: np.ndarray,
+    height: float,
+    dt: float,
+    friction: float,
+) -> float:
+    """Put the free particles with x·n < ``height`` back on the plane, in place, and return the
+    energy (J) the ground removed (`equations.ground_contact` per particle).
+
+    ``normal`` n (d,) is a unit vector; x, v are the step's new state (N, d), x_old and v_old
+    its start.
     """
+    candidates = (x @ normal < height).nonzero()[0]
+    below = candidates[~fixed[candidates]]  # fixed ones only among the few below
+    if len(below) == 0:
+        return 0.0
+    y, u = x.take(below, axis=0), v.take(below, axis=0)
+    depth = height - y @ normal
+    y += depth[:, None] * normal
+    x[below] = y
+    landing = u @ normal  # the normal velocity the step ended with (m/s)
+    moved = (y - x_old.take(below, axis=0)) @ normal
+    tangential = u - landing[:, None] * normal
+    keep = 1.0 - friction
+    normal_speed, removed = equations.ground_contact(
+        masses.take(below), landing, moved, v_old.take(below, axis=0) @ normal,
+        np.einsum("ij,ij->i", tangential, tangential), dt, keep,
+    )  # fmt: skip
+    v[below] = keep * tangential + normal_speed[:, None] * normal
+    return float(np.sum(removed))
+
+
+class NumpyKernel:
+    """The readable backend (`spring_kernel.SpringKernel`): the functions above on whole arrays."""
 
     name = "numpy"
     spring_forces = staticmethod(add_spring_forces)
     elastic_energy = staticmethod(elastic_energy)
     jacobians = staticmethod(spring_jacobians)
     finite = staticmethod(finite)
+    advance = staticmethod(advance)
+    damping_work = staticmethod(equations.damping_work)
+    ground_clamp = staticmethod(ground_clamp)

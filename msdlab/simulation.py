@@ -193,7 +193,7 @@ class Simulation:
         elif (factor := integrator.velocity_factor) == 1.0:
             damping = 0.0
         else:  # Integrator.dissipated_energy's work of the velocity factor
-            damping = self.dynamics.damping_work(body.masses, v, v_new, factor)
+            damping = self.dynamics.springs.damping_work(body.masses, v, v_new, factor)
         booked = {"dashpot": self.dynamics.dashpot_power(x, v) * dt, "integrator": damping}
         for force in self.dynamics.forces:
             if type(force).dissipated_power is Force.dissipated_power:

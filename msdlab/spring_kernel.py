@@ -1,14 +1,13 @@
-"""The spring kernel interface: what `Dynamics` needs from a backend, and choosing one.
+"""The backend contract: what `Dynamics`, `Simulation` and `Ground` need from a backend.
 
-A spring kernel computes, for all springs of a body at once, what `Spring.force`
-computes for one (eq. 1.1-1.2 with the dashpot), their energy and their
-Jacobians. `SpringKernel` is the whole contract, five methods, the last one
-optional; `Dynamics` calls only these and never knows which backend runs:
-`kernels.NumpyKernel` (readable, whole arrays, the reference every backend is
-tested against) or `msdlab.compiled.NumbaKernel` (compiled loops, the default).
-Both apply the same `msdlab.equations`. Everything else (a = F/m, the ledger's
-sums) is plain numpy in `Dynamics` and `msdlab.energy`. What the methods return is named in
-`msdlab.kernel_results`.
+A backend computes, for all springs of a body at once, what `Spring.force` computes for
+one (eq. 1.1-1.2 with the dashpot), their energy and Jacobians, and steps the particles
+with an integrator's update; it also checks the state and sums the integrator's damping
+work and the ground's clamp for the ledger. `SpringKernel` is the whole contract, seven
+methods, none optional; nothing else asks a backend for more, and nothing asks which one
+runs: `kernels.NumpyKernel` (readable, whole arrays, the reference every backend is tested
+against) or `msdlab.compiled.NumbaKernel` (compiled loops, the default). Both apply the
+same `msdlab.equations`. What the methods return is named in `msdlab.kernel_results`.
 """
 
 from __future__ import annotations
@@ -16,30 +15,25 @@ from __future__ import annotations
 import os
 import sys
 import warnings
-from collections.abc import Callable
 from typing import Protocol
 
 import numpy as np
 
 from .body import Body
 from .jacobian import JacobianPattern
-from .kernel_results import Advanced, Jacobians, SpringSums
+from .kernel_results import Advanced, Jacobians, SpringSums, Update
 from .kernels import NumpyKernel
 
 KERNELS = ("numba", "numpy")
-Update = Callable[..., tuple[np.ndarray, np.ndarray]]
 
 
 class SpringKernel(Protocol):
-    """What `Dynamics` needs from a spring kernel; `NumpyKernel` and `NumbaKernel` have it.
+    """What a backend provides; `NumpyKernel` and `NumbaKernel` have all of it.
 
     ``body`` is a `Body` (its spring arrays ``spring_a``, ``spring_b``,
     ``spring_values``; ``masses``, ``fixed``), ``x`` and ``v`` are positions (m) and
     velocities (m/s), (N, d) float64 with d = 2 or 3. ``springs`` (indices) restricts
-    a method to some springs. `advance` is optional: without it `Dynamics`
-    computes a = F/m and runs the update on whole arrays. A kernel may also offer
-    a faster `equations.damping_work` for the ledger and a ``ground_clamp`` for
-    `interaction.Ground` (the numba kernel does).
+    a method to some springs.
     """
 
     name: str
@@ -52,7 +46,8 @@ class SpringKernel(Protocol):
         out: np.ndarray,
         springs: np.ndarray | None = None,
     ) -> SpringSums:
-        """Add the spring and dashpot forces (N), eq. (1.1)-(1.2), to ``out`` (N, d)."""
+        """Add the spring and dashpot forces (N), eq. (1.1)-(1.2), to ``out`` (N, d); with the
+        largest stretch and the dashpots' power (W) of the same pass."""
 
     def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
         """Energy (J) stored in the springs, Σ ½ k (|x_a - x_b| - l)²."""
@@ -77,9 +72,30 @@ class SpringKernel(Protocol):
         """``update(x, v, a, dt, *coefficients)`` with a = (F + m·g)/m, 0 for fixed particles.
 
         F is the spring forces plus ``forces`` (N, d) in N, the other forces, if given;
-        g = ``field`` (d,) in m/s². Optional: a backend that has it runs the springs'
-        pass, a = F/m and the update together (the numba kernel: one loop).
+        g = ``field`` (d,) in m/s². The numpy backend does it in three lines on arrays;
+        the numba backend runs the springs' pass, a and the update in compiled loops.
         """
+
+    def damping_work(
+        self, masses: np.ndarray, v_before: np.ndarray, v_after: np.ndarray, factor: float
+    ) -> float:
+        """`equations.damping_work` (J): the work of a velocity factor per step."""
+
+    def ground_clamp(
+        self,
+        x: np.ndarray,
+        v: np.ndarray,
+        x_old: np.ndarray,
+        v_old: np.ndarray,
+        masses: np.ndarray,
+        fixed: np.ndarray,
+        normal: np.ndarray,
+        height: float,
+        dt: float,
+        friction: float,
+    ) -> float:
+        """`interaction.Ground`: the free particles below the plane put back on it, in place
+        (`kernels.ground_clamp`); the energy (J) the ground removed."""
 
 
 def default_kernel() -> str:

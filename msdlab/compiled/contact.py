@@ -1,28 +1,22 @@
 """The ground's clamp in one loop over the particles, with its booking on the way.
 
-`interaction.Ground.apply` on numpy arrays takes some thirty numpy calls on the
-few particles below the plane, which for a small body cost more than its
-springs; this loop does the same per particle: put it back on the plane, keep
-its tangential velocity (times 1 - friction), give it the normal velocity of the
-displacement it really made, and sum the contact's work (`equations.contact_work`)
-and the friction's loss (`energy.kinetic_energy_removed`).
+The numpy backend's `kernels.ground_clamp` takes some thirty numpy calls on the few
+particles below the plane, which for a small body cost more than its springs; this loop
+does the same per particle: put it back on the plane and apply
+`equations.ground_contact` (its new normal speed and the energy removed).
 """
 
 import numba
+
+from .equations import ground_contact
 
 
 @numba.njit(cache=True)
 def ground_clamp(x, v, x_old, v_old, masses, fixed, normal, height, dt, friction):
     """Clamp the free particles with x·n < ``height`` onto the plane, in place; return the
-    energy (J) the ground removed: friction's loss minus the contact's work.
-
-    For such a particle (n = ``normal``, unit): x += (height - x·n) n;
-    ṡ = (x - x_old)·n / dt; v ← (1 - friction)(v - (v·n) n) + ṡ n. The contact's
-    work is ½ m (ṡ - v·n)(v_old·n + ṡ), friction's loss (1 - (1 - friction)²) ½ m |v_t|².
-    """
+    energy (J) the ground removed (`kernels.ground_clamp`, one particle at a time)."""
     keep = 1.0 - friction
-    work = 0.0
-    rubbed = 0.0
+    removed = 0.0
     dim = x.shape[1]
     for i in range(len(x)):
         above = 0.0
@@ -37,12 +31,12 @@ def ground_clamp(x, v, x_old, v_old, masses, fixed, normal, height, dt, friction
             landing += v[i, q] * normal[q]
             moved += (x[i, q] - x_old[i, q]) * normal[q]
             before += v_old[i, q] * normal[q]
-        normal_speed = moved / dt
         tangential = 0.0
         for q in range(dim):
-            along = v[i, q] - landing * normal[q]
-            tangential += along * along
-            v[i, q] = keep * along + normal_speed * normal[q]
-        work += masses[i] * (normal_speed - landing) * (before + normal_speed)
-        rubbed += masses[i] * tangential
-    return 0.5 * (1.0 - keep * keep) * rubbed - 0.5 * work
+            v[i, q] -= landing * normal[q]
+            tangential += v[i, q] * v[i, q]
+        normal_speed, lost = ground_contact(masses[i], landing, moved, before, tangential, dt, keep)
+        removed += lost
+        for q in range(dim):
+            v[i, q] = keep * v[i, q] + normal_speed * normal[q]
+    return removed

@@ -56,7 +56,7 @@ class Ground(Constraint):
     which is what position Verlet implies: no bounce, no sticking.
 
     The ledger books the work of the contact force, not the energy difference
-    across the clamp (`msdlab.energy.contact_work`): the clamp gives each
+    across the clamp (`msdlab.equations.ground_contact`): the clamp gives each
     particle a kick Δv along the normal, and the force m·Δv/dt works at the
     particle's mean velocity over the step. A particle held at rest gets no
     work; one that lands loses energy, and with Verlet the ground never puts
@@ -64,9 +64,8 @@ class Ground(Constraint):
     x(t+dt) is on the plane and x(t-dt) was not below it). A body at rest on the
     ground books nothing. Friction books the kinetic energy it takes out of the tangential velocity.
 
-    A kernel with a ``ground_clamp`` loop (the numba kernel) does all this in one
-    compiled pass over the particles, the same arithmetic per particle; `apply` on
-    numpy arrays is the readable reference that loop is tested against.
+    The step's backend does it (`SpringKernel.ground_clamp`): `kernels.ground_clamp` on
+    numpy arrays, the readable reference, or one compiled pass over the particles.
     """
 
     ledger_name = "ground"
@@ -98,38 +97,10 @@ class Ground(Constraint):
             )
 
     def apply(self, state: StepState) -> float:
-        n = _UP[state.body.dim] if self.normal is None else self.normal
-        clamp = getattr(state.kernel, "ground_clamp", None)  # the kernel's loop, if it has one
-        if clamp is not None:
-            body = state.body
-            arrays = (state.x, state.v, state.x_old, state.v_old, body.masses, body.fixed, n)
-            return clamp(*arrays, self.height, state.dt, self.friction)
-        heights = state.x[:, 1] if self.normal is None else (state.x * n).sum(axis=1)  # x·n (m)
-        candidates = (heights < self.height).nonzero()[0]
-        below = candidates[~state.body.fixed[candidates]]  # fixed ones only among the few below
-        if len(below) == 0:
-            return 0.0
-        x = state.x.take(below, axis=0)
-        x += (self.height - heights[below])[:, None] * n  # depth > 0 along n
-        state.x[below] = x
-        v = state.v.take(below, axis=0)
-        landing = v @ n  # the normal velocity the step ended with (m/s)
-        normal_speed = (x - state.x_old.take(below, axis=0)) @ n / state.dt
-        tangential = v - landing[:, None] * n
-        kept = (1.0 - self.friction) * tangential if self.friction else tangential
-        state.v[below] = kept + normal_speed[:, None] * n
-        # the ledger, along the normal: the kick normal_speed - landing at the mean velocity
-        masses = state.body.masses.take(below)
-        before = state.v_old.take(below, axis=0) @ n
-        work = energy.contact_work(
-            masses, (normal_speed - landing)[:, None], before[:, None], normal_speed[:, None]
-        )
-        rubbed = (
-            energy.kinetic_energy_removed(masses, tangential, 1.0 - self.friction)
-            if self.friction
-            else 0.0  # no friction: the tangential velocity is kept
-        )
-        return rubbed - work
+        """The backend's `ground_clamp` (`kernels.ground_clamp` on numpy arrays) on the step."""
+        body, n = state.body, self.normal_of(state.body)
+        arrays = (state.x, state.v, state.x_old, state.v_old, body.masses, body.fixed, n)
+        return state.kernel.ground_clamp(*arrays, self.height, state.dt, self.friction)
 
     def __repr__(self) -> str:
         return f"Ground(height={self.height:g}, normal={self.normal}, friction={self.friction:g})"

@@ -3,9 +3,10 @@
 The numpy kernel (`kernels.NumpyKernel`) is the reference. Each kernel named in
 `spring_kernel.KERNELS` runs each method of `spring_kernel.SpringKernel` on the same
 bodies (a cloth built from arrays, grids in 2-D and 3-D, a pinned body, a damped
-body) and must give the numpy kernel's results to rounding; its fused `advance`, if
-it has one, must give what the numpy kernel's forces, a = (F + m·g)/m and the
-update on whole arrays give. A new backend is added to `KERNELS` and gets all of it.
+body) and must give the numpy kernel's results to rounding (`RTOL`; a compiled loop
+sums in its own order); its `advance` must give what the numpy kernel's forces,
+a = (F + m·g)/m and the update on whole arrays give. A new backend is added to
+`KERNELS` and gets all of it.
 """
 
 from __future__ import annotations
@@ -195,8 +196,6 @@ def test_fused_advance(
 ) -> None:
     """The fused `advance` is the forces, a = (F + m·g)/m and the update on arrays, with the
     stretch and power of the pass; ``others`` adds forces beside the springs'."""
-    if not hasattr(backend, "advance"):
-        pytest.skip(f"the {backend.name} kernel has no fused advance")
     function, coefficients = UPDATES[update]
     x, v, dt = body.positions, body.velocities, 1e-3
     field = np.array([0.0, -9.81, 0.0][: body.dim])
@@ -221,8 +220,6 @@ def test_the_fused_advance_is_its_own_forces_then_the_update_bit_for_bit(
 ) -> None:
     """Fusing changes no bit: the kernel's own `spring_forces`, then a = (F + m·g)/m and
     `Verlet.update` on whole arrays give the same new state."""
-    if not hasattr(backend, "advance"):
-        pytest.skip(f"the {backend.name} kernel has no fused advance")
     x, v, dt = body.positions, body.velocities, 1e-3
     field = np.array([0.0, -9.81, 0.0][: body.dim])
     forces = np.zeros_like(x)
@@ -234,3 +231,33 @@ def test_the_fused_advance_is_its_own_forces_then_the_update_bit_for_bit(
     np.testing.assert_array_equal(step.x, expected[0])
     np.testing.assert_array_equal(step.v, expected[1])
     assert (step.stretch, step.power) == sums
+
+
+def test_damping_work(backend: spring_kernel.SpringKernel, body: msd.Body) -> None:
+    v_new = np.random.default_rng(6).normal(size=body.velocities.shape)
+    arrays = (body.masses, body.velocities, v_new, 0.97)
+    assert backend.damping_work(*arrays) == pytest.approx(REFERENCE.damping_work(*arrays), rel=RTOL)
+
+
+@pytest.mark.parametrize("friction", [0.0, 0.3])
+def test_ground_clamp(backend: spring_kernel.SpringKernel, body: msd.Body, friction: float) -> None:
+    """The same particles are put on the plane (a tilted one, above the middle of the body)
+    with the same velocities, and the same energy is booked; fixed ones stay below."""
+    normal = np.array([0.2, 1.0, -0.1][: body.dim])
+    normal /= np.linalg.norm(normal)
+    height = float(np.median(body.positions @ normal))
+    rng = np.random.default_rng(8)
+    x_old, v_old = body.positions, body.velocities
+    x_new, v_new = x_old + 0.01 * rng.normal(size=x_old.shape), rng.normal(size=x_old.shape)
+    x_new[body.fixed] = x_old[body.fixed]
+    ends = []
+    for kernel in (backend, REFERENCE):
+        x, v = x_new.copy(), v_new.copy()
+        arrays = (x, v, x_old, v_old, body.masses, body.fixed, normal, height, 0.01, friction)
+        ends.append((x, v, kernel.ground_clamp(*arrays)))
+    (x, v, removed), (x_ref, v_ref, removed_ref) = ends
+    assert removed_ref != 0.0 and not np.array_equal(x_ref, x_new)  # the ground acted
+    assert_close(x, x_ref)
+    assert_close(v, v_ref)
+    np.testing.assert_array_equal(x[body.fixed], x_old[body.fixed])
+    assert removed == pytest.approx(removed_ref, rel=RTOL)

@@ -18,7 +18,7 @@ def test_damping_work_is_the_readable_sum_to_rounding(kernel: str) -> None:
     )
     expected = msd.energy.damping_work(masses, v, v_new, 0.99)
     body = msd.Body.from_arrays(np.zeros((1000, 3)), masses=masses)
-    got = msd.Dynamics(body, kernel=kernel).damping_work(masses, v, v_new, 0.99)
+    got = msd.Dynamics(body, kernel=kernel).springs.damping_work(masses, v, v_new, 0.99)
     assert got == pytest.approx(expected, rel=1e-12)
 
 
