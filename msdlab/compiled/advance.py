@@ -1,46 +1,22 @@
 """The update loop: an integrator's update function compiled into one loop over the particles.
 
-`compile_advance` turns an update such as `integrators.Verlet.update` into a
-loop that computes a = F/m (plus gravity's g) and the update together, and adds
-the spring forces the spring loops left pending in the same pass. numba caches a
-compiled loop on disk only for a function defined in a file, so for msdlab's own
-updates (the integrators') the loop is written once into a file of its own in a
-cache folder (`loop_file`), and later processes load it compiled instead of
-compiling it again (about 0.5 s); a user's update is compiled once per process.
+`compile_advance` turns an update such as `integrators.Verlet.update` into a loop that
+computes a = F/m (plus gravity's g) and the update together, and adds the spring forces
+the spring loops left pending in the same pass. The update is handed to numba as it is
+written (`register_jitable`), and the loop calls it as a closure variable: numba inlines
+it, and keys the loop's disk cache by the update's own code, so msdlab's integrators'
+loops are compiled once per machine; a user's update is compiled once per process.
 """
 
 from __future__ import annotations
 
-import hashlib
-import importlib.util
-import inspect
-import os
-import sys
+import types
 from collections.abc import Callable
-from pathlib import Path
 
 import numba
+from numba.extending import register_jitable
 
-from .. import equations as physics
-from . import equations
 from .equations import acceleration
-
-LOOP = """\
-import numba
-
-from msdlab.compiled.advance import particle_acceleration
-{import_update}
-
-scalar = numba.njit({update})
-
-
-@numba.njit(parallel={threads}, cache={cache})
-def advance(x, v, forces, partial, field, masses, fixed, dt, coefficients, x_new, v_new):
-    for i in numba.prange(len(masses)):
-        for q in range(x.shape[1]):
-            a = particle_acceleration(i, q, forces, partial, field, masses, fixed)
-            x_new[i, q], v_new[i, q] = scalar(x[i, q], v[i, q], a, dt, *coefficients)
-"""
 
 
 @numba.njit(cache=True, inline="always")
@@ -54,7 +30,7 @@ def particle_acceleration(i, q, forces, partial, field, masses, fixed):
     return acceleration(total + masses[i] * field[q], masses[i], not fixed[i])
 
 
-def compile_advance(update: Callable, threads: bool) -> Callable:
+def compile_advance(update: Callable, threads: bool) -> Callable | None:
     """A loop over the particles doing a = (F + m·g)/m then ``update`` per coordinate.
 
     F is ``forces`` (N, d) plus the threads' ``partial`` forces (`particle_acceleration`);
@@ -62,63 +38,35 @@ def compile_advance(update: Callable, threads: bool) -> Callable:
     transposed (numba compiles the loop once for each layout it is given). The new
     state goes to ``x_new`` and ``v_new``. With ``threads`` the particles are split
     between the threads (each writes only its own rows). numba compiles it at its
-    first call (or loads it from its disk cache, see `loop_file`), which raises a
-    numba error if it cannot.
+    first call (or loads it from its disk cache, `cached`), which raises a numba error
+    if it cannot. None if ``update`` is not a plain function (numba compiles only those).
     """
-    path = loop_file(update, threads)
-    if path is not None:
-        spec = importlib.util.spec_from_file_location(f"msdlab_loop_{path.stem}", path)
-        module = sys.modules[spec.name] = importlib.util.module_from_spec(spec)  # numba's cache
-        try:  # finds its loop's globals by the module's name
-            spec.loader.exec_module(module)
-            return module.advance
-        except (OSError, RuntimeError):  # numba found no folder to write its cache in
-            del sys.modules[spec.name]
-    namespace = {"update": update}
-    exec(LOOP.format(import_update="", update="update", threads=threads, cache=False), namespace)
-    return namespace["advance"]
-
-
-def loop_file(update: Callable, threads: bool) -> Path | None:
-    """The file of `LOOP` for ``update``, written once into the cache folder (numba's
-    ``NUMBA_CACHE_DIR``, else the user's cache), named by a hash of everything the
-    compiled loop depends on: the loop, the module of ``update`` and the equations.
-    None for an update that is not msdlab's own (a user's module may change where
-    the hash does not see it), or if the folder cannot be written."""
-    module, name = getattr(update, "__module__", "") or "", getattr(update, "__qualname__", "")
-    if not module.startswith("msdlab.") or not _imports_as(update, module, name):
+    if not isinstance(update, types.FunctionType):
         return None
-    head = name.split(".")[0]
-    source = LOOP.format(
-        import_update=f"from {module} import {head}", update=name, threads=threads, cache=True
+    scalar = register_jitable(_copy(update))
+
+    @numba.njit(parallel=threads, cache=cached(update))
+    def advance(x, v, forces, partial, field, masses, fixed, dt, coefficients, x_new, v_new):
+        for i in numba.prange(len(masses)):
+            for q in range(x.shape[1]):
+                a = particle_acceleration(i, q, forces, partial, field, masses, fixed)
+                x_new[i, q], v_new[i, q] = scalar(x[i, q], v[i, q], a, dt, *coefficients)
+
+    return advance
+
+
+def cached(update: Callable) -> bool:
+    """Whether the loop of ``update`` is kept in numba's disk cache: for msdlab's own updates.
+
+    numba keys a cached loop by the update's code (its copy, `_copy`, is pickled by value),
+    not by the functions it calls, which a user's module may change unseen.
+    """
+    return (getattr(update, "__module__", "") or "").startswith("msdlab.")
+
+
+def _copy(update: Callable) -> Callable:
+    """A copy of the function ``update`` (its code, globals and defaults): one that cannot be
+    imported by name, so the loop's cache key holds its code, not its name."""
+    return types.FunctionType(
+        update.__code__, update.__globals__, update.__name__, update.__defaults__
     )
-    files = (inspect.getsourcefile(update), __file__, equations.__file__, physics.__file__)
-    key = [source, numba.__version__, *(Path(file).read_text(encoding="utf-8") for file in files)]
-    digest = hashlib.sha256("\0".join(key).encode()).hexdigest()[:16]
-    folder = Path(numba.config.CACHE_DIR or _user_cache()) / "msdlab_loops"
-    path = folder / f"advance_{digest}.py"
-    try:
-        if not path.is_file():
-            folder.mkdir(parents=True, exist_ok=True)
-            partial = path.with_suffix(f".{os.getpid()}.tmp")
-            partial.write_text(source, encoding="utf-8")
-            os.replace(partial, path)  # whole, even with another process writing it too
-    except OSError:
-        return None
-    return path
-
-
-def _imports_as(update: Callable, module: str, name: str) -> bool:
-    """Whether ``from module import ...`` then ``name`` gives ``update`` itself."""
-    try:
-        found: object = importlib.import_module(module)
-        for part in name.split("."):
-            found = getattr(found, part)
-    except (ImportError, AttributeError):
-        return False
-    return found is update
-
-
-def _user_cache() -> Path:
-    """The user's cache folder for msdlab (``XDG_CACHE_HOME`` or ~/.cache)."""
-    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "msdlab"
