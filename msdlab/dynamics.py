@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import weakref
 from collections.abc import Sequence
-from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
@@ -24,15 +22,6 @@ def keep_acceleration(
     """The update that returns the acceleration a (m/s²) in place of the new positions:
     through a kernel's fused advance, a = F/m alone in one compiled loop."""
     return a, v
-
-
-class SpringPass(NamedTuple):
-    """The dashpot power (W) a pass over all springs summed with their forces, and the
-    state (x, v) it read, referred to weakly."""
-
-    x: weakref.ref
-    v: weakref.ref
-    power: float
 
 
 class Dynamics:
@@ -58,9 +47,10 @@ class Dynamics:
         # the kernel of a step while a debugger traces the program (`Simulation.step`)
         self.readable = NumpyKernel() if kernel_left_to_msdlab(kernel) else None
         self.max_stretch = 0.0  # largest |d|/l seen in the last force evaluation
-        self._last_pass: SpringPass | None = None  # of the last force evaluation
+        # The power (W) each mechanism takes out at the body's state, by ledger name: the
+        # dashpots' ("dashpot") and each force's, from the last pass there (None: none yet).
+        self.opening: dict[str, float] | None = None
         self._pattern: JacobianPattern | None = None
-        self._dashpots = (-1, True)  # (body version, whether any spring has a dashpot)
 
     @property
     def kernel(self) -> str:
@@ -80,17 +70,14 @@ class Dynamics:
     def force(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Total force on each particle (N, d) in N."""
         total = np.zeros_like(x)
-        self._spring_pass(x, v, total)
-        for force in self.forces:
-            force.add_to(self.body, x, v, total)
-        return total
-
-    def _spring_pass(self, x: np.ndarray, v: np.ndarray, total: np.ndarray) -> None:
-        """Add the spring and dashpot forces at (x, v) to ``total``; keep the largest
-        stretch and the dashpot power (W) the pass found (for `dashpot_power`)."""
         sums = self.springs.spring_forces(self.body, x, v, total)
+        powers = {"dashpot": sums.power}
+        for force in self.forces:
+            _count(powers, force.ledger_name, force.add_to(self.body, x, v, total))
         self.max_stretch = sums.stretch
-        self._last_pass = SpringPass(weakref.ref(x), weakref.ref(v), sums.power)
+        if x is self.body.positions and v is self.body.velocities:
+            self.opening = powers
+        return total
 
     def acceleration(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Acceleration of each particle (N, d) in m/s², a = (F + m·g)/m: F the spring,
@@ -107,42 +94,31 @@ class Dynamics:
         returning the new (x, v). The backend's `SpringKernel.advance` runs it: the numpy
         backend on whole arrays, the numba backend compiled into one loop with the springs'
         pass and a. The uniform fields go in as g, the other forces as an array.
+
+        A pass at the body's own state (where a step starts) keeps the power each mechanism
+        takes out there in `opening`, for the energy ledger: the dashpots' from the
+        backend's pass over the springs, each force's from its `Force.add_to`.
         """
         field, others = np.zeros(x.shape[1]), None  # Σ g (m/s²); the other forces (N)
+        powers = {"dashpot": 0.0}
         for force in self.forces:
             g = force.uniform_acceleration(self.body)
             if g is not None:
                 field += g
                 continue
             others = np.zeros_like(x) if others is None else others
-            force.add_to(self.body, x, v, others)
+            _count(powers, force.ledger_name, force.add_to(self.body, x, v, others))
         step = self.springs.advance(update, self.body, x, v, field, dt, coefficients, others)
-        self.max_stretch = step.stretch
-        self._last_pass = SpringPass(weakref.ref(x), weakref.ref(v), step.power)
+        self.max_stretch, powers["dashpot"] = step.stretch, step.power
+        if x is self.body.positions and v is self.body.velocities:
+            self.opening = powers
         return step.x, step.v
 
-    def dashpot_power(self, x: np.ndarray, v: np.ndarray) -> float:
-        """Power (W) the dashpots take out at (x, v), Σ c ((v_a - v_b)·n)², always >= 0.
-
-        When the last pass over the springs read these very arrays (the integrator's
-        at the start of a step), it is the power that pass summed with the forces;
-        otherwise a pass of its own sums it.
-        """
-        last = self._last_pass
-        if last is not None and last.x() is x and last.v() is v:
-            return last.power
-        if not self._has_dashpots():
-            return 0.0
-        return self.springs.spring_forces(self.body, x, v, np.zeros_like(x)).power
-
-    def _has_dashpots(self) -> bool:
-        """Whether any spring has a dashpot (checked again when the springs are edited)."""
-        body = self.body
-        if body.grid_springs is not None:  # one dashpot for all, without laying springs out
-            return body.grid_springs.damping != 0.0
-        if self._dashpots[0] != body.version:
-            self._dashpots = (body.version, bool(body.spring_damping.any()))
-        return self._dashpots[1]
+    def powers_now(self) -> dict[str, float]:
+        """The power (W) each mechanism takes out at the body's state, by ledger name, from a
+        pass of its own there (kept in `opening`)."""
+        self.force(self.body.positions, self.body.velocities)
+        return self.opening
 
     def acceleration_of(
         self,
@@ -213,3 +189,9 @@ class Dynamics:
         return self.elastic_energy(x) + sum(
             force.potential_energy(self.body, x) for force in self.forces
         )
+
+
+def _count(powers: dict[str, float], name: str, power: float | None) -> None:
+    """Add ``power`` (W; None or 0 for a conservative force) to ``powers[name]``."""
+    if power:
+        powers[name] = powers.get(name, 0.0) + power

@@ -15,9 +15,11 @@ from .errors import check_non_negative, shown
 class Force(ABC):
     """A force field acting on the particles of a body.
 
-    Conservative forces also give their potential energy, dissipative ones the
-    power they take out (booked in the energy ledger under ``ledger_name``), and
-    forces that depend on x or v may give their Jacobians (for `ImplicitEuler`).
+    `add_to` adds the force and returns the power it takes out (booked in the energy
+    ledger under ``ledger_name``; 0 for a conservative force): whether and how it
+    dissipates, from the pass that computed it. Conservative forces also give their
+    potential energy, and forces that depend on x or v may give their Jacobians (for
+    `ImplicitEuler`).
     """
 
     ledger_name = "other"
@@ -27,17 +29,14 @@ class Force(ABC):
         """Raise ValueError if this force cannot act on ``body`` (e.g. wrong dimension)."""
 
     @abstractmethod
-    def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
-        """Add this force on each particle (N, d), in N, to ``out``."""
+    def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> float:
+        """Add this force on each particle (N, d), in N, to ``out``; return the power (W) it
+        takes out of the body at (x, v), 0 for a conservative force."""
 
     def potential_energy(
         self, body: Body, x: np.ndarray, particles: np.ndarray | None = None
     ) -> float:
         """Potential energy (J) of this force, or of the terms involving ``particles``."""
-        return 0.0
-
-    def dissipated_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
-        """Power (W) this force takes out of the body; 0 for conservative forces."""
         return 0.0
 
     def uniform_acceleration(self, body: Body) -> np.ndarray | None:
@@ -72,10 +71,11 @@ class Gravity(Force):
                 f"give {body.dim} components"
             )
 
-    def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> float:
         for axis, g in enumerate(self.g):  # per axis: much faster than m[:, None] * g
             if g != 0.0:
                 out[:, axis] += g * body.masses
+        return 0.0
 
     def uniform_acceleration(self, body: Body) -> np.ndarray:
         return self.g
@@ -103,11 +103,9 @@ class ViscousDamping(Force):
     def __init__(self, coefficient: float) -> None:
         self.coefficient = float(check_non_negative("viscous damping coefficient", coefficient))
 
-    def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> float:
+        """Add -c v to ``out``; return the power c Σ |v|² (W) over the free particles."""
         out -= self.coefficient * v
-
-    def dissipated_power(self, body: Body, x: np.ndarray, v: np.ndarray) -> float:
-        """c Σ |v|² over the free particles (W)."""
         free = ~body.fixed
         return float(self.coefficient * np.einsum("ij,ij->", v[free], v[free]))
 

@@ -185,5 +185,4 @@ class NumpyKernel:
     jacobians = staticmethod(spring_jacobians)
     finite = staticmethod(finite)
     advance = staticmethod(advance)
-    damping_work = staticmethod(equations.damping_work)
     ground_clamp = staticmethod(ground_clamp)

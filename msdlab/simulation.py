@@ -137,6 +137,7 @@ class Simulation:
         if dynamics.readable is not None:  # a debugger attached since reaches the equations
             dynamics.springs = dynamics.readable if sys.gettrace() else dynamics.chosen
         x, v = body.positions, body.velocities
+        dynamics.opening = None  # the integrator's first pass at (x, v) fills it in
         x_new, v_new = self._integrate(x, v)
         energy_of = partial(self._energy, x_new, v_new) if self.ledger else _unbooked
         state = StepState(
@@ -146,7 +147,7 @@ class Simulation:
         for constraint in self.constraints:
             removed.append((constraint.ledger_name, constraint.apply(state)))
         if self.ledger:  # after the constraints: the integrator's damping works at the final v
-            self._book(x, v, v_new, removed)
+            self._book(v, v_new, removed)
         stretched = self.max_stretch is not None and self.dynamics.max_stretch > self.max_stretch
         if stretched or not self.dynamics.springs.finite(x_new, v_new):
             raise self._divergence(x, x_new, v_new)
@@ -181,29 +182,20 @@ class Simulation:
             v_new[pinned] = 0.0
         return x_new, v_new
 
-    def _book(
-        self, x: np.ndarray, v: np.ndarray, v_new: np.ndarray, removed: list[tuple[str, float]]
-    ) -> None:
-        """Add to `dissipated` the energy (J) each mechanism took out in the step from (x, v)
-        to velocities ``v_new``: the dashpots, the integrator's damping, the dissipative
-        forces, and the constraints (``removed``: (ledger name, energy) of each)."""
-        body, dt, integrator = self.body, self._dt, self.integrator
-        if type(integrator).dissipated_energy is not Integrator.dissipated_energy:
-            damping = integrator.dissipated_energy(v, body.masses, v_new)  # its own booking
-        elif (factor := integrator.velocity_factor) == 1.0:
-            damping = 0.0
-        else:  # Integrator.dissipated_energy's work of the velocity factor
-            damping = self.dynamics.springs.damping_work(body.masses, v, v_new, factor)
-        booked = {"dashpot": self.dynamics.dashpot_power(x, v) * dt, "integrator": damping}
-        for force in self.dynamics.forces:
-            if type(force).dissipated_power is Force.dissipated_power:
-                continue  # a conservative force: nothing to book
-            lost = force.dissipated_power(body, x, v)
-            if lost:
-                booked[force.ledger_name] = booked.get(force.ledger_name, 0.0) + lost * dt
+    def _book(self, v: np.ndarray, v_new: np.ndarray, removed: list[tuple[str, float]]) -> None:
+        """Add to `dissipated` the energy (J) each mechanism took out in the step from the
+        body's state, velocities ``v``, to velocities ``v_new``: the dashpots and the
+        dissipative forces at the power of the step's pass there (`Dynamics.opening`), the
+        integrator's damping (`Integrator.dissipated_energy`), and the constraints
+        (``removed``: (ledger name, energy) of each)."""
+        dynamics, dt = self.dynamics, self._dt
+        powers = dynamics.opening or dynamics.powers_now()  # the integrator's pass, if it took one
+        for name, power in powers.items():
+            self.dissipated[name] += power * dt
+        self.dissipated["integrator"] += self.integrator.dissipated_energy(
+            v, self.body.masses, v_new
+        )
         for name, energy in removed:
-            booked[name] = booked.get(name, 0.0) + energy
-        for name, energy in booked.items():
             self.dissipated[name] += energy
 
     def run(
@@ -282,10 +274,8 @@ class Simulation:
         part uses the velocity at the time of x (see `Integrator.velocity_at_positions`)."""
         body, dynamics, integrator = self.body, self.dynamics, self.integrator
         touching = body.springs_touching(particles)
-        u = v[particles]
-        if type(integrator).velocity_at_positions is not Integrator.velocity_at_positions:
-            a = dynamics.acceleration_of(particles, x, v, touching)
-            u = integrator.velocity_at_positions(u, a, self._dt)
+        a = dynamics.acceleration_of(particles, x, v, touching)
+        u = integrator.velocity_at_positions(v[particles], a, self._dt)
         kinetic = equations.kinetic_energy(body.masses[particles], u)
         potential = sum(f.potential_energy(body, x, particles) for f in self.forces)
         return float(kinetic + potential + dynamics.elastic_energy(x, touching))

@@ -2,8 +2,8 @@
 
 A backend computes, for all springs of a body at once, what `Spring.force` computes for
 one (eq. 1.1-1.2 with the dashpot), their energy and Jacobians, and steps the particles
-with an integrator's update; it also checks the state and sums the integrator's damping
-work and the ground's clamp for the ledger. `SpringKernel` is the whole contract, seven
+with an integrator's update; it also checks the state and clamps particles to the
+ground, booking the energy that takes out. `SpringKernel` is the whole contract, six
 methods, none optional; nothing else asks a backend for more, and nothing asks which one
 runs: `kernels.NumpyKernel` (readable, whole arrays, the reference every backend is tested
 against) or `msdlab.compiled.NumbaKernel` (compiled loops, the default). Both apply the
@@ -75,11 +75,6 @@ class SpringKernel(Protocol):
         g = ``field`` (d,) in m/s². The numpy backend does it in three lines on arrays;
         the numba backend runs the springs' pass, a and the update in compiled loops.
         """
-
-    def damping_work(
-        self, masses: np.ndarray, v_before: np.ndarray, v_after: np.ndarray, factor: float
-    ) -> float:
-        """`equations.damping_work` (J): the work of a velocity factor per step."""
 
     def ground_clamp(
         self,

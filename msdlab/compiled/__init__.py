@@ -1,4 +1,4 @@
-"""The numba spring kernel: the same `msdlab.equations`, compiled into loops.
+"""The numba backend: the same `msdlab.equations`, compiled into loops.
 
 `kernels.NumpyKernel` applies the equations to (E, d) arrays of all springs,
 then sums them per particle. `NumbaKernel` compiles the same functions
@@ -9,11 +9,13 @@ then sums them per particle. `NumbaKernel` compiles the same functions
   offset go by offset instead, with no list of springs;
 - `advance`: an integrator's update function (for example
   `integrators.Verlet.update`) compiled into one loop over the particles that
-  computes a = F/m (plus gravity's g) and the update together; it is compiled
-  once per machine for msdlab's integrators (cached on disk, `advance.loop_file`)
-  and once per process for a user's update. The spring forces not
+  computes a = F/m (plus gravity's g) and the update together; numba compiles the
+  function itself, and keeps msdlab's integrators' loops in its disk cache (a user's
+  update is compiled once per process). The spring forces not
   yet summed (the edge loop's threads' buffers, or the gather's forces by
   coordinate) are added in that loop too, not in a pass of their own;
+- `contact`: the ground's clamp, one loop over the particles;
+- `reductions`: the finiteness check of the state;
 - `kernel`: `NumbaKernel`, which keeps what a body needs between calls and
   picks the loops.
 

@@ -24,7 +24,7 @@ from .edges import (
 )
 from .gather import gather_parallel, gather_serial
 from .grid_sums import grid_sum_parallel, grid_sum_serial
-from .reductions import PARALLEL_MIN_PARTICLES, damping_work, finite
+from .reductions import PARALLEL_MIN_PARTICLES, finite
 from .stencil import (
     GridStencil,
     column_masks,
@@ -68,8 +68,7 @@ class NumbaKernel:
     extra thread. What is kept is rebuilt when the springs change
     (``body.version``, which every edit of the springs counts). ``springs``
     (indices) restricts a computation to some springs, on one thread, in the
-    body's order. `finite` and `damping_work` run
-    on the threads for a body big enough to share out.
+    body's order. `finite` runs on the threads for a body big enough to share out.
     """
 
     def __init__(self) -> None:
@@ -95,7 +94,6 @@ class NumbaKernel:
 
     name = "numba"
     finite = staticmethod(finite)
-    damping_work = staticmethod(damping_work)  # the ledger's sum, compiled (`Dynamics`)
     ground_clamp = staticmethod(ground_clamp)  # `interaction.Ground`'s clamp, if present
 
     def spring_forces(

@@ -1,16 +1,10 @@
-"""Sums over the state at the end of a step, compiled: one pass each, no temporary arrays.
-
-The same quantities as the numpy kernel's (`kernels.finite`, `equations.damping_work`).
-The work is summed over blocks of `BLOCK` particles, then over the blocks in order, so
-one thread and several give the same sum; it may differ from numpy's in the last bits.
-"""
+"""The finiteness check of the state at the end of a step, compiled: one pass, no temporary
+arrays (`kernels.finite`)."""
 
 from __future__ import annotations
 
 import numba
-import numpy as np
 
-BLOCK = 4096  # particles per partial sum
 PARALLEL_MIN_PARTICLES = 20_000  # from here a pass over the state runs on the threads
 
 
@@ -32,48 +26,3 @@ def finite(x, v):
         for i in numba.prange(len(xs)):
             zero += 0.0 * xs[i] + 0.0 * vs[i]
     return zero == 0.0
-
-
-@numba.njit(cache=True)
-def _kick_dots(masses, v_before, v_after, block):
-    """Σ m v_before·(v_before + v_after) (kg·m²/s²) over the particles of ``block``."""
-    total = 0.0
-    for i in range(block * BLOCK, min(len(masses), (block + 1) * BLOCK)):
-        dot = 0.0
-        for q in range(v_before.shape[1]):
-            dot += v_before[i, q] * (v_before[i, q] + v_after[i, q])
-        total += masses[i] * dot
-    return total
-
-
-def damping_work(masses, v_before, v_after, factor):
-    """`equations.damping_work`: (1 - factor)·½ Σ m v_before·(v_before + v_after) (J).
-
-    Summed by blocks of `BLOCK` particles, on the threads for a big state
-    (`PARALLEL_MIN_PARTICLES`), then over the blocks in order: the same sum either way.
-    A small state never compiles the threaded loop.
-    """
-    big = len(masses) >= PARALLEL_MIN_PARTICLES
-    work = damping_work_parallel if big else damping_work_serial
-    return work(masses, v_before, v_after, factor)
-
-
-@numba.njit(cache=True)
-def damping_work_serial(masses, v_before, v_after, factor):
-    """`damping_work` on one thread, the blocks one after the other."""
-    total = 0.0
-    for block in range((len(masses) + BLOCK - 1) // BLOCK):
-        total += _kick_dots(masses, v_before, v_after, block)
-    return (1.0 - factor) * (0.5 * total)
-
-
-@numba.njit(cache=True, parallel=True)
-def damping_work_parallel(masses, v_before, v_after, factor):
-    """`damping_work` with the blocks shared between the threads, then added in order."""
-    sums = np.empty((len(masses) + BLOCK - 1) // BLOCK)
-    for block in numba.prange(len(sums)):
-        sums[block] = _kick_dots(masses, v_before, v_after, block)
-    total = 0.0
-    for block in range(len(sums)):
-        total += sums[block]
-    return (1.0 - factor) * (0.5 * total)

@@ -98,7 +98,8 @@ class Ground(Constraint):
 
     def apply(self, state: StepState) -> float:
         """The backend's `ground_clamp` (`kernels.ground_clamp` on numpy arrays) on the step."""
-        body, n = state.body, self.normal_of(state.body)
+        body = state.body
+        n = _UP[body.dim] if self.normal is None else self.normal
         arrays = (state.x, state.v, state.x_old, state.v_old, body.masses, body.fixed, n)
         return state.kernel.ground_clamp(*arrays, self.height, state.dt, self.friction)
 

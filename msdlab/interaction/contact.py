@@ -49,15 +49,16 @@ class SphereContact(Force):
         inside = distance < self.radius
         return others[inside], d[inside], distance[inside]
 
-    def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> None:
+    def add_to(self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray) -> float:
         touched, d, distance = self._depths(body, x)
         if len(touched) == 0:
-            return
+            return 0.0
         depth = self.radius - distance
         direction = d / np.where(distance > 0, distance, np.inf)[:, None]
         f = (self.stiffness * depth)[:, None] * direction
         np.add.at(out, touched, f)
         out[self.center] -= f.sum(axis=0)
+        return 0.0  # a penalty spring: conservative
 
     def potential_energy(
         self, body: Body, x: np.ndarray, particles: np.ndarray | None = None
