@@ -65,6 +65,14 @@ def kernel_mistake(task2):
     return matching_variant(got, oracles.axis_spring_mistakes(x, spacing, stiffness, task2))
 
 
+def named(task2, got, x, spacing, stiffness):
+    """The mistake a check names where its result ``got`` for ``x`` is what a typical mistake
+    gives: the one recognised in the student's function (`kernel_mistake`, named alike by
+    every check), else its own; None where ``got`` is no typical mistake's."""
+    own = matching_variant(got, oracles.axis_spring_mistakes(x, spacing, stiffness, task2))
+    return own and (kernel_mistake(task2) or own)
+
+
 def student_acceleration(task2, x, spacing, stiffness):
     got = task2.spring_acceleration(x.copy(), spacing, stiffness)
     return as_array(got, "spring_acceleration", x.shape)
@@ -77,9 +85,7 @@ def compare_with_engine(task2, got, x, spacing, stiffness, what):
     if error < 1e-9:
         return
     worst = np.unravel_index(np.argmax(np.linalg.norm(got - expected, axis=-1)), x.shape[:3])
-    mistake = kernel_mistake(task2) or matching_variant(
-        got, oracles.axis_spring_mistakes(x, spacing, stiffness, task2)
-    )
+    mistake = named(task2, got, x, spacing, stiffness)
     expect(
         False,
         saw=f"{what}: the {grid_place(worst, x.shape[:3])} gets a = {vec(got[worst])}, eq. "

@@ -169,9 +169,8 @@ def test_rotation_matrix_right_handed(task3):
         for angle in (30.0, -58.3, 180.0):
             got = as_array(task3.rotation_matrix(axis, angle), "rotation_matrix", (3, 3))
             expected = msd.rotation_matrix(angle, axis)
-            mistake = matrix_mistake(task3) or matching_variant(
-                got, matrix_mistakes(axis, angle), rtol=1e-9
-            )
+            own = matching_variant(got, matrix_mistakes(axis, angle), rtol=1e-9)
+            mistake = own and (matrix_mistake(task3) or own)
             expect(
                 np.allclose(got, expected, atol=1e-12),
                 saw=f"rotation_matrix({axis}, {angle}) has R Rᵀ = I off by "
@@ -236,6 +235,14 @@ def sum_mistake(task3):
     return matching_variant(got, sum_mistakes(x, springs, rest, 0.7, task3))
 
 
+def named(task3, got, x, springs, rest, stiffness):
+    """The mistake a check names where its accelerations ``got`` are what a typical mistake
+    gives: the one recognised in the student's spring_acceleration (`sum_mistake`, named
+    alike by every check), else its own; None where ``got`` is no typical mistake's."""
+    own = matching_variant(got, sum_mistakes(x, springs, rest, stiffness, task3))
+    return own and (sum_mistake(task3) or own)
+
+
 def compare_with_engine(task3, got, body, x, what):
     expected = oracles.spring_acceleration(body, x)
     error = relative_error(got, expected)
@@ -243,9 +250,7 @@ def compare_with_engine(task3, got, body, x, what):
         return
     springs, rest = springs_of(body)
     worst = int(np.argmax(np.linalg.norm(got - expected, axis=1)))
-    mistake = sum_mistake(task3) or matching_variant(
-        got, sum_mistakes(x, springs, rest, body.stiffness[0], task3)
-    )
+    mistake = named(task3, got, x, springs, rest, body.stiffness[0])
     expect(
         False,
         saw=f"{what}: particle {worst} gets a = {vec(got[worst])}, eq. (1.1)-(1.2) give "
