@@ -44,20 +44,24 @@ EVERY_KIND = (
     "neighbours of every kind (axis, face- and body-diagonal), not only those that were "
     "asked for with squared_distances"
 )
+AT_THE_BORDER = (
+    "springs missing at the border: each offset joins every particle whose neighbour "
+    "(i, j, k) + offset is inside the grid, up to the last one"
+)
 LENGTHS = {1: "axis (spacing)", 2: "face-diagonal (spacing·√2)", 3: "body-diagonal (spacing·√3)"}
 
 
 @functools.lru_cache(maxsize=16)  # per task module: the checks of one submission ask often
 def springs_mistake(task4):
     """The typical mistake the student's grid_springs (and the neighbour_offsets it uses) is
-    recognised as, or None: the springs of a 2 × 3 × 4 grid of spacing 0.3 (no template's
-    number) with all neighbours and with axis neighbours only are exactly what the mistake
-    gives, and no other's.
+    recognised as, or None: the springs of a 3 × 4 × 5 grid (with interior particles) of
+    spacing 0.3 (no template's number) with all neighbours and with axis neighbours only
+    are exactly what the mistake gives.
 
     Every check of the springs and of what is built from them (the cube, the cost) names it
     as its cause, so the report names the one mistake once.
     """
-    shape, spacing = (2, 3, 4), 0.3
+    shape, spacing = (3, 4, 5), 0.3
     try:
         every = student_springs(task4, shape, spacing, (1, 2, 3))
         axis = student_springs(task4, shape, spacing, (1,))
@@ -90,6 +94,13 @@ def pairs_mistake(found, shape, axis_springs):
     axis = {frozenset(p) for p in axis_springs.tolist()}
     if axis == set(expected) and len(axis_springs) == len(expected):
         return Recognised(EVERY_KIND)
+    wanted = {tuple(sorted(p)) for p in expected}
+    missing = wanted - set(found)
+    if missing and set(found) < wanted and len(set(found)) == len(found):
+        border = np.array([(0, n - 1) for n in shape])
+        where = np.stack(np.unravel_index(np.array(sorted(missing)), shape), axis=-1)  # (M, 2, 3)
+        if np.all(np.any((where == border[:, 0]) | (where == border[:, 1]), axis=(1, 2))):
+            return Recognised(AT_THE_BORDER)
     return None
 
 
@@ -239,10 +250,7 @@ def pairs_cause(missing, extra, repeated, given, expected):
     if repeated or (given == 2 * expected and not missing):
         return TWICE
     if missing and not extra:
-        return (
-            "springs missing at the border: each offset joins every particle whose "
-            "neighbour (i, j, k) + offset is inside the grid, up to the last one"
-        )
+        return AT_THE_BORDER
     if missing and extra and given == expected:
         return "C order mixed up: particle (i, j, k) is row (i·ny + j)·nz + k"
     return "neighbours across the border wrapped around, or offsets of the wrong kind"
