@@ -94,8 +94,9 @@ TAKEN_OUT = {
     "dashpot": "the springs' dashpots",
     "integrator": "the integrator's damping λ",
     "ground": "the floor (contact and friction)",
-    "viscous": "drag on every particle",
-    "drag": "the hand dragging a particle",
+    "viscous": "viscous damping, the force -c v on every particle",
+    "drag": "air drag, v slowed by exp(-rate dt) each step",
+    "hand": "the hand holding a particle (what it puts in counts negative)",
     "walls": "the walls",
     "driven": "a driven particle",
 }
