@@ -32,7 +32,11 @@ SOLUTIONS = ROOT / "solutions"
 SECTION = re.compile(r"^## Task (\d+)\n.*?(?=^## Task |\Z)", re.M | re.S)
 FINGERPRINT = re.compile(r"<!-- inputs: (\w+) -->")
 RECOGNISED = re.compile(re.escape(MISTAKE_SENTENCE).replace(r"\{\}", "(.+?)") + "$", re.M)
-INTRODUCTION = """# What a single mistake costs
+INTRODUCTION = """---
+html_theme.sidebar_secondary.remove: true
+---
+
+# What a single mistake costs
 
 Each row is one planted bug (`tests/course/planted/variants.py`): the reference answer with
 one typical mistake, checked by every check of its task, public and hidden. It says which
