@@ -76,8 +76,9 @@ def shuffled(grid: msd.Body, seed: int = 0) -> msd.Body:
     """The same particles and springs, the springs in a random order, not a grid."""
     order = np.random.default_rng(seed).permutation(grid.n_springs)
     body = msd.Body.from_arrays(grid.positions, masses=grid.masses)
-    pairs = np.stack([grid.spring_a[order], grid.spring_b[order]], axis=1)
-    body.add_springs(pairs, grid.stiffness[order], grid.rest_lengths[order])
+    edges = grid.edges()
+    pairs = np.stack([edges.a[order], edges.b[order]], axis=1)
+    body.add_springs(pairs, edges.stiffness[order], edges.rest_lengths[order])
     return body
 
 
@@ -140,7 +141,7 @@ def compile_seconds() -> float:
     start = time.perf_counter()
     for body in (msd.Body.grid((6, 5), neighbours=(1, 2)), make_grid(17)[0]):  # 17³: threaded
         sim = msd.Simulation(body, msd.Verlet(0.01), forces=[msd.Gravity(GRAVITY[: body.dim])])
-        body.spring_damping = 0.1
+        body.set_springs(damping=0.1)
         sim.run(steps=1)
     return time.perf_counter() - start
 
@@ -152,7 +153,7 @@ def small_body_seconds(kernel: str, resting: bool, steps: int = 10_000) -> float
         (20, 15), spacing=0.1, stiffness=50.0, neighbours=(1, 2), origin=(0, 0.5 if resting else 50)
     )
     body.fixed[:3] = True
-    body.spring_damping = 0.05
+    body.set_springs(damping=0.05)
     forces = [msd.Gravity((0, -9.81)), msd.Ground(), msd.Drag(0.1)]
     sim = msd.Simulation(body, msd.Verlet(0.01), dt=1e-3, forces=forces, kernel=kernel)
     sim.run(steps=500)  # warm up, and land when resting
@@ -170,7 +171,7 @@ def resting_ledger_ratios(n: int = 20, repeats: int = 9, steps: int = 50) -> dic
         sims = []
         for ledger in (True, False):
             body = msd.Body.grid((n,) * 3, spacing=0.1, stiffness=200.0, neighbours=(1, 2, 3))
-            body.spring_damping = 0.05
+            body.set_springs(damping=0.05)
             forces = [msd.Gravity(GRAVITY), msd.Ground()]
             sim = msd.Simulation(body, integrator(), dt=DT, forces=forces, ledger=ledger)
             sim.run(steps=300)  # settle onto the ground

@@ -36,7 +36,7 @@ if TYPE_CHECKING:  # the public names; imported on first use at run time (`__get
         stability_limit,
         stiffest_mode,
     )
-    from .body import Body, rotation_matrix
+    from .body import Body
     from .constraint import Constraint, StepState
     from .dynamics import Dynamics
     from .energy import (
@@ -60,6 +60,7 @@ if TYPE_CHECKING:  # the public names; imported on first use at run time (`__get
     )
     from .interaction import Drag, Grab, Ground, Prescribed, SphereContact, Walls
     from .particle import Particle
+    from .rotation import rotation_matrix
     from .simulation import Simulation, Trajectory
     from .spring import Spring
 

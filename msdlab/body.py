@@ -1,146 +1,59 @@
-"""Body: particles and springs, stored as arrays (one row per particle / spring)."""
+"""Body: particles as arrays (one row each) and one spring set (an edge list or a lattice)."""
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
 from .bound import Rows
-from .errors import as_vectors, check_non_negative, check_positive, shown
-from .lattice import (
-    GRID_EXAMPLE,
-    GridSprings,
-    grid_pair_blocks,
-    grid_positions,
-    grid_shape,
-    neighbour_offsets,
-)
-from .particle import Particle
+from .errors import as_vectors, shown
+from .lattice import LatticeSprings, grid_positions, grid_shape, lattice_springs
+from .particle import Particle, checked_masses, particle_arrays
+from .rotation import checked_rotation
 from .spring import Spring
+from .springs import EdgeSprings, checked_value, copied, edge_springs, incidence, touching
 
-MASS_HINT = "To pin a particle use fixed=True instead of a zero mass."
-VALUE_HINTS = {  # the spring values and what a bad one is told
-    "stiffness": "Use k >= 0 (N/m).",
-    "rest_lengths": "It is in m.",
-    "spring_damping": "Use a dashpot coefficient c >= 0 (N·s/m).",
-}
-SPRING_ARRAYS = ("spring_a", "spring_b", *VALUE_HINTS)
-
-
-def _per_row(name: str, values: object, count: int, hint: str, zero: bool = True) -> np.ndarray:
-    """``values`` checked finite and >= 0 (> 0 unless ``zero``), as ``count`` floats."""
-    array = check_non_negative(name, values, hint, zero=zero)
-    if array.ndim and array.shape != (count,):
-        raise ValueError(f"{name} needs one value or one per row ({count}), got {array.shape}")
-    return np.broadcast_to(array, (count,)).copy()
-
-
-def _pin(body: Body, mask: object) -> None:
-    body.fixed[...] = mask
-    body.velocities[body.fixed] = 0.0  # pinned particles stop
-
-
-def _read_only(name: str) -> Callable[[Body, object], None]:
-    def refuse(body: Body, value: object) -> None:
-        raise AttributeError(f"body.{name} is read-only; add springs with body.add_springs(...)")
-
-    return refuse
-
-
-# `body.<name> = value`: a whole array, checked and written into the body's arrays
-_WHOLE: dict[str, Callable[[Body, object], None]] = {
-    "positions": lambda body, x: body.positions.__setitem__(
-        ..., as_vectors("positions", x, body.dim or 3, len(body))
-    ),
-    "velocities": lambda body, v: body.velocities.__setitem__(
-        ...,
-        np.where(body.fixed[:, None], 0.0, as_vectors("velocities", v, body.dim or 3, len(body))),
-    ),
-    "masses": lambda body, m: body.masses.__setitem__(
-        ..., _per_row("mass", m, len(body), MASS_HINT, zero=False)
-    ),
-    "fixed": _pin,
-    "stiffness": lambda body, k: body.set_springs(stiffness=k),
-    "rest_lengths": lambda body, rest: body.set_springs(rest_lengths=rest),
-    "spring_damping": lambda body, c: body.set_springs(spring_damping=c),
-    **{name: _read_only(name) for name in ("spring_a", "spring_b", "spring_values")},
-}
+STATE = ("positions", "velocities", "masses", "fixed")  # the particles' arrays
 
 
 class Body:
     """A mass-spring body in 2-D or 3-D (fixed by the first particle added).
 
-    The state is four arrays, read and written in place: ``positions`` (N, d) in m,
-    ``velocities`` (N, d) in m/s, ``masses`` (N,) in kg and ``fixed`` (N,). The springs
-    are read-only arrays (E,): ``spring_a``, ``spring_b``, ``stiffness`` (N/m),
-    ``rest_lengths`` (m), ``spring_damping`` (N·s/m); they change only through
-    `add_springs`, `set_springs` (or assigning a whole array), each of which adds one
-    to ``version``. A grid (`Body.grid`) keeps its springs per offset (`grid_springs`)
-    until `lay_out_springs` writes them out; ``particles[i]`` and ``springs[k]`` are
-    objects reading and writing one row.
+    The particles are arrays read and written in place: ``positions`` (N, d) in m,
+    ``velocities`` (N, d) in m/s, ``masses`` (N,) in kg, ``fixed`` (N,). The springs are
+    ``spring_set``: an edge list (`springs.EdgeSprings`) or, from `Body.grid`, a lattice
+    (`lattice.LatticeSprings`, values per neighbour offset), changed only by the methods
+    that add one to ``version``. ``particles[i]`` and ``springs[k]`` read and write one.
     """
 
     def __init__(self, dim: int | None = None) -> None:
         if dim not in (None, 2, 3):
             raise ValueError(f"a body is 2-D or 3-D, got dim = {shown(dim)}")
-        self.dim = dim
-        self.grid_shape: tuple[int, ...] | None = None
-        self.version = 0  # grows whenever the springs change: added or edited
-        self.grid_springs: GridSprings | None = None  # `Body.grid`'s springs, until laid out
-        self._incidence: tuple[int, np.ndarray, np.ndarray] | None = None
-        self._new_state: tuple[np.ndarray, ...] = ()  # see `new_state`
-        width = dim or 3
-        self._keep(positions=np.zeros((0, width)), velocities=np.zeros((0, width)))
-        self._keep(masses=np.zeros(0), fixed=np.zeros(0, bool))
-        self._keep_springs(np.zeros(0, np.int64), np.zeros(0, np.int64), *np.zeros((3, 0)))
-
-    def _keep(self, **arrays: np.ndarray) -> None:
-        """Make ``arrays`` the body's attributes (past `__setattr__`'s checks)."""
-        self.__dict__.update(arrays)
-
-    def _keep_springs(self, *arrays: np.ndarray) -> None:
-        """Make the spring arrays (ends, stiffness, rest lengths, dashpots) the body's,
-        read-only."""
-        for array in arrays:
-            array.flags.writeable = False
-        self._keep(**dict(zip(SPRING_ARRAYS, arrays)), spring_values=arrays[2:])
+        self.dim, self.version = dim, 0  # the version grows with every addition or edit
+        self.spring_set: EdgeSprings | LatticeSprings = EdgeSprings.empty()
+        self.positions, self.velocities = np.zeros((0, dim or 3)), np.zeros((0, dim or 3))
+        self.masses, self.fixed = np.zeros(0), np.zeros(0, bool)
+        self._incidence: tuple[int, np.ndarray, np.ndarray] = (-1, *np.zeros((2, 0), int))
 
     def __setattr__(self, name: str, value: object) -> None:
-        """``body.masses = 2.0`` or ``body.stiffness = 50.0`` (whole arrays) are checked and
-        written into the body's arrays; the ends of the springs cannot be assigned."""
-        write = _WHOLE.get(name)
-        if write is None:
-            super().__setattr__(name, value)
-        else:
-            write(self, value)
-
-    def __getattr__(self, name: str) -> object:
-        """The ends and rest lengths of a grid's springs kept per offset: laid out first."""
-        laid_out = name in SPRING_ARRAYS or name == "spring_values"
-        if laid_out and self.__dict__.get("grid_springs") is not None:
-            self.lay_out_springs()
-            return self.__dict__[name]
-        raise AttributeError(f"'Body' object has no attribute {name!r}")
-
-    def __setstate__(self, state: dict) -> None:
-        self.__dict__.update(state)
-        for name in SPRING_ARRAYS:
-            if name in state:
-                state[name].flags.writeable = False
-
-    @property
-    def n_particles(self) -> int:
-        return len(self.positions)
+        """``body.positions = ...`` (or velocities, masses, fixed): checked, then written
+        into the body's array in place; other attributes are set as usual."""
+        if name not in STATE or name not in vars(self):
+            return super().__setattr__(name, value)
+        if name in ("positions", "velocities"):
+            value = as_vectors(name, value, self.dim or 3, len(self))
+        getattr(self, name)[...] = checked_masses(value, len(self)) if name == "masses" else value
+        self.velocities[self.fixed] = 0.0  # pinned particles stop
 
     @property
     def n_springs(self) -> int:
-        grid = self.grid_springs
-        return len(self.stiffness) if grid is None else grid.count
+        return self.spring_set.count
 
     def __len__(self) -> int:
         return len(self.positions)
+
+    n_particles = property(__len__, doc="Number of particles N.")
 
     @property
     def particles(self) -> Rows[Particle]:
@@ -149,21 +62,17 @@ class Body:
 
     @property
     def springs(self) -> Rows[Spring]:
-        """``springs[k]`` reads/writes spring k's rows of the arrays."""
+        """``springs[k]`` reads/writes spring k of the spring set."""
         return Rows(self, Spring, self.n_springs)
 
-    # ----------------------------------------------------------------- building
     def add_particle(self, particle: Particle) -> int:
         """Add ``particle`` and return its index; the object then reads/writes this body."""
-        if not isinstance(particle, Particle):
-            raise TypeError(f"add_particle takes a msdlab.Particle, got {type(particle).__name__}")
-        if particle.body is not None:
-            raise ValueError("this particle already belongs to a body; make a new Particle")
-        new = self.add_particles(
+        Particle.check_new(particle, "add_particle")
+        (index,) = self.add_particles(
             [particle.position], [particle.velocity], particle.mass, particle.fixed
         )
-        particle.bind(self, int(new[0]))
-        return int(new[0])
+        particle.bind(self, int(index))
+        return int(index)
 
     def add_particles(
         self,
@@ -173,36 +82,19 @@ class Body:
         fixed: object = False,
     ) -> np.ndarray:
         """Add many particles at once (arrays or broadcastable values); return their indices."""
-        positions = np.array(positions, dtype=float)
-        dim = positions.shape[-1] if positions.ndim == 2 else None
-        if dim not in (2, 3):
-            raise ValueError(f"positions must have shape (N, 2) or (N, 3), got {positions.shape}")
-        if self.dim not in (None, dim):
-            raise ValueError(
-                f"this body is {self.dim}-D but the new particle has {dim} coordinates; "
-                "do not mix 2-D and 3-D particles in one body"
-            )
-        count, first = len(positions), len(self)
-        positions = as_vectors("positions", positions, dim, count)
-        velocities = np.zeros((count, dim)) if velocities is None else velocities
-        velocities = as_vectors("velocities", velocities, dim, count)
-        fixed = np.broadcast_to(np.asarray(fixed, dtype=bool), (count,))
-        masses = _per_row("mass", masses, count, MASS_HINT, zero=False)
+        new = particle_arrays(self.dim, positions, velocities, masses, fixed)
+        count, first = len(new[0]), len(self)
         if self.dim is None:
-            self.dim = dim
-            self._keep(positions=np.zeros((0, dim)), velocities=np.zeros((0, dim)))
-        velocities = np.where(fixed[:, None], 0.0, velocities)
-        new = {"positions": positions, "velocities": velocities, "masses": masses, "fixed": fixed}
-        self._keep(**{name: np.concatenate([getattr(self, name), new[name]]) for name in new})
+            self.dim = new[0].shape[1]
+            vars(self).update(positions=new[0][:0], velocities=new[1][:0])
+        joined = (np.concatenate([getattr(self, name), array]) for name, array in zip(STATE, new))
+        vars(self).update(zip(STATE, joined))  # new arrays: past `__setattr__`
         self.version += 1
         return np.arange(first, first + count)
 
     def add_spring(self, spring: Spring) -> int:
         """Add ``spring`` and return its index; the object then reads/writes this body."""
-        if not isinstance(spring, Spring):
-            raise TypeError(f"add_spring takes a msdlab.Spring, got {type(spring).__name__}")
-        if spring.body is not None:
-            raise ValueError("this spring already belongs to a body; make a new Spring")
+        Spring.check_new(spring, "add_spring")
         (index,) = self.add_springs(
             [[spring.a, spring.b]], spring.stiffness, spring.rest_length, spring.damping
         )
@@ -216,126 +108,47 @@ class Body:
         rest_lengths: object = None,
         damping: object = 0.0,
     ) -> np.ndarray:
-        """Add springs between index pairs (E, 2); rest lengths default to current distances.
-
-        Values are one per spring or one for all (checked once, not per spring).
-        """
-        pairs = np.asarray(pairs)
-        if pairs.size == 0:  # also () and [], which numpy makes float
-            pairs = pairs.reshape(0, 2).astype(np.int64)
-        if pairs.ndim != 2 or pairs.shape[1] != 2:
-            raise ValueError(f"spring pairs must have shape (E, 2), got shape {pairs.shape}")
-        if not np.issubdtype(pairs.dtype, np.integer):
-            raise TypeError(f"spring ends must be integer particle indices, got {pairs.dtype}")
-        count, n = len(pairs), self.n_particles
-        if count and (pairs.min() < 0 or pairs.max() >= n):
-            bad = np.flatnonzero(((pairs < 0) | (pairs >= n)).any(axis=1))[0]
-            raise ValueError(
-                f"spring {bad} joins particles {pairs[bad, 0]} and {pairs[bad, 1]}, but the body "
-                f"has {n} particles (indices 0 to {n - 1}); add the particles first"
-            )
-        a, b = pairs[:, 0], pairs[:, 1]
-        if (a == b).any():
-            same = np.flatnonzero(a == b)[0]
-            raise ValueError(
-                f"spring {same} joins particle {a[same]} to itself; "
-                "a spring needs two different particles"
-            )
-        if rest_lengths is None:
-            rest_lengths = np.linalg.norm(self.positions[a] - self.positions[b], axis=1)
-            if count and rest_lengths.min() == 0:
-                zero = np.flatnonzero(rest_lengths == 0)[0]
-                raise ValueError(
-                    f"zero-length spring: particles {a[zero]} and {b[zero]} are at the same "
-                    f"position {self.positions[a[zero]].tolist()}; "
-                    "move them apart or give rest_length > 0"
-                )
-        values = _checked_values(count, stiffness, rest_lengths, damping)
-        self.lay_out_springs()
+        """Add springs between index pairs (E, 2) to the edge list; rest lengths default to
+        the current distances. Values are one per spring or one for all."""
+        new = edge_springs(self.positions, pairs, stiffness, rest_lengths, damping)
         first = self.n_springs
-        new = (a.astype(np.int64), b.astype(np.int64), *values.values())
-        self._keep_springs(
-            *(np.concatenate([getattr(self, n), v]) for n, v in zip(SPRING_ARRAYS, new))
-        )
+        self.spring_set = self.spring_set.joined(new)
         self.version += 1
-        return np.arange(first, first + count)
+        return np.arange(first, first + new.count)
 
     def set_springs(self, springs: object = None, **values: object) -> None:
-        """Set ``stiffness`` (N/m), ``rest_lengths`` (m) and/or ``spring_damping`` (N·s/m) of
-        the springs ``springs`` (indices; default all), each one value or one per spring.
-
-        A grid keeps its springs per offset when every spring gets one value; an edit of
-        some springs, or per spring, lays them out first (`lay_out_springs`).
-        """
-        unknown = set(values) - set(VALUE_HINTS)
-        if unknown:
-            raise TypeError(f"set_springs sets {', '.join(VALUE_HINTS)}, not {sorted(unknown)}")
-        chosen = np.arange(self.n_springs)[slice(None) if springs is None else springs]
-        checked = {name: _checked_value(name, v, len(chosen)) for name, v in values.items()}
-        grid = self.grid_springs
-        one = {
-            name: float(v[0]) for name, v in checked.items() if len(chosen) and np.all(v == v[0])
-        }
-        if grid is not None and springs is None and len(one) == len(checked):
-            self._keep_grid(grid.with_values(**one))
-            return
-        self.lay_out_springs()
-        for name, value in checked.items():
-            array = getattr(self, name)
-            array.flags.writeable = True  # the body's own array, read-only to others
-            array[chosen] = value
-            array.flags.writeable = False
+        """Set ``stiffness`` (N/m), ``rest_lengths`` (m) and/or ``damping`` (N·s/m) of the
+        springs ``springs`` (indices; default all), each one value or one per spring.
+        A lattice takes one value for all its springs (see `springs_as_edges`)."""
+        chosen = None if springs is None else np.arange(self.n_springs)[springs]
+        count = self.n_springs if chosen is None else len(chosen)
+        checked = {name: checked_value(name, value, count) for name, value in values.items()}
+        self.spring_set.set_values(chosen, **checked)
         self.version += 1
 
-    def lay_out_springs(self) -> None:
-        """Write the springs of `grid_springs` into per-spring arrays (a no-op without).
+    def edges(self) -> EdgeSprings:
+        """The springs as an edge list: the body's own, or a lattice's laid out (not kept)."""
+        return self.spring_set.edges()
 
-        The springs keep their order and values, so the kernels compute the same (and
-        ``version`` stays).
-        """
-        grid = self.grid_springs
-        if grid is None:
-            return
-        blocks = [np.zeros((0, 2), np.int64), *grid_pair_blocks(grid.shape, grid.offsets)]
-        pairs, counts = np.concatenate(blocks), [len(block) for block in blocks[1:]]
-        self._keep_springs(
-            pairs[:, 0].copy(),
-            pairs[:, 1].copy(),
-            np.full(grid.count, grid.stiffness),
-            np.repeat(grid.rest_lengths, counts),
-            np.full(grid.count, grid.damping),
-        )
-        self.grid_springs = None
-
-    def _keep_grid(self, grid: GridSprings) -> None:
-        """Keep the springs per offset (``grid``): one stiffness and dashpot for all springs,
-        read as broadcast arrays (no memory per spring); the ends and rest lengths come
-        when laid out (`__getattr__`)."""
-        for name in ("spring_a", "spring_b", "rest_lengths", "spring_values"):
-            self.__dict__.pop(name, None)
-        self._keep(
-            grid_springs=grid,
-            stiffness=np.broadcast_to(grid.stiffness, (grid.count,)),
-            spring_damping=np.broadcast_to(grid.damping, (grid.count,)),
-        )
-        self.version += 1
+    def springs_as_edges(self) -> EdgeSprings:
+        """Make the springs an edge list, to edit single springs or add some; return it."""
+        edges = self.spring_set.edges()
+        if edges is not self.spring_set:
+            self.spring_set, self.version = edges, self.version + 1
+        return edges
 
     def new_state(self) -> tuple[np.ndarray, np.ndarray]:
-        """Empty arrays (N, d) for the next positions and velocities, for a kernel to write
-        a step's new state into; `store_state` then makes them the body's own, uncopied."""
+        """Empty arrays (N, d) for a step's new positions and velocities (`store_state`)."""
         new = (np.empty_like(self.positions), np.empty_like(self.velocities))
-        self.__dict__["_new_state"] = new  # every step: past `__setattr__`
+        vars(self).update(_new_state=new)  # every step: past `__setattr__`
         return new
 
     def store_state(self, positions: np.ndarray, velocities: np.ndarray) -> None:
-        """Make ``positions`` (m) and ``velocities`` (m/s), (N, d), the body's state.
-
-        The arrays of the last `new_state` become the body's own; others are copied
-        in. Arrays read from the body before may then keep the old state.
-        """
-        new, self.__dict__["_new_state"] = self._new_state, ()  # every step: past `__setattr__`
-        if new and positions is new[0] and velocities is new[1] and len(new[0]) == len(self):
-            self.__dict__.update(positions=positions, velocities=velocities)
+        """Make ``positions`` (m) and ``velocities`` (m/s), (N, d), the body's state: those of
+        the last `new_state` uncopied (arrays read before keep the old state), others copied."""
+        new = vars(self).pop("_new_state", ())
+        if new and positions is new[0] and velocities is new[1] and len(positions) == len(self):
+            vars(self).update(positions=positions, velocities=velocities)  # past `__setattr__`
         else:
             self.positions[...], self.velocities[...] = positions, velocities
 
@@ -352,10 +165,13 @@ class Body:
         rest_lengths: object = None,
         damping: object = 0.0,
     ) -> Body:
-        """A body from arrays: positions (N, d), spring index pairs (E, 2) and their values."""
+        """A body from positions (N, d) and springs: index pairs (E, 2) and values, or a lattice."""
         body = cls()
         body.add_particles(positions, velocities, masses, fixed)
-        body.add_springs(springs, stiffness, rest_lengths, damping)
+        if isinstance(springs, LatticeSprings):
+            body.spring_set = springs
+        else:
+            body.add_springs(springs, stiffness, rest_lengths, damping)
         return body
 
     @classmethod
@@ -369,38 +185,21 @@ class Body:
         mass: float = 1.0,
         damping: float = 0.0,
     ) -> Body:
-        """A 2-D or 3-D grid of particles ``origin + spacing·(i, j[, k])``, C order.
-
-        ``neighbours`` are squared distances in grid units: 1 makes axis springs
-        (rest length = spacing), 2 face diagonals (√2·spacing), 3 body diagonals
-        (√3·spacing). The grid is at rest: every spring starts at its rest length.
-        The springs are kept per offset (`grid_springs`) until laid out.
-        """
+        """A 2-D or 3-D grid of particles ``origin + spacing·(i, j[, k])``, C order, joined at
+        rest by a lattice (`lattice.LatticeSprings`) to its ``neighbours``: squared distances
+        in grid units, 1 axis springs (rest length = spacing), 2 face diagonals (√2·spacing),
+        3 body diagonals (√3·spacing)."""
         shape = grid_shape(shape)
-        spacing = check_positive("spacing", spacing, "Grid spacing is in m and must be > 0.")
-        origin = np.zeros(len(shape)) if origin is None else np.asarray(origin, dtype=float)
-        if origin.shape != (len(shape),):
-            raise ValueError(f"origin must have {len(shape)} coordinates, got {origin.tolist()}")
-        offsets = neighbour_offsets(len(shape), neighbours)
         body = cls()
         body.add_particles(grid_positions(shape, spacing, origin), masses=mass)
-        k = _per_row("stiffness", stiffness, 1, f"Use k >= 0 in N/m, e.g. {GRID_EXAMPLE}.")
-        c = _per_row("damping", damping, 1, "Use a dashpot c >= 0 in N·s/m, e.g. damping=0.1.")
-        rest = spacing * np.sqrt((offsets**2).sum(axis=1))
-        body._keep_grid(GridSprings(shape, offsets, rest, float(k[0]), float(c[0])))
-        body.grid_shape = shape
+        body.spring_set = lattice_springs(shape, neighbours, spacing, stiffness, damping)
         return body
 
-    # ----------------------------------------------------------------- helpers
     def copy(self) -> Body:
-        """An independent copy of the body (state and springs)."""
+        """An independent copy of the body (particles and springs)."""
         body = Body(self.dim)
         body.add_particles(self.positions, self.velocities, self.masses, self.fixed)
-        if self.grid_springs is None:
-            body._keep_springs(*(getattr(self, name).copy() for name in SPRING_ARRAYS))
-        else:
-            body._keep_grid(self.grid_springs)
-        body.grid_shape = self.grid_shape
+        body.spring_set = copied(self.spring_set)
         return body
 
     def center_of_mass(self) -> np.ndarray:
@@ -410,60 +209,19 @@ class Body:
     def rotate(self, rotation: np.ndarray, about: Sequence[float] | None = None) -> None:
         """Rotate positions and velocities by a (d, d) rotation matrix about a point
         (default: the centre of mass). See `rotation_matrix`."""
-        rotation = np.asarray(rotation, dtype=float)
-        if rotation.shape != (self.dim, self.dim) or not np.allclose(
-            rotation @ rotation.T, np.eye(self.dim), atol=1e-9
-        ):
-            raise ValueError(f"rotation must be an orthogonal ({self.dim}, {self.dim}) matrix")
+        rotation = checked_rotation(rotation, self.dim)
         centre = self.center_of_mass() if about is None else np.asarray(about, dtype=float)
         self.positions[:] = (self.positions - centre) @ rotation.T + centre
         self.velocities[:] = self.velocities @ rotation.T
 
-    def incident_springs(self) -> tuple[np.ndarray, np.ndarray]:
-        """CSR lists of the springs touching each particle: ``springs[start[i]:start[i+1]]``."""
-        if self._incidence is None or self._incidence[0] != self.version:
-            ends = np.concatenate([self.spring_a, self.spring_b])
-            start = np.zeros(self.n_particles + 1, dtype=np.int64)
-            np.cumsum(np.bincount(ends, minlength=self.n_particles), out=start[1:])
-            springs = np.argsort(ends, kind="stable") % max(self.n_springs, 1)
-            self._incidence = (self.version, start, springs)
-        return self._incidence[1], self._incidence[2]
-
     def springs_touching(self, particles: np.ndarray) -> np.ndarray:
         """Indices of the springs with an end in ``particles`` (sorted, unique)."""
-        start, springs = self.incident_springs()
-        if len(particles) == 1:  # one slice (a wall's bounce asks for one particle at a time)
-            return np.unique(springs[start[particles[0]] : start[particles[0] + 1]])
-        counts = start[particles + 1] - start[particles]
-        first = np.repeat(start[particles] - (np.cumsum(counts) - counts), counts)
-        return np.unique(springs[first + np.arange(counts.sum())])
+        if self._incidence[0] != self.version:  # the CSR lists of `springs.incidence`
+            self._incidence = (self.version, *incidence(self.edges(), self.n_particles))
+        return touching(*self._incidence[1:], particles)
 
     def __repr__(self) -> str:
         kind = f"{self.dim}-D" if self.dim else "empty"
-        grid = f", grid {self.grid_shape}" if self.grid_shape else ""
+        lattice = isinstance(self.spring_set, LatticeSprings)
+        grid = f", grid {self.spring_set.shape}" if lattice else ""
         return f"<Body {kind}: {self.n_particles} particles, {self.n_springs} springs{grid}>"
-
-
-def _checked_value(name: str, values: object, count: int) -> np.ndarray:
-    """Spring value ``name`` for ``count`` springs, checked (rest lengths > 0, others >= 0)."""
-    label = {"rest_lengths": "rest length", "spring_damping": "damping"}.get(name, name)
-    return _per_row(label, values, count, VALUE_HINTS[name], zero=name != "rest_lengths")
-
-
-def _checked_values(count: int, k: object, rest: object, c: object) -> dict[str, np.ndarray]:
-    return {name: _checked_value(name, v, count) for name, v in zip(VALUE_HINTS, (k, rest, c))}
-
-
-def rotation_matrix(angle_degrees: float, axis: Sequence[float] | None = None) -> np.ndarray:
-    """Right-handed rotation by ``angle_degrees``: 2×2 in 2-D (no axis), 3×3 about ``axis``."""
-    angle = math.radians(angle_degrees)
-    c, s = math.cos(angle), math.sin(angle)
-    if axis is None:
-        return np.array([[c, -s], [s, c]])
-    axis = np.asarray(axis, dtype=float)
-    norm = np.linalg.norm(axis)
-    if axis.shape != (3,) or not np.isfinite(norm) or norm == 0:
-        raise ValueError(f"rotation axis must be a non-zero 3-vector, got {axis.tolist()}")
-    x, y, z = axis / norm
-    cross = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
-    return c * np.eye(3) + s * cross + (1 - c) * np.outer([x, y, z], [x, y, z])

@@ -37,7 +37,7 @@ class Field:
         if item is None:
             return self
         body = item.body
-        value = item._own[self.name] if body is None else getattr(body, self.array)[item.index]
+        value = item._own[self.name] if body is None else item.read(self.array)
         return value if self.kind is None or value is None else self.kind(value)
 
     def __set__(self, item: Bound, value: Any) -> None:
@@ -65,6 +65,20 @@ class Bound:
         Bound.__init__(item)
         item.bind(body, index)
         return item
+
+    @classmethod
+    def check_new(cls, item: object, method: str) -> None:
+        """TypeError unless ``item`` is one of these, ValueError if it is in a body already
+        (``method`` is the body's method that was given it)."""
+        kind = cls.__name__
+        if not isinstance(item, cls):
+            raise TypeError(f"{method} takes a msdlab.{kind}, got {type(item).__name__}")
+        if item.body is not None:
+            raise ValueError(f"this {kind.lower()} already belongs to a body; make a new {kind}")
+
+    def read(self, array: str) -> Any:
+        """Row ``index`` of the body's ``array`` (a view for a row of several numbers)."""
+        return getattr(self.body, array)[self.index]
 
     def write(self, array: str, value: Any) -> None:
         """Write ``value`` into row ``index`` of the body's ``array``."""

@@ -26,7 +26,8 @@ class JacobianPattern:
     def __init__(self, body: Body) -> None:
         dim = body.dim or 3
         n_dof = body.n_particles * dim
-        rows, cols = _block_indices(body.spring_a, body.spring_b, dim)
+        edges = body.edges()
+        rows, cols = _block_indices(edges.a, edges.b, dim)
         diagonal = np.arange(n_dof, dtype=np.int64)
         keys = np.concatenate([rows * n_dof + cols, diagonal * (n_dof + 1)])
         unique, inverse = np.unique(keys, return_inverse=True)

@@ -8,9 +8,10 @@ backend is tested against it, method by method. The numba backend
 (`msdlab.compiled.NumbaKernel`, the default) applies the same equations one
 spring or particle at a time in compiled loops.
 
-Every function takes the spring arrays of a `Body` (``a``, ``b`` particle indices,
-``k`` stiffness, ``rest`` rest lengths, ``c`` dashpot coefficients) and computes,
-for all springs at once, what `Spring.force` computes for one.
+Every function reads a body's springs as an edge list (`springs.EdgeSprings`: ``a``,
+``b`` particle indices, stiffness, rest lengths, dashpots; `Body.edges`, which lays a
+lattice out) and computes, for all springs at once, what `Spring.force` computes for
+one. `NumpyKernel` keeps a lattice's edge list, laid out once per edit.
 """
 
 from __future__ import annotations
@@ -21,11 +22,17 @@ from . import equations
 from .body import Body
 from .jacobian import JacobianPattern
 from .kernel_results import Advanced, Jacobians, SpringSums, Update
+from .springs import EdgeSprings
 
 
 def spring_vectors(body: Body, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Spring vectors x_a - x_b (E, d) and lengths (E,) in m."""
-    d = x.take(body.spring_a, axis=0) - x.take(body.spring_b, axis=0)
+    return vectors(body.edges(), x)
+
+
+def vectors(edges: EdgeSprings, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """`spring_vectors` of the springs ``edges``."""
+    d = x.take(edges.a, axis=0) - x.take(edges.b, axis=0)
     return d, np.sqrt(np.einsum("ij,ij->i", d, d))
 
 
@@ -45,65 +52,45 @@ def spring_forces(
     restricts the sum to some springs (indices).
     """
     out = np.zeros_like(x) if out is None else out
-    return out, add_spring_forces(body, x, v, out, springs).stretch
-
-
-def add_spring_forces(
-    body: Body,
-    x: np.ndarray,
-    v: np.ndarray,
-    out: np.ndarray,
-    springs: np.ndarray | None = None,
-) -> SpringSums:
-    """Add `spring_forces` to ``out`` (N, d); with the largest stretch and the power (W)
-    the dashpots take at (x, v), Σ c ((v_a - v_b)·n)²."""
-    a, b = body.spring_a, body.spring_b
-    stiffness, rest, damping = body.spring_values
-    if springs is not None:
-        a, b, stiffness, rest, damping = (
-            values[springs] for values in (a, b, stiffness, rest, damping)
-        )
-    d = x.take(a, axis=0) - x.take(b, axis=0)
-    length = np.sqrt(np.einsum("ij,ij->i", d, d))
-    power, w = 0.0, np.zeros_like(d[:1])  # without dashpots v_a - v_b is not needed
-    if damping.any():
-        w = v.take(a, axis=0) - v.take(b, axis=0)
-        safe = np.where(length > 0, length, np.inf)  # coincident ends: no rate
-        power = float(np.sum(equations.dashpot_power(damping, np.einsum("ij,ij->i", w, d) / safe)))
-    along = (*d.T, 0.0)[:3], (*w.T, 0.0)[:3]  # three coordinates each, the third 0 in 2-D
-    f = equations.spring_force(stiffness, rest, damping, *along)
-    for q in range(x.shape[1]):  # eq. (1.1): f on each a, -f on each b
-        out[:, q] += np.bincount(a, f[q], len(x)) - np.bincount(b, f[q], len(x))
-    stretch = float((length / rest).max()) if len(length) else 0.0
-    return SpringSums(stretch, power)
+    return out, NumpyKernel().spring_forces(body, x, v, out, springs).stretch
 
 
 def elastic_energy(body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
     """Energy stored in the springs (or in the given ones), Σ ½ k (|x_a - x_b| - l)² (J)."""
+    return energy(body.edges(), x, springs)
+
+
+def energy(edges: EdgeSprings, x: np.ndarray, springs: np.ndarray | None = None) -> float:
+    """`elastic_energy` of the springs ``edges``."""
     pick = slice(None) if springs is None else springs
-    d = x[body.spring_a[pick]] - x[body.spring_b[pick]]
+    d = x[edges.a[pick]] - x[edges.b[pick]]
     length = np.sqrt(np.einsum("ij,ij->i", d, d))
-    stiffness, rest, _ = (values[pick] for values in body.spring_values)
-    return float(np.sum(equations.spring_energy(stiffness, rest, length)))
+    return float(
+        np.sum(equations.spring_energy(edges.stiffness[pick], edges.rest_lengths[pick], length))
+    )
 
 
 def spring_jacobians(
     body: Body, x: np.ndarray, pattern: JacobianPattern | None = None
 ) -> Jacobians:
-    """∂F/∂x and ∂F/∂v (N·d × N·d, sparse) of the spring and dashpot forces.
+    """∂F/∂x and ∂F/∂v (N·d × N·d, sparse) of the spring and dashpot forces (`jacobians`)."""
+    return jacobians(body.edges(), x, JacobianPattern(body) if pattern is None else pattern)
+
+
+def jacobians(edges: EdgeSprings, x: np.ndarray, pattern: JacobianPattern) -> Jacobians:
+    """`spring_jacobians` of the springs ``edges``, on the sparsity ``pattern`` of an
+    earlier call on the same springs.
 
     Per spring with n = d/|d|, the stiffness block is B = k n nᵀ + k_t (I - n nᵀ),
     k_t = `equations.transverse_stiffness`, and the dashpot block is C = c n nᵀ.
     Both enter as -B on the (a, a) and (b, b) blocks and +B on (a, b) and (b, a).
-    ``pattern`` reuses the sparsity of an earlier call on the same springs.
     """
-    pattern = JacobianPattern(body) if pattern is None else pattern
     dim = x.shape[1]
-    d, length = spring_vectors(body, x)
+    d, length = vectors(edges, x)
     safe = np.where(length > 0, length, np.inf)  # coincident ends: n = 0, B = k I
     n = d / safe[:, None]
     outer = n[:, :, None] * n[:, None, :]
-    stiffness, rest, damping = body.spring_values
+    stiffness, rest, damping = edges.values()
     across = equations.transverse_stiffness(stiffness, rest, safe)[:, None, None]
     stiff = (stiffness[:, None, None] - across) * outer + across * np.eye(dim)
     return Jacobians(
@@ -114,28 +101,6 @@ def spring_jacobians(
 def finite(x: np.ndarray, v: np.ndarray) -> bool:
     """Whether every position and velocity (N, d) is a finite number."""
     return bool(np.isfinite(x).all() and np.isfinite(v).all())
-
-
-def advance(
-    update: Update,
-    body: Body,
-    x: np.ndarray,
-    v: np.ndarray,
-    field: np.ndarray,
-    dt: float,
-    coefficients: tuple[float, ...],
-    forces: np.ndarray | None = None,
-) -> Advanced:
-    """``update(x, v, a, dt, *coefficients)`` on whole arrays, a = (F + m·g)/m (0 if fixed):
-    F the spring forces plus ``forces`` (N, d) if given, g = ``field`` (d,) in m/s²."""
-    total = np.zeros_like(x)
-    sums = add_spring_forces(body, x, v, total)
-    total = total if forces is None else total + forces
-    masses = body.masses[:, None]
-    if field.any():
-        total += masses * field
-    a = equations.acceleration(total, masses, ~body.fixed[:, None])
-    return Advanced(*update(x, v, a, dt, *coefficients), *sums)
 
 
 def ground_clamp(
@@ -177,12 +142,86 @@ def ground_clamp(
 
 
 class NumpyKernel:
-    """The readable backend (`spring_kernel.SpringKernel`): the functions above on whole arrays."""
+    """The readable kernel (`spring_kernel.SpringKernel`): the equations on whole arrays.
+
+    It reads a body's springs as an edge list: an edge list's own arrays, or a
+    lattice laid out once per edit (``body.version``) and kept here.
+    """
 
     name = "numpy"
-    spring_forces = staticmethod(add_spring_forces)
-    elastic_energy = staticmethod(elastic_energy)
-    jacobians = staticmethod(spring_jacobians)
     finite = staticmethod(finite)
-    advance = staticmethod(advance)
     ground_clamp = staticmethod(ground_clamp)
+
+    def __init__(self) -> None:
+        self._edges: tuple[object, int, EdgeSprings] = (None, -1, EdgeSprings.empty())
+
+    def edges(self, body: Body) -> EdgeSprings:
+        """The springs of ``body`` as an edge list (a lattice's laid out once per edit)."""
+        if self._edges[0] is not body.spring_set or self._edges[1] != body.version:
+            self._edges = (body.spring_set, body.version, body.spring_set.edges())
+        return self._edges[2]
+
+    def spring_forces(
+        self,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        out: np.ndarray,
+        springs: np.ndarray | None = None,
+    ) -> SpringSums:
+        """Add `spring_forces` to ``out`` (N, d); with the largest stretch and the power (W)
+        the dashpots take at (x, v), Σ c ((v_a - v_b)·n)²."""
+        kept = self._edges  # `edges`, its check written out: no call a step
+        same = kept[0] is body.spring_set and kept[1] == body.version
+        edges = kept[2] if same else self.edges(body)
+        a, b, stiffness, rest, damping = (
+            edges.a, edges.b, edges.stiffness, edges.rest_lengths, edges.damping
+        )  # fmt: skip
+        if springs is not None:
+            a, b, stiffness, rest, damping = (
+                values[springs] for values in (a, b, stiffness, rest, damping)
+            )
+        d = x.take(a, axis=0) - x.take(b, axis=0)
+        length = np.sqrt(np.einsum("ij,ij->i", d, d))
+        power, w = 0.0, np.zeros_like(d[:1])  # without dashpots v_a - v_b is not needed
+        if damping.any():
+            w = v.take(a, axis=0) - v.take(b, axis=0)
+            safe = np.where(length > 0, length, np.inf)  # coincident ends: no rate
+            rate = np.einsum("ij,ij->i", w, d) / safe
+            power = float(np.sum(equations.dashpot_power(damping, rate)))
+        along = (*d.T, 0.0)[:3], (*w.T, 0.0)[:3]  # three coordinates each, the third 0 in 2-D
+        f = equations.spring_force(stiffness, rest, damping, *along)
+        for q in range(x.shape[1]):  # eq. (1.1): f on each a, -f on each b
+            out[:, q] += np.bincount(a, f[q], len(x)) - np.bincount(b, f[q], len(x))
+        stretch = float((length / rest).max()) if len(length) else 0.0
+        return SpringSums(stretch, power)
+
+    def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
+        """`energy` of the body's springs (J)."""
+        return energy(self.edges(body), x, springs)
+
+    def jacobians(self, body: Body, x: np.ndarray, pattern: JacobianPattern) -> Jacobians:
+        """`jacobians` of the body's springs."""
+        return jacobians(self.edges(body), x, pattern)
+
+    def advance(
+        self,
+        update: Update,
+        body: Body,
+        x: np.ndarray,
+        v: np.ndarray,
+        field: np.ndarray,
+        dt: float,
+        coefficients: tuple[float, ...],
+        forces: np.ndarray | None = None,
+    ) -> Advanced:
+        """``update(x, v, a, dt, *coefficients)`` on whole arrays, a = (F + m·g)/m (0 if fixed):
+        F the spring forces plus ``forces`` (N, d) if given, g = ``field`` (d,) in m/s²."""
+        total = np.zeros_like(x)
+        sums = self.spring_forces(body, x, v, total)
+        total = total if forces is None else total + forces
+        masses = body.masses[:, None]
+        if field.any():
+            total += masses * field
+        a = equations.acceleration(total, masses, ~body.fixed[:, None])
+        return Advanced(*update(x, v, a, dt, *coefficients), *sums)

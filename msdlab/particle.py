@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .bound import Bound, Field
-from .errors import check_finite_array, check_positive, shown
+from .errors import as_vectors, check_finite_array, check_non_negative, check_positive, shown
 
 
 def _coordinates(value: object) -> np.ndarray:
@@ -18,9 +18,42 @@ def _coordinates(value: object) -> np.ndarray:
     return vector
 
 
+MASS_HINT = "Give every particle a mass > 0 (kg); to pin a particle use fixed=True."
+
+
 def _mass(value: float) -> float:
-    hint = "Give every particle a mass > 0 (kg); to pin a particle use fixed=True."
-    return check_positive("mass", value, hint)
+    return check_positive("mass", value, MASS_HINT)
+
+
+def checked_masses(masses: object, count: int) -> np.ndarray:
+    """``masses`` (kg), one or one per particle, checked > 0, as ``count`` floats."""
+    array = check_non_negative("mass", masses, MASS_HINT, zero=False)
+    if array.ndim and array.shape != (count,):
+        raise ValueError(f"mass needs one value or one per particle ({count}), got {array.shape}")
+    return np.broadcast_to(array, (count,)).copy()
+
+
+def particle_arrays(
+    dim: int | None, positions: object, velocities: object, masses: object, fixed: object
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """New particles' positions (N, d), velocities (zero if fixed or None), masses (N,) and
+    fixed mask (N,), checked for a body of ``dim`` (None: not chosen yet)."""
+    positions = np.array(positions, dtype=float)
+    width = positions.shape[-1] if positions.ndim == 2 else None
+    if width not in (2, 3):
+        raise ValueError(f"positions must have shape (N, 2) or (N, 3), got {positions.shape}")
+    if dim not in (None, width):
+        raise ValueError(
+            f"this body is {dim}-D but the new particle has {width} coordinates; "
+            "do not mix 2-D and 3-D particles in one body"
+        )
+    count = len(positions)
+    positions = as_vectors("positions", positions, width, count)
+    velocities = np.zeros(width) if velocities is None else velocities
+    velocities = as_vectors("velocities", velocities, width, count)
+    fixed = np.broadcast_to(np.asarray(fixed, dtype=bool), (count,)).copy()
+    velocities[fixed] = 0.0
+    return positions, velocities, checked_masses(masses, count), fixed
 
 
 class _Pin(Field):

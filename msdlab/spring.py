@@ -38,11 +38,11 @@ class Spring(Bound):
     `msdlab.compiled`) all apply `equations.spring_force`.
     """
 
-    a = Field("spring_a", "Index of the first particle.", kind=int)
-    b = Field("spring_b", "Index of the second particle.", kind=int)
+    a = Field("a", "Index of the first particle.", kind=int)
+    b = Field("b", "Index of the second particle.", kind=int)
     stiffness = Field("stiffness", "Stiffness k (N/m).", _stiffness)
     rest_length = Field("rest_lengths", "Rest length l (m); None until in a body.", _rest_length)
-    damping = Field("spring_damping", "Dashpot coefficient c (N·s/m).", _damping)
+    damping = Field("damping", "Dashpot coefficient c (N·s/m).", _damping)
 
     def __init__(
         self,
@@ -64,6 +64,10 @@ class Spring(Bound):
             raise ValueError(f"a spring cannot join particle {a} to itself; pick two particles")
         self.stiffness, self.damping = stiffness, damping
         self._own["rest_length"] = None if rest_length is None else _rest_length(rest_length)
+
+    def read(self, array: str) -> float:
+        """This spring's value ``array`` in its body's spring set (`springs.SpringValues`)."""
+        return getattr(self.body.spring_set.spring(self.index), array)
 
     def write(self, array: str, value: float) -> None:
         """Set this spring's value ``array`` in its body (`Body.set_springs`)."""

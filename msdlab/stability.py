@@ -171,11 +171,11 @@ def describe_blowup(
         fastest = int(np.argmax(speed))
         lines.append(f"particle {fastest} moves at {speed[fastest]:.3g} m/s")
     if body.n_springs:
-        _, length = kernels.spring_vectors(body, x)
-        stretch = length / body.rest_lengths
+        edges = body.edges()
+        stretch = kernels.vectors(edges, x)[1] / edges.rest_lengths
         worst = int(np.argmax(stretch))
         lines.append(
-            f"spring {worst} (particles {body.spring_a[worst]}-{body.spring_b[worst]}) is at "
+            f"spring {worst} (particles {edges.a[worst]}-{edges.b[worst]}) is at "
             f"{stretch[worst]:.3g}× its rest length"
         )
     lines.append(_against_the_limit(integrator, dt, stiffest_mode(body, forces, reference)))

@@ -66,7 +66,9 @@ def measure_blowup_dt(
         low, high = predicted / 5 if low is None else low, predicted * 3 if high is None else high
     rng = np.random.default_rng(seed)
     kick = (
-        perturbation * float(np.min(body.rest_lengths)) * rng.standard_normal(body.positions.shape)
+        perturbation
+        * float(np.min(body.spring_set.rest_lengths))
+        * rng.standard_normal(body.positions.shape)
     )
     kick[body.fixed] = 0.0
     is_stable = partial(_stays_stable, body, integrator, forces, kick, steps)
@@ -75,8 +77,9 @@ def measure_blowup_dt(
 
 def _strain(body: Body) -> float:
     """The largest spring strain |l/l₀ - 1| of ``body``."""
-    _, length = kernels.spring_vectors(body, body.positions)
-    return float(np.max(np.abs(length / body.rest_lengths - 1.0)))
+    edges = body.edges()
+    _, length = kernels.vectors(edges, body.positions)
+    return float(np.max(np.abs(length / edges.rest_lengths - 1.0)))
 
 
 def _stays_stable(

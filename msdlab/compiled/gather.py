@@ -9,7 +9,8 @@ neighbour would leave its row masked out), three offsets at a time (a
 particle's position is read and its force written once for three springs).
 The threads take grid planes, every third one at once in three rounds, so
 that no two write the same particle; one thread takes them in the same order,
-with the same sums. The layout these loops read is made in `stencil`.
+with the same sums. The layout these loops read (`stencil.Layout`, named arrays per
+triple of offsets) and their memory (`stencil.Scratch`) are made in `stencil`.
 """
 
 import math
@@ -52,7 +53,7 @@ def _pull_damped(y0, y1, y2, u0, u1, u2, xs, vs, q, there, k, rest, c):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _push_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, values, scales, pad):
+def _push_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, springs, scales, pad):
     """Add to particles ``first`` to ``stop - 1`` the forces of their springs to three
     neighbours, at p + ``shifts[j]``, the same grid row offset apart, and keep each
     spring's f/|d| in ``scales[j, pad + p - first]`` for `_react`.
@@ -61,8 +62,8 @@ def _push_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, values
     contiguous, so the loop runs on vector registers; a particle's position
     is read and its force written once for three springs. ``columns[masks[j], p - first]``
     is 1 where p has neighbour j, 0 where it would leave p's grid row.
-    ``values[j]`` (3, 4) holds the spring's stiffness, rest length, dashpot and
-    1/rest²; ``squared[p]`` keeps the largest |d|²/l² seen (a running maximum
+    ``springs`` holds the springs' stiffness, rest length, dashpot and 1/rest²
+    (3,) each; ``squared[p]`` keeps the largest |d|²/l² seen (a running maximum
     would keep the loop scalar). Returns the dashpot power (W) of these
     springs; with dashpots the loop stays scalar. Indices are unsigned: numba
     then needs no negative-index test, which would also keep the loop scalar.
@@ -71,9 +72,11 @@ def _push_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, values
     f0, f1, f2 = fs
     ma, mb, mc = masks  # rows of `columns`
     sa, sb, sc = shifts
-    ka, ra, ca, wa = values[0, 0], values[0, 1], values[0, 2], values[0, 3]
-    kb, rb, cb, wb = values[1, 0], values[1, 1], values[1, 2], values[1, 3]
-    kc, rc, cc, wc = values[2, 0], values[2, 1], values[2, 2], values[2, 3]
+    stiffness, rest, damping, inverse_rest_squared = springs
+    ka, kb, kc = stiffness[0], stiffness[1], stiffness[2]
+    ra, rb, rc = rest[0], rest[1], rest[2]
+    ca, cb, cc = damping[0], damping[1], damping[2]
+    wa, wb, wc = inverse_rest_squared[0], inverse_rest_squared[1], inverse_rest_squared[2]
     kept_a, kept_b, kept_c = scales[0], scales[1], scales[2]
     power = 0.0
     if ca == 0.0 and cb == 0.0 and cc == 0.0:  # no sum across springs: vector registers
@@ -111,13 +114,13 @@ def _push_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, values
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _push_one(xs, vs, fs, squared, column, first, stop, shift, values, kept, pad):
+def _push_one(xs, vs, fs, squared, column, first, stop, shift, spring, kept, pad):
     """`_push_three` for a triple holding one spring: to the neighbours at p + ``shift``,
-    masked by ``column``, with the values (4,) ``values``, f/|d| kept in ``kept``; the
-    other two would be computed for nothing."""
+    masked by ``column``, with the stiffness, rest length, dashpot and 1/rest² ``spring``,
+    f/|d| kept in ``kept``; the other two would be computed for nothing."""
     x0, x1, x2 = xs
     f0, f1, f2 = fs
-    k, rest, c, w = values[0], values[1], values[2], values[3]
+    k, rest, c, w = spring
     power = 0.0
     if c == 0.0:  # vector registers, as in `_push_three`
         for i in range(first, stop):
@@ -183,69 +186,70 @@ def _react(xs, fs, scales, first, stop, shifts, pad):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _push_rows(scratch, pad, columns, shape, triples, rows_of, o2s, values, plane, rows, scales):
+def _push_rows(memory, layout, triples, plane, rows, scales):
     """Add the forces of the springs from the particles of grid rows ``rows`` (first, stop)
     of ``plane`` to their neighbours ahead to both ends; return their dashpot power (W).
 
-    ``scratch`` (10, N + 2·pad) holds the positions, velocities and forces by
-    coordinate and the squared stretches, particle p at p + pad (the padding
-    stays zero, so a masked neighbour past either end is still in memory);
-    ``scales`` (3, rows·n_2 + 2·pad) is the room `_push_three` and `_react` share.
-    Triple t joins each particle to its neighbours at the offsets
-    (``triples[t]``, ``o2s[t, j]``), j = 0, 1, 2, with the spring values
-    ``values[t, j]`` (see `stencil.stencil_triples`); for each, the rows whose
-    neighbours exist are consecutive, so the inner loops run over all of them
-    at once, and ``columns[rows_of[t, j]]`` masks the particles whose
-    neighbour would be past the end of their row (see `stencil.column_masks`).
+    ``memory`` is the `stencil.Scratch`, ``layout`` and ``triples`` the
+    `stencil.Layout` and `stencil.Triples`; ``scales``
+    (3, rows·n_2 + 2·pad) is the room `_push_three` and `_react` share. For each
+    triple of offsets the rows whose neighbours exist are consecutive, so the inner
+    loops run over all of them at once, with the column masks for the particles
+    whose neighbour would be past the end of their row.
     """
-    xs = (scratch[0], scratch[1], scratch[2])
-    vs = (scratch[3], scratch[4], scratch[5])
-    fs = (scratch[6], scratch[7], scratch[8])
-    n0, n1, n2 = shape[0], shape[1], shape[2]
+    xs, vs, fs, pad = memory.positions, memory.velocities, memory.forces, memory.pad
+    columns = layout.columns
+    n0, n1, n2 = layout.shape[0], layout.shape[1], layout.shape[2]
     power = 0.0
-    for t in range(len(triples)):
-        o0, o1 = triples[t, 0], triples[t, 1]
+    for t in range(len(triples.ahead)):
+        o0, o1 = triples.ahead[t, 0], triples.ahead[t, 1]
         lo, hi = max(rows[0], -o1), min(rows[1], n1 - o1)  # rows whose neighbours exist
         if not (0 <= plane + o0 < n0 and lo < hi):
             continue
         shift = (o0 * n1 + o1) * n2
         first, stop = (plane * n1 + lo) * n2 + pad, (plane * n1 + hi) * n2 + pad
-        masks = (rows_of[t, 0], rows_of[t, 1], rows_of[t, 2])
-        shifts = (shift + o2s[t, 0], shift + o2s[t, 1], shift + o2s[t, 2])
-        if masks[1] == len(columns) - 1:  # one spring (they come first, see `stencil_triples`)
-            column, one = columns[masks[0]], values[t, 0]
+        along, masks = triples.along[t], triples.masks[t]
+        shifts = (shift + along[0], shift + along[1], shift + along[2])
+        springs = (
+            triples.stiffness[t],
+            triples.rest_lengths[t],
+            triples.damping[t],
+            triples.inverse_rest_squared[t],
+        )
+        if masks[1] == len(columns) - 1:  # one spring (in the first place, see `Triples`)
+            one = (springs[0][0], springs[1][0], springs[2][0], springs[3][0])
             power += _push_one(
-                xs, vs, fs, scratch[9], column, first, stop, shifts[0], one, scales[0], pad
-            )
+                xs, vs, fs, memory.squared, columns[masks[0]], first, stop, shifts[0], one,
+                scales[0], pad,
+            )  # fmt: skip
             _react_one(xs, fs, scales[0], first, stop, shifts[0], pad)
             continue
+        masks3 = (masks[0], masks[1], masks[2])
         power += _push_three(
-            xs, vs, fs, scratch[9], columns, masks, first, stop, shifts, values[t], scales, pad
+            xs, vs, fs, memory.squared, columns, masks3, first, stop, shifts, springs, scales, pad
         )
         _react(xs, fs, scales, first, stop, shifts, pad)
     return power
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _push_unit(scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, unit):
+def _push_unit(memory, layout, triples, unit):
     """`_push_rows` for a unit of work: grid plane ``unit`` (3-D), or rows ``unit``·rows
-    to (``unit`` + 1)·rows - 1 (2-D), ``rows`` at a time. Returns the largest squared
-    stretch |d|²/l² of the springs from its particles and their dashpot power (W).
+    to (``unit`` + 1)·rows - 1 (2-D), ``layout.rows`` at a time. Returns the largest
+    squared stretch |d|²/l² of the springs from its particles and their dashpot power (W).
 
     A unit's springs reach the next unit only, and its masked neighbours (whose
     force is 0) the one after; so units three apart can be pushed at once.
     """
-    n0, n1, n2 = shape[0], shape[1], shape[2]
+    n0, n1, n2 = layout.shape[0], layout.shape[1], layout.shape[2]
+    rows, pad = layout.rows, memory.pad
     plane, lo, hi = (unit, 0, n1) if n0 > 1 else (0, unit * rows, min(unit * rows + rows, n1))
     scales = np.zeros((3, rows * n2 + 2 * pad))
     power = 0.0
     for first in range(lo, hi, rows):
-        block = (first, min(first + rows, hi))
-        power += _push_rows(
-            scratch, pad, columns, shape, triples, rows_of, o2s, values, plane, block, scales
-        )
+        power += _push_rows(memory, layout, triples, plane, (first, min(first + rows, hi)), scales)
     start, end = (plane * n1 + lo) * n2 + pad, (plane * n1 + hi) * n2 + pad
-    return scratch[9, start:end].max(), power
+    return memory.squared[start:end].max(), power
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -259,59 +263,62 @@ def _totals(squares, powers):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def gather_serial(x, v, shape, triples, rows_of, o2s, values, columns, rows, scratch, out, add):
+def gather_serial(x, v, layout, triples, memory, out, add):
     """One thread: `gather_parallel`'s work in the same order, so the same sums."""
-    pad = (scratch.shape[1] - len(x)) // 2
-    damped = np.any(values[:, :, 2] != 0.0)
-    scratch[6:, :] = 0.0
+    pad, damped = memory.pad, np.any(triples.damping != 0.0)
+    memory.forces[:, :] = 0.0
+    memory.squared[:] = 0.0
     for p in range(len(x)):  # loops, not slices: numba compiles them much faster
         for q in range(x.shape[1]):
-            scratch[q, p + pad] = x[p, q]
+            memory.positions[q, p + pad] = x[p, q]
             if damped:
-                scratch[3 + q, p + pad] = v[p, q]
-    units = shape[0] if shape[0] > 1 else (shape[1] + rows - 1) // rows
-    squares = np.zeros(units)
-    powers = np.zeros(units)
+                memory.velocities[q, p + pad] = v[p, q]
+    units = (
+        layout.shape[0]
+        if layout.shape[0] > 1
+        else (layout.shape[1] + layout.rows - 1) // layout.rows
+    )
+    squares, powers = np.zeros(units), np.zeros(units)
     for phase in range(3):
         for unit in range(phase, units, 3):
-            squares[unit], powers[unit] = _push_unit(
-                scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, unit
-            )
+            squares[unit], powers[unit] = _push_unit(memory, layout, triples, unit)
     for p in range(len(x) if add else 0):
         for q in range(x.shape[1]):
-            out[p, q] += scratch[6 + q, p + pad]
+            out[p, q] += memory.forces[q, p + pad]
     return _totals(squares, powers)
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
-def gather_parallel(x, v, shape, triples, rows_of, o2s, values, columns, rows, scratch, out, add):
-    """Add to ``out`` (N, d) the forces of a grid body's springs, each computed once, from
+def gather_parallel(x, v, layout, triples, memory, out, add):
+    """Add to ``out`` (N, d) the forces of a lattice's springs, each computed once, from
     the particle behind (`_push_unit`); return the largest stretch |d|/l and the dashpot
-    power (W), summed over the units in order. Without ``add`` the forces stay in
-    ``scratch`` (rows 6 to 8) for the caller to add in a loop of its own (see
-    `advance.compile_advance`).
+    power (W), summed over the units in order. ``layout``, ``triples`` and ``memory``
+    are the lattice's `stencil.Layout`, `stencil.Triples` and `stencil.Scratch`; without
+    ``add`` the forces stay in ``memory.forces`` for the caller to add in a loop of its
+    own (see `advance.compile_advance`).
 
     The threads push every third unit at once, in three rounds, so no two
     write the same particle.
     """
-    pad = (scratch.shape[1] - len(x)) // 2
-    damped = np.any(values[:, :, 2] != 0.0)
+    positions, velocities, forces, squared, pad = memory  # arrays, not the tuple, in prange
+    damped = np.any(triples.damping != 0.0)
     for p in numba.prange(len(x)):
         for q in range(x.shape[1]):
-            scratch[q, p + pad] = x[p, q]
+            positions[q, p + pad] = x[p, q]
             if damped:
-                scratch[3 + q, p + pad] = v[p, q]
-        scratch[6, p + pad] = scratch[7, p + pad] = scratch[8, p + pad] = scratch[9, p + pad] = 0.0
-    units = shape[0] if shape[0] > 1 else (shape[1] + rows - 1) // rows
-    squares = np.zeros(units)
-    powers = np.zeros(units)
+                velocities[q, p + pad] = v[p, q]
+        forces[0, p + pad] = forces[1, p + pad] = forces[2, p + pad] = squared[p + pad] = 0.0
+    units = (
+        layout.shape[0]
+        if layout.shape[0] > 1
+        else (layout.shape[1] + layout.rows - 1) // layout.rows
+    )
+    squares, powers = np.zeros(units), np.zeros(units)
     for phase in range(3):
         for u in numba.prange((units - phase + 2) // 3):
             unit = phase + 3 * u
-            squares[unit], powers[unit] = _push_unit(
-                scratch, pad, columns, shape, rows, triples, rows_of, o2s, values, unit
-            )
+            squares[unit], powers[unit] = _push_unit(memory, layout, triples, unit)
     for p in numba.prange(len(x) if add else 0):
         for q in range(x.shape[1]):
-            out[p, q] += scratch[6 + q, p + pad]
+            out[p, q] += forces[q, p + pad]
     return _totals(squares, powers)

@@ -1,8 +1,9 @@
-"""Energy of a grid's springs kept per offset (`lattice.GridSprings`), compiled: each
-offset's springs visited in grid order, with no list of springs.
+"""Energy of a lattice's springs (`lattice.LatticeSprings`), compiled: each offset's springs
+visited in grid order, with no list of springs.
 
-The grid is laid out as in `stencil.GridStencil`: shape (3,) in C order (2-D grids as
-(1, n0, n1)) and offsets (M, 3); spring m of particle p joins it to p + offset m.
+The grid has shape (3,) in C order (2-D grids as (1, n0, n1), `stencil.padded_shape`)
+and offsets (M, 3); spring m of particle p joins it to p + offset m, with the
+stiffness and rest length of offset m.
 """
 
 import math
@@ -14,12 +15,13 @@ from .equations import spring_energy
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _plane_sum(x, shape, offsets, values, m, plane):
+def _plane_sum(x, shape, offsets, stiffness, rest_lengths, m, plane):
     """Σ over the springs of offset m from the particles of grid ``plane``: their energy
-    ½ k (|d| - l)² (J), d = x_p - x_q, with ``values[:, m]`` k (N/m) and l (m)."""
+    ½ k (|d| - l)² (J), d = x_p - x_q, with k = ``stiffness[m]`` (N/m) and
+    l = ``rest_lengths[m]`` (m)."""
     n1, n2 = shape[1], shape[2]
     o1, o2 = offsets[m, 1], offsets[m, 2]
-    k, rest = values[0, m], values[1, m]
+    k, rest = stiffness[m], rest_lengths[m]
     shift = (offsets[m, 0] * n1 + o1) * n2 + o2
     total = 0.0
     for row in range(max(0, -o1), n1 - max(0, o1)):
@@ -35,22 +37,22 @@ def _plane_sum(x, shape, offsets, values, m, plane):
 
 
 @numba.njit(cache=True, error_model="numpy")
-def grid_sum_serial(x, shape, offsets, values):
+def grid_sum_serial(x, shape, offsets, stiffness, rest_lengths):
     """One thread: `grid_sum_parallel`'s sums, in the same order."""
     sums = np.zeros((len(offsets), shape[0]))
     for m in range(len(offsets)):
         for plane in range(max(0, -offsets[m, 0]), shape[0] - max(0, offsets[m, 0])):
-            sums[m, plane] = _plane_sum(x, shape, offsets, values, m, plane)
+            sums[m, plane] = _plane_sum(x, shape, offsets, stiffness, rest_lengths, m, plane)
     return sums.sum()
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
-def grid_sum_parallel(x, shape, offsets, values):
-    """The energy (J) of all springs (see `_plane_sum`), with ``values`` (3, M) the
-    stiffness, rest length and dashpot of each offset; the
-    threads take planes, and the sums are added in a fixed order."""
+def grid_sum_parallel(x, shape, offsets, stiffness, rest_lengths):
+    """The energy (J) of all springs (see `_plane_sum`), with the ``stiffness`` (N/m) and
+    ``rest_lengths`` (m) of each offset (M,); the threads take planes, and the sums are
+    added in a fixed order."""
     sums = np.zeros((len(offsets), shape[0]))
     for m in range(len(offsets)):
         for plane in numba.prange(max(0, -offsets[m, 0]), shape[0] - max(0, offsets[m, 0])):
-            sums[m, plane] = _plane_sum(x, shape, offsets, values, m, plane)
+            sums[m, plane] = _plane_sum(x, shape, offsets, stiffness, rest_lengths, m, plane)
     return sums.sum()

@@ -12,6 +12,8 @@ import numpy as np
 from .. import equations
 from ..body import Body
 from ..kernel_results import Advanced, Jacobians, SpringSums
+from ..lattice import LatticeSprings
+from ..springs import EdgeSprings
 from .advance import compile_advance
 from .contact import ground_clamp
 from .edges import (
@@ -25,14 +27,7 @@ from .edges import (
 from .gather import gather_parallel, gather_serial
 from .grid_sums import grid_sum_parallel, grid_sum_serial
 from .reductions import PARALLEL_MIN_PARTICLES, finite
-from .stencil import (
-    GridStencil,
-    column_masks,
-    grid_stencil,
-    stencil_triples,
-    triple_values,
-    uniform_blocks,
-)
+from .stencil import NO_PLAN, padded_shape, plan
 
 if TYPE_CHECKING:
     from ..jacobian import JacobianPattern
@@ -62,10 +57,10 @@ _FAILED: set[Callable] = set()  # updates numba cannot compile: they run on arra
 class NumbaKernel:
     """The compiled spring kernel for one body, with what it needs kept between calls.
 
-    Grid bodies whose springs share their values per offset are gathered by
-    offset (`grid_stencil`); other bodies go through the edge loop, over the
-    springs sorted by their ends (`_edge_list`), with one force buffer per
-    extra thread. What is kept is rebuilt when the springs change
+    A lattice (`lattice.LatticeSprings`, the springs of `Body.grid`) is gathered
+    by offset (`gather`, laid out by `stencil`); an edge list goes through the edge
+    loop, over the springs sorted by their ends (`_edge_list`), with one force
+    buffer per extra thread. What is kept is rebuilt when the springs change
     (``body.version``, which every edit of the springs counts). ``springs``
     (indices) restricts a computation to some springs, on one thread, in the
     body's order. `finite` runs on the threads for a body big enough to share out.
@@ -77,16 +72,8 @@ class NumbaKernel:
         self._partial: np.ndarray | None = None
         self._no_partial = np.zeros((0, 0, 0))  # no threads' buffers pending
         self._threads = 1
-        self._stencil_version = -1
-        self._stencil: GridStencil | None = None
-        self._stencil_values = np.zeros((3, 0))
-        self._columns = (np.ones((1, 0)), 1)  # see `stencil.column_masks`
-        self._triples: tuple[np.ndarray, ...] = ()  # see `stencil.stencil_triples`, and mask rows
-        self._triple_values = np.zeros((0, 3, 4))
-        self._scratch = np.zeros((10, 0))  # see `gather.gather_parallel`
-        self._pad = 0
-        self._values_version = -1
-        self._uniform = False
+        self._gather = NO_PLAN  # see `stencil.plan`
+        self._laid_out: tuple[object, int, EdgeSprings] = (None, -1, EdgeSprings.empty())
         self._forces = np.zeros((0, 0))  # the spring forces of `advance` (scratch)
         self._order: np.ndarray | None = None
         self._classes_version = -1
@@ -124,27 +111,21 @@ class NumbaKernel:
         if self._no_partial.shape[1:] != x.shape:
             self._no_partial = np.zeros((0, *x.shape))
         none = self._no_partial
-        if springs is None:
-            if (self._stencil_version, self._values_version) != (body.version,) * 2:
-                self.grid_stencil(body)
-            stencil = self._stencil if self._uniform else None
-            if stencil is not None:
-                big = stencil.starts[-1] >= PARALLEL_MIN_GATHERED
-                threads = big and numba.get_num_threads() > 1  # asked only when it matters
-                gather = gather_parallel if threads else gather_serial
-                if self._scratch.shape != (10, len(x) + 2 * self._pad):
-                    self._scratch = np.zeros((10, len(x) + 2 * self._pad))  # 2-D: x2 = v2 = 0
-                triples, _, o2s, rows_of = self._triples
-                columns, rows = self._columns
-                layout = (stencil.shape, triples, rows_of, o2s, self._triple_values, columns, rows)
-                stretch, power = gather(x, v, *layout, self._scratch, out, reduce)
-                if reduce:
-                    return stretch, power, (out, none)
-                by_coordinate = self._scratch[6 : 6 + x.shape[1], self._pad : self._pad + len(x)]
-                return stretch, power, (by_coordinate.T, none)
+        lattice, kept = body.spring_set, self._gather
+        if springs is None and isinstance(lattice, LatticeSprings):
+            if (kept.lattice, kept.version, kept.particles) != (lattice, body.version, len(x)):
+                kept = self._gather = plan(lattice, body.version, len(x))  # edited: again
+            big = kept.springs >= PARALLEL_MIN_GATHERED
+            threads = big and numba.get_num_threads() > 1  # asked only when it matters
+            gather = gather_parallel if threads else gather_serial
+            memory = kept.memory
+            stretch, power = gather(x, v, kept.layout, kept.triples, memory, out, reduce)
+            if reduce:
+                return stretch, power, (out, none)
+            by_coordinate = memory.forces[: x.shape[1], memory.pad : memory.pad + len(x)]
+            return stretch, power, (by_coordinate.T, none)
         if springs is not None:
-            a, b, k, rest, c = (body.spring_a, body.spring_b, *body.spring_values)
-            a, b, k, rest, c = (array[springs] for array in (a, b, k, rest, c))
+            a, b, k, rest, c = (array[springs] for array in self.edges(body).arrays())
             return *spring_forces_serial(x, v, a, b, None, k, rest, c, out), (out, none)
         arrays = self._edge_list(body)
         if not self._parallel(body):
@@ -156,39 +137,15 @@ class NumbaKernel:
         sums = spring_forces_parallel(x, v, *arrays, self._partial, out, reduce)
         return *sums, (out, none if reduce else self._partial)
 
-    def grid_stencil(self, body: Body) -> GridStencil | None:
-        """The body's grid stencil if its forces can be gathered by offset now, else None.
-
-        The stencil is found, and that each of its blocks has one stiffness, rest
-        length and dashpot checked, whenever the springs change (``body.version``),
-        so edits of single springs switch to the edge loop at once.
-        """
-        if self._stencil_version != body.version:
-            self._stencil = grid_stencil(body)
-            blocks = 0 if self._stencil is None else len(self._stencil.offsets)
-            if self._stencil is not None:
-                self._columns = column_masks(self._stencil.shape, self._stencil.offsets)
-                triples, members, o2s = stencil_triples(self._stencil.offsets)
-                reach = int(np.abs(o2s).max(initial=0))
-                self._pad = 2 * reach  # the padding of the scratch (see `gather`)
-                no_spring = len(self._columns[0]) - 1  # the all-zero mask
-                rows_of = np.where(members >= 0, o2s + reach, no_spring)
-                self._triples = (triples, members, o2s, rows_of)
-            self._stencil_values = np.zeros((3, blocks))
-            self._stencil_version = body.version
-            self._values_version = -1
-        if self._stencil is None:
-            return None
-        if body.version != self._values_version:
-            if body.grid_springs is not None:  # one value per offset by construction
-                self._stencil_values[...], self._uniform = body.grid_springs.values(), True
-            else:
-                values, starts = body.spring_values, self._stencil.starts
-                self._uniform = uniform_blocks(*values, starts, self._stencil_values)
-            self._values_version = body.version
-            if self._uniform:
-                self._triple_values = triple_values(self._stencil_values, self._triples[1])
-        return self._stencil if self._uniform else None
+    def edges(self, body: Body) -> EdgeSprings:
+        """The body's springs as an edge list: its own, or its lattice laid out (kept here,
+        made again when the springs are edited)."""
+        springs = body.spring_set
+        if isinstance(springs, EdgeSprings):
+            return springs
+        if self._laid_out[0] is not springs or self._laid_out[1] != body.version:
+            self._laid_out = (springs, body.version, springs.edges())
+        return self._laid_out[2]
 
     def _parallel(self, body: Body, least: int | None = None) -> bool:
         """Whether the springs of ``body`` are worth splitting between threads: at least
@@ -199,36 +156,29 @@ class NumbaKernel:
         self._threads = numba.get_num_threads()
         return self._threads > 1
 
-    def _grid_energy(self, body: Body, x: np.ndarray) -> float | None:
-        """The springs' energy (J) summed by offset for a grid that keeps its springs per
-        offset (`grid_sums`); None for other bodies."""
-        stencil = None if body.grid_springs is None else self.grid_stencil(body)
-        if stencil is None:
-            return None
-        grid_sum = grid_sum_parallel if self._parallel(body) else grid_sum_serial
-        return grid_sum(x, stencil.shape, stencil.offsets, self._stencil_values)
-
     def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
-        """Energy (J) stored in the springs (or in the given ones) at positions x."""
-        energy = None if springs is not None else self._grid_energy(body, x)
-        if energy is not None:
-            return energy
-        arrays = (body.spring_a, body.spring_b, *body.spring_values[:2])
+        """Energy (J) stored in the springs (or in the given ones) at positions x; a
+        lattice's summed by offset (`grid_sums`)."""
+        lattice = body.spring_set
+        if springs is None and isinstance(lattice, LatticeSprings):
+            grid_sum = grid_sum_parallel if self._parallel(body) else grid_sum_serial
+            return grid_sum(x, *padded_shape(lattice), lattice.stiffness, lattice.rest_lengths)
+        edges = self.edges(body)
+        arrays = (edges.a, edges.b, edges.stiffness, edges.rest_lengths)
         if springs is not None:
             return elastic_energy_serial(x, *(array[springs] for array in arrays))
         if not self._parallel(body):
             return elastic_energy_serial(x, *arrays)
         return elastic_energy_parallel(x, *arrays, self._threads)
 
-    @staticmethod
-    def jacobians(body: Body, x: np.ndarray, pattern: JacobianPattern) -> Jacobians:
+    def jacobians(self, body: Body, x: np.ndarray, pattern: JacobianPattern) -> Jacobians:
         """∂F/∂x and ∂F/∂v of the springs on ``pattern``, as `kernels.spring_jacobians`,
         with the blocks computed spring by spring."""
-        values = body.spring_values
+        edges = self.edges(body)
         dim = x.shape[1]
-        stiff = np.empty((body.n_springs, dim, dim))
-        damp = np.empty((body.n_springs if values[2].any() else 0, dim, dim))
-        jacobian_blocks(x, body.spring_a, body.spring_b, *values, stiff, damp)
+        stiff = np.empty((edges.count, dim, dim))
+        damp = np.empty((edges.count if edges.damping.any() else 0, dim, dim))
+        jacobian_blocks(x, *edges.arrays(), stiff, damp)
         return Jacobians(*pattern.jacobians(stiff, damp if len(damp) else None))
 
     def advance(
@@ -309,21 +259,22 @@ class NumbaKernel:
         order the springs were added in (a shuffled 60³ grid: several times
         faster). The ends (uint32: half the memory traffic of int64) and the
         order are kept per topology; the classes (`edges.spring_classes`) are found
-        again when the values are edited (see `grid_stencil`). Past
+        again when the values are edited. Past
         `SPRING_CLASSES` distinct values the loop reads them per spring: the
         body's arrays, or copies in the sorted order.
         """
         if self._version != body.version:
             index = np.uint32 if body.n_particles < 2**32 else np.uint64
-            order = np.lexsort((body.spring_b, body.spring_a))
+            edges = self.edges(body)
+            order = np.lexsort((edges.b, edges.a))
             self._order = None if np.array_equal(order, np.arange(len(order))) else order
-            ends = (body.spring_a, body.spring_b)
+            ends = (edges.a, edges.b)
             if self._order is not None:
                 ends = tuple(end[order] for end in ends)
             self._a, self._b = (end.astype(index) for end in ends)
             self._version = body.version
             self._classes_version = -1
-        values = body.spring_values
+        values = self.edges(body).values()
         if body.version != self._classes_version:
             self._classes = self._classify(values)
             self._classes_version = body.version

@@ -1,109 +1,99 @@
-"""Grid stencils: springs that join every particle of a grid to its neighbours by fixed offsets.
+"""A lattice (`lattice.LatticeSprings`) laid out for the gather loop (`gather`), and that loop's
+scratch memory.
 
-`Body.grid` lays its springs out this way, one block per offset. A spring
-kernel that knows it can gather each particle's forces from its neighbours by
-offset, with no list of springs (see `gather`). Here the stencil is found,
-its values checked uniform per offset, and laid out as the gather reads it.
+The gather walks the particles in C order, each one's springs to the neighbours
+ahead of it, three offsets at a time (a triple). Here the offsets are grouped
+into triples, the spring values arranged per triple, and the particles whose
+neighbour would leave their grid row masked; all of it is a few small arrays,
+made again whenever the lattice is edited.
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
+from typing import NamedTuple
 
-import numba
 import numpy as np
 
-from ..body import Body
-from ..lattice import grid_pair_count
+from ..lattice import LatticeSprings
 
 # Particles a gather block holds (whole grid rows): long inner loops, enough blocks for threads.
 GATHER_BLOCK = 4096
 
 
-@dataclass(frozen=True)
-class GridStencil:
-    """Springs that form a regular grid stencil, as `Body.grid` builds them.
+class Triples(NamedTuple):
+    """The lattice's offsets, each pointing ahead, three at a time; T triples.
 
-    The particles fill a grid of ``shape`` (3,) in C order (2-D grids as
-    (1, n0, n1)); spring block m, ``starts[m]`` to ``starts[m + 1] - 1``, joins
-    every particle p to the particle at p's grid coordinates plus ``offsets[m]``
-    (3,), in the order of `lattice.grid_pair_blocks`. With the same stiffness,
-    rest length and dashpot in each block, the forces on a particle can be
-    gathered from its neighbours by offset, with no list of springs.
+    Triple t joins each particle to those at grid offsets (``ahead[t]``, ``along[t, j]``),
+    j = 0, 1, 2 (``ahead``: the first two coordinates, ``along``: the last), by springs
+    of ``stiffness``, ``rest_lengths``, ``damping`` and ``inverse_rest_squared`` 1/l²
+    (T, 3 each); ``masks[t, j]`` is the row of `column_masks` for that neighbour. A
+    place with no spring has all values 0 and the all-zero mask, and fills triples
+    from the back, so ``masks[t, 1]`` is that mask for a triple of one spring.
     """
+
+    ahead: np.ndarray
+    along: np.ndarray
+    masks: np.ndarray
+    stiffness: np.ndarray
+    rest_lengths: np.ndarray
+    damping: np.ndarray
+    inverse_rest_squared: np.ndarray
+
+
+class Layout(NamedTuple):
+    """A lattice's grid as the gather reads it: ``shape`` (3,) in C order (2-D as
+    (1, n0, n1)), the column masks (`column_masks`) and the number of grid ``rows`` a
+    block of work holds."""
 
     shape: np.ndarray
-    offsets: np.ndarray
-    starts: np.ndarray
+    columns: np.ndarray
+    rows: int
 
 
-def grid_stencil(body: Body) -> GridStencil | None:
-    """The grid stencil the springs of ``body`` form, or None if they form none.
+class Scratch(NamedTuple):
+    """The gather's memory, particle p at column p + ``pad``: ``positions``,
+    ``velocities`` and ``forces`` by coordinate (3, N + 2·pad) and each particle's
+    largest squared stretch |d|²/l² (N + 2·pad,). The padding stays zero, so a masked
+    neighbour past either end is still in memory."""
 
-    A grid that keeps its springs per offset (`Body.grid_springs`) forms one
-    by construction. Otherwise it needs ``body.grid_shape`` and springs in
-    blocks of one offset each, every block holding all the pairs of its offset
-    in grid order (checked block by block, not assumed). Whether the spring
-    values are uniform per block is for the caller to check, as they may
-    change at any step.
-    """
-    grid = body.grid_springs
-    shape = body.grid_shape if grid is None else grid.shape
-    if shape is None or math.prod(shape) != body.n_particles or body.n_springs == 0:
-        return None
-    padded = (1,) * (3 - len(shape)) + tuple(shape)
-    if grid is not None:
-        offsets = np.zeros((len(grid.offsets), 3), dtype=np.int64)
-        offsets[:, 3 - len(shape) :] = grid.offsets
-        counts = [grid_pair_count(shape, offset[None]) for offset in grid.offsets]
-        return GridStencil(np.array(padded), offsets, np.cumsum([0, *counts]))
-    index = np.arange(body.n_particles, dtype=np.int64).reshape(padded)
-    a, b = body.spring_a, body.spring_b
-    offsets, starts = [], [0]
-    while starts[-1] < body.n_springs:
-        first = starts[-1]
-        offset = np.subtract(np.unravel_index(b[first], padded), np.unravel_index(a[first], padded))
-        source = tuple(slice(max(0, -o), n - max(0, o)) for o, n in zip(offset, padded))
-        expected = index[source].ravel()
-        stop = first + len(expected)
-        shift = int(offset @ np.array([padded[1] * padded[2], padded[2], 1]))
-        if (
-            stop > body.n_springs
-            or not np.array_equal(a[first:stop], expected)
-            or not np.array_equal(b[first:stop], expected + shift)
-        ):
-            return None
-        offsets.append(offset)
-        starts.append(stop)
-    return GridStencil(np.array(padded), np.array(offsets, dtype=np.int64), np.array(starts))
+    positions: np.ndarray
+    velocities: np.ndarray
+    forces: np.ndarray
+    squared: np.ndarray
+    pad: int
 
 
-def stencil_triples(offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The stencil's offsets, each pointing ahead (o or -o, whichever is later in C order),
-    grouped by their first two coordinates, three at a time.
+def padded_shape(lattice: LatticeSprings) -> tuple[np.ndarray, np.ndarray]:
+    """The lattice's shape (3,) and offsets (M, 3), 2-D ones as the plane (1, n0, n1)."""
+    missing = 3 - len(lattice.shape)
+    offsets = np.zeros((len(lattice.offsets), 3), dtype=np.int64)
+    offsets[:, missing:] = lattice.offsets
+    return np.array((1,) * missing + lattice.shape, dtype=np.int64), offsets
 
-    Returns (triples, members, o2s): triple t joins each particle to those at
-    (``triples[t]``, ``o2s[t, j]``), j = 0, 1, 2, by the springs of offset
-    block ``members[t, j]``; -1 marks an empty place (no spring).
-    """
+
+def layout(lattice: LatticeSprings) -> tuple[Layout, Triples]:
+    """The gather's layout of ``lattice`` and its `Triples`, with its values as they are now."""
+    shape, offsets = padded_shape(lattice)
     groups: dict[tuple[int, int], list[tuple[int, int]]] = {}
     for m, offset in enumerate(offsets.tolist()):
         o0, o1, o2 = offset if tuple(offset) > (0, 0, 0) else [-o for o in offset]
         groups.setdefault((o0, o1), []).append((o2, m))
-    triples, members, o2s = [], [], []
-    for (o0, o1), group in sorted(groups.items()):
-        group.sort()
-        group += [(0, -1)] * (-len(group) % 3)
-        for first in range(0, len(group), 3):
-            triples.append((o0, o1))
-            o2s.append([o2 for o2, _ in group[first : first + 3]])
-            members.append([m for _, m in group[first : first + 3]])
-    return (
-        np.array(triples, dtype=np.int64).reshape(-1, 2),
-        np.array(members, dtype=np.int64).reshape(-1, 3),
-        np.array(o2s, dtype=np.int64).reshape(-1, 3),
-    )
+    ahead, along, members = [], [], []
+    for first_two, group in sorted(groups.items()):
+        group = sorted(group) + [(0, -1)] * (-len(group) % 3)
+        for start in range(0, len(group), 3):
+            ahead.append(first_two)
+            along.append([o2 for o2, _ in group[start : start + 3]])
+            members.append([m for _, m in group[start : start + 3]])
+    along_, member = (np.array(rows, np.int64).reshape(-1, 3) for rows in (along, members))
+    columns, rows = column_masks(shape, offsets)
+    reach = int(np.abs(offsets[:, 2]).max(initial=0))
+    masks = np.where(member >= 0, along_ + reach, len(columns) - 1)
+    values = [np.where(member >= 0, array[member], 0.0) for array in lattice.values()]
+    with np.errstate(divide="ignore"):
+        inverse = np.where(member >= 0, 1.0 / values[1] ** 2, 0.0)
+    ahead_ = np.array(ahead, np.int64).reshape(-1, 2)
+    return Layout(shape, columns, rows), Triples(ahead_, along_, masks, *values, inverse)
 
 
 def column_masks(shape: np.ndarray, offsets: np.ndarray) -> tuple[np.ndarray, int]:
@@ -122,26 +112,30 @@ def column_masks(shape: np.ndarray, offsets: np.ndarray) -> tuple[np.ndarray, in
     return np.array([*masks, np.zeros(rows * n2, dtype=bool)], dtype=float), rows
 
 
-def triple_values(values: np.ndarray, members: np.ndarray) -> np.ndarray:
-    """Stiffness, rest length, dashpot and 1/rest² (T, 3, 4) of the springs of each triple
-    (`stencil_triples`), from the values (3, M) of each offset block; 0 for no spring."""
-    k, rest, c = values[:, members]
-    with np.errstate(divide="ignore"):
-        table = np.stack([k, rest, c, 1.0 / rest**2], axis=-1)
-    table[members < 0] = 0.0
-    return table
+def scratch(lattice: LatticeSprings, n_particles: int) -> Scratch:
+    """Zeroed scratch memory (`Scratch`) for the gather of ``lattice`` on ``n_particles``."""
+    pad = 2 * int(np.abs(lattice.offsets[:, -1]).max(initial=0))  # the last axis's reach, twice
+    width = n_particles + 2 * pad
+    return Scratch(*np.zeros((3, 3, width)), np.zeros(width), pad)
 
 
-@numba.njit(cache=True)
-def uniform_blocks(k, rest, c, starts, values):
-    """True if every spring block has one stiffness, rest length and dashpot; they go to
-    ``values`` (3, M). Stops at the first spring that differs from its block's first."""
-    for m in range(len(starts) - 1):
-        first = starts[m]
-        values[0, m], values[1, m], values[2, m] = k[first], rest[first], c[first]
-        same = True
-        for s in range(first, starts[m + 1]):
-            same &= (k[s] == k[first]) & (rest[s] == rest[first]) & (c[s] == c[first])
-        if not same:
-            return False
-    return True
+class Plan(NamedTuple):
+    """What the gather of ``lattice`` at ``version`` (`Body.version`) on ``particles``
+    particles reads: its `Layout`, `Triples` and `Scratch`, and its number of ``springs``."""
+
+    lattice: LatticeSprings | None
+    version: int
+    particles: int
+    layout: Layout
+    triples: Triples
+    memory: Scratch
+    springs: int
+
+
+NO_PLAN = Plan(None, -1, -1, *(None,) * 3, 0)  # type: ignore[arg-type]
+
+
+def plan(lattice: LatticeSprings, version: int, n_particles: int) -> Plan:
+    """The gather's `Plan` for ``lattice``, edited ``version`` times, on ``n_particles``."""
+    memory = scratch(lattice, n_particles)
+    return Plan(lattice, version, n_particles, *layout(lattice), memory, lattice.count)

@@ -29,7 +29,7 @@ from .feedback import CheckFailed
 SPRING_KERNELS = ("msdlab.kernels:spring_forces", "msdlab.kernels:spring_vectors")
 DYNAMICS = ("msdlab.dynamics:Dynamics.__init__",)
 VERLET = ("msdlab.integrators:Verlet.__init__", "msdlab.integrators:Verlet.step")
-ROTATIONS = ("msdlab.body:rotation_matrix", "msdlab.body:Body.rotate")
+ROTATIONS = ("msdlab.rotation:rotation_matrix", "msdlab.body:Body.rotate")
 LATTICE = (
     "msdlab.body:Body.grid",
     "msdlab.lattice:neighbour_offsets",

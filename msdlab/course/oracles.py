@@ -196,7 +196,7 @@ def spring_list_mistakes(
     one_sided = one_sided_acceleration(positions, springs, rest, stiffness)
     length = np.linalg.norm(positions[springs[:, 0]] - positions[springs[:, 1]], axis=1)
     unnormalised = spring_body(positions, springs, rest, 1.0)
-    unnormalised.stiffness = stiffness * np.maximum(length, 1e-300)  # k|d| (l - |d|) d̂
+    unnormalised.set_springs(stiffness=stiffness * np.maximum(length, 1e-300))  # k|d| (l - |d|) d̂
     count = np.bincount(springs.ravel(), minlength=len(positions)).astype(float)
     mistakes = {}
     constant = task_constant(task, "STIFFNESS")
@@ -232,7 +232,8 @@ def axis_spring_mistakes(
     shape = x.shape[:3]
     flat = np.asarray(x, dtype=float).reshape(-1, 3)
     body = grid_body(shape, spacing, stiffness)
-    springs = np.stack([body.spring_a, body.spring_b], axis=1)
+    edges = body.edges()
+    springs = np.stack([edges.a, edges.b], axis=1)
     right = spring_acceleration(body, flat).reshape(x.shape)
     wrapped = spring_body(flat, wrapped_border_pairs(shape), spacing, stiffness)
     border = np.ones(shape, dtype=bool)

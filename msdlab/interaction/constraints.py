@@ -33,7 +33,8 @@ def lead(state: StepState, particles: np.ndarray, target: np.ndarray) -> float:
     """
     body = state.body
     touching = body.springs_touching(particles)
-    ends = np.setdiff1d(np.union1d(body.spring_a[touching], body.spring_b[touching]), particles)
+    edges = body.edges()
+    ends = np.setdiff1d(np.union1d(edges.a[touching], edges.b[touching]), particles)
     now = state.x[ends]
     state.x[ends] = 0.5 * (state.x_old[ends] + now)
     state.v[particles] = state.v_old[particles]

@@ -25,7 +25,7 @@ import numpy as np
 from ..body import Body
 from ..forces import Gravity, ViscousDamping
 from ..integrators import Integrator, SymplecticEuler
-from ..lattice import grid_pairs, neighbour_offsets
+from ..lattice import lattice_springs
 from ..simulation import Simulation
 
 PINS = ("corners", "row")
@@ -60,17 +60,15 @@ def cloth(
         raise ValueError(f"the cloth needs at least 2×2 nodes, got {nx}×{ny}")
     ij = np.stack(np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij"), axis=-1)
     ij = ij.reshape(-1, 2)
-    xy = ij * (np.asarray(extent, dtype=float) / (nx - 1, ny - 1))
-    pairs, _ = grid_pairs((nx, ny), neighbour_offsets(2, (1, 2) if shear else (1,)))
+    spacing = np.asarray(extent, dtype=float) / (nx - 1, ny - 1)
+    springs = lattice_springs((nx, ny), (1, 2) if shear else (1,), spacing, stiffness, 0.0)
     top = ij[:, 1] == ny - 1
     fixed = top if pin == "row" else top & ((ij[:, 0] == 0) | (ij[:, 0] == nx - 1))
     body = Body.from_arrays(
-        np.column_stack([xy, np.full(len(xy), float(height))]),
-        pairs,
+        np.column_stack([ij * spacing, np.full(len(ij), float(height))]),
+        springs,
         masses=mass,
         fixed=fixed,
-        stiffness=stiffness,
     )
-    body.grid_shape = (nx, ny)
     forces = [Gravity((0.0, 0.0, gravity)), ViscousDamping(damping)]
     return Simulation(body, integrator or SymplecticEuler(), dt, forces)

@@ -34,11 +34,12 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from ..body import Body, rotation_matrix
+from ..body import Body
 from ..constraint import Constraint
 from ..forces import Force, Gravity
 from ..integrators import VelocityVerlet
 from ..interaction import Drag, Prescribed, Walls
+from ..rotation import rotation_matrix
 from ..simulation import Simulation
 from ..units import PAGE
 from .frame_model import FrameEuler
@@ -288,7 +289,7 @@ def truss(
     cells = Body.grid((segments + 1, 2), neighbours=(1, 2))
     body = Body.from_arrays(
         (60.0, 60.0) + cells.positions * (length, width),
-        np.column_stack([cells.spring_a, cells.spring_b]),
+        np.column_stack([cells.edges().a, cells.edges().b]),
         stiffness=stiffness,
     )
     return simulation(body, model=model, damping=damping, gravity=gravity, walls=walls)

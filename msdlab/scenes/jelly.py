@@ -14,10 +14,11 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from ..body import Body, rotation_matrix
+from ..body import Body
 from ..forces import Gravity
 from ..integrators import Integrator, Verlet
 from ..interaction import Ground
+from ..rotation import rotation_matrix
 from ..simulation import Simulation
 
 

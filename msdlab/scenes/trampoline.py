@@ -82,7 +82,7 @@ def trampoline(
         raise ValueError(f"the net needs size >= 3 nodes per side, got {size!r}")
     ij = np.stack(np.meshgrid(np.arange(size), np.arange(size), indexing="ij"), axis=-1)
     ij = ij.reshape(-1, 2)
-    pairs, _ = grid_pairs((size, size), neighbour_offsets(2, (1,)))
+    pairs = grid_pairs((size, size), neighbour_offsets(2, (1,)))
     body = Body.from_arrays(
         np.column_stack([ij, np.zeros(len(ij))]).astype(float),
         pairs,

@@ -35,10 +35,11 @@ def colour_table(cmap: str = "coolwarm") -> list[str]:
 
 def body_arrays(body: Body) -> dict[str, bytes]:
     """The body's fixed arrays as bytes: springs (int32 pairs), rest lengths, pinned."""
-    pairs = np.column_stack([body.spring_a, body.spring_b]).astype(np.int32)
+    edges = body.edges()
+    pairs = np.column_stack([edges.a, edges.b]).astype(np.int32)
     return {
         "springs": pairs.tobytes(),
-        "rest": body.rest_lengths.astype(np.float32).tobytes(),
+        "rest": edges.rest_lengths.astype(np.float32).tobytes(),
         "fixed": body.fixed.astype(np.uint8).tobytes(),
     }
 

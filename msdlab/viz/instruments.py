@@ -99,12 +99,12 @@ def gravity_of(sim: Simulation) -> Gravity | None:
 def hung_from(body: Body, particle: int) -> tuple[int, int] | None:
     """(spring, anchor) when ``particle`` hangs by its only spring from a pinned particle
     (the anchor), held in hand or not; else None."""
-    springs = np.flatnonzero((body.spring_a == particle) | (body.spring_b == particle))
+    springs = body.springs_touching(np.array([particle]))
     if len(springs) != 1:
         return None
-    spring = int(springs[0])
-    anchor = int(body.spring_a[spring] + body.spring_b[spring] - particle)
-    return (spring, anchor) if body.fixed[anchor] else None
+    spring = body.springs[int(springs[0])]
+    anchor = spring.a + spring.b - particle
+    return (spring.index, anchor) if body.fixed[anchor] else None
 
 
 def hanging_lines(sim: Simulation, particle: int) -> dict[str, list[float]] | None:
@@ -121,7 +121,7 @@ def hanging_lines(sim: Simulation, particle: int) -> dict[str, list[float]] | No
     pull = body.positions[particle] - body.positions[anchor]
     down = g if np.any(g) else pull
     down = down / max(float(np.linalg.norm(down)), 1e-300)
-    rest, k = float(body.rest_lengths[spring]), float(body.stiffness[spring])
+    rest, k = body.springs[spring].rest_length, body.springs[spring].stiffness
     stretch = float(body.masses[particle] * np.linalg.norm(g) / k)
     at = body.positions[anchor]
     return {

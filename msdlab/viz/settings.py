@@ -61,7 +61,7 @@ def live_settings(sim: Simulation) -> list[Setting]:
     """Sliders for what ``sim`` lets change while it runs."""
     settings = []
     if sim.body.n_springs:
-        k = float(np.mean(sim.body.stiffness))
+        k = float(np.mean(sim.body.spring_set.stiffness))
         settings.append(_slider("stiffness", "stiffness k", k, k / 10, 4 * k))
     damper = _damper(sim)
     if damper is not None:
@@ -96,8 +96,8 @@ def apply(sim: Simulation, name: str, value: float, start: dict[str, object]) ->
     """Set the live setting ``name`` of ``sim`` to ``value``; ``start`` holds the stiffness
     and gravity direction at the start ("stiffness", "gravity")."""
     if name == "stiffness":
-        stiffness = np.asarray(start["stiffness"])
-        sim.body.stiffness = stiffness * (value / float(np.mean(stiffness)))
+        scaled = np.asarray(start["stiffness"]) * (value / float(np.mean(start["stiffness"])))
+        sim.body.set_springs(stiffness=scaled[0] if np.all(scaled == scaled[0]) else scaled)
     elif name == "damping":
         owner, attribute = _damper(sim)  # type: ignore[misc]
         setattr(owner, attribute, float(value))
@@ -115,4 +115,4 @@ def start_of(sim: Simulation) -> dict[str, object]:
     direction = None
     if gravity is not None and np.any(gravity.g):
         direction = gravity.g / np.linalg.norm(gravity.g)
-    return {"stiffness": sim.body.stiffness.copy(), "gravity": direction}
+    return {"stiffness": sim.body.spring_set.stiffness.copy(), "gravity": direction}

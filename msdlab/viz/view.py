@@ -36,14 +36,16 @@ _UNIT_SPHERE = np.stack([np.cos(_U) * np.sin(_V), np.sin(_U) * np.sin(_V), np.co
 
 def strains(body: Body, positions: np.ndarray) -> np.ndarray:
     """Strain of each spring, |x_a - x_b| / rest length - 1 (> 0 stretched, < 0 squeezed)."""
-    d = positions[body.spring_a] - positions[body.spring_b]
-    return np.sqrt(np.einsum("ij,ij->i", d, d)) / body.rest_lengths - 1.0
+    edges = body.edges()
+    d = positions[edges.a] - positions[edges.b]
+    return np.sqrt(np.einsum("ij,ij->i", d, d)) / edges.rest_lengths - 1.0
 
 
 def sags(body: Body, positions: np.ndarray, up: str, rim: float) -> np.ndarray:
     """Depth of each spring's middle below the height ``rim`` along the ``up`` axis (> 0 below)."""
     axis = UPS.index(up)
-    middles = 0.5 * (positions[body.spring_a, axis] + positions[body.spring_b, axis])
+    edges = body.edges()
+    middles = 0.5 * (positions[edges.a, axis] + positions[edges.b, axis])
     return rim - middles
 
 
@@ -213,7 +215,8 @@ class BodyView:
                 axis.set_major_locator(MaxNLocator(2))
 
     def _segments(self, positions: np.ndarray) -> np.ndarray:
-        return np.stack([positions[self.body.spring_a], positions[self.body.spring_b]], axis=1)
+        edges = self.body.edges()
+        return np.stack([positions[edges.a], positions[edges.b]], axis=1)
 
     def _ball(self, centre: np.ndarray, radius: float) -> Artist:
         if not self.is_3d:

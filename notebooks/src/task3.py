@@ -50,12 +50,13 @@ with course.attempt():
 # %%
 # NBVAL_CHECK_OUTPUT
 cube = msd.Body.grid((4, 4, 4), spacing=0.5, neighbours=(1, 2, 3))
+springs = cube.edges()  # the grid's springs as a list: ends a, b and their values
 with course.attempt():
     turned = task3.rotate_layout(cube.positions, (1, 1, 0), 30)
     moved = turned.mean(axis=0) - cube.positions.mean(axis=0)
     print("the centroid stays:", np.allclose(moved, 0))
-    lengths = np.linalg.norm(turned[cube.spring_a] - turned[cube.spring_b], axis=1)
-    print("every distance stays:", np.allclose(lengths, cube.rest_lengths))
+    lengths = np.linalg.norm(turned[springs.a] - turned[springs.b], axis=1)
+    print("every distance stays:", np.allclose(lengths, springs.rest_lengths))
 
 # %% [markdown]
 # ## Forces that do not care about orientation
@@ -70,14 +71,14 @@ with course.attempt():
 # NBVAL_CHECK_OUTPUT
 rng = np.random.default_rng(3)
 x = cube.positions + 0.05 * rng.standard_normal(cube.positions.shape)
-springs = np.column_stack([cube.spring_a, cube.spring_b])
+pairs = np.column_stack([springs.a, springs.b])
 expected = msd.Dynamics(cube).acceleration(x, np.zeros_like(x))  # stiffness 1
 with course.attempt():
-    a = task3.spring_acceleration(x, springs, cube.rest_lengths, 1.0)
+    a = task3.spring_acceleration(x, pairs, springs.rest_lengths, 1.0)
     print("same as the engine:", np.allclose(a, expected, atol=1e-12))
     print("forces add up to zero:", np.allclose(a.sum(axis=0), 0, atol=1e-12))
     R = msd.rotation_matrix(40, (1, 0, 1))
-    turned = task3.spring_acceleration(x @ R.T, springs, cube.rest_lengths, 1.0)
+    turned = task3.spring_acceleration(x @ R.T, pairs, springs.rest_lengths, 1.0)
     print("a(Rx) = R a(x):", np.allclose(turned, a @ R.T, atol=1e-12))
 
 # %% [markdown]

@@ -43,7 +43,7 @@ def cloth(n: int = 9, spacing: float = 0.05) -> msd.Body:
     body = msd.Body.from_arrays(
         positions, np.vstack(pairs), masses=0.01, fixed=fixed, stiffness=np.concatenate(stiffness)
     )
-    body.spring_damping = 0.02
+    body.set_springs(damping=0.02)
     return shaken(body, seed=1)
 
 
@@ -75,8 +75,9 @@ def damped(dim: int) -> msd.Body:
     """A grid whose springs each have their own stiffness and dashpot (some none)."""
     body = grid(dim)
     rng = np.random.default_rng(4)
-    body.stiffness = rng.uniform(10.0, 50.0, body.n_springs)
-    body.spring_damping = np.where(rng.random(body.n_springs) < 0.5, 0.3, 0.0)
+    body.springs_as_edges()  # values of their own per spring
+    body.set_springs(stiffness=rng.uniform(10.0, 50.0, body.n_springs))
+    body.set_springs(damping=np.where(rng.random(body.n_springs) < 0.5, 0.3, 0.0))
     body.fixed[[0, 3]] = True
     body.velocities[[0, 3]] = 0.0
     return body
@@ -141,7 +142,7 @@ def test_spring_forces(backend: spring_kernel.SpringKernel, body: msd.Body) -> N
     assert_close(out - 1.0, expected)
     assert sums.stretch == pytest.approx(reference.stretch, rel=RTOL)
     assert sums.power == pytest.approx(reference.power, rel=RTOL, abs=1e-300)
-    assert (sums.power > 0.0) == bool(body.spring_damping.any())
+    assert (sums.power > 0.0) == bool(body.edges().damping.any())
     some = body.springs_touching(np.array([1, 5, 6]))
     out, expected = np.zeros_like(x), np.zeros_like(x)
     subset = backend.spring_forces(body, x, v, out, some)

@@ -127,17 +127,21 @@ def test_bad_grid_arguments():
 
 def test_whole_array_assignments_and_spring_values_are_checked():
     body = body_2d()
-    body.stiffness = 5.0
-    assert body.stiffness[0] == 5.0
+    body.set_springs(stiffness=5.0)
+    assert body.edges().stiffness[0] == 5.0
     with pytest.raises(ValueError, match=r"stiffness must be finite and >= 0"):
-        body.stiffness = -1.0
+        body.set_springs(stiffness=-1.0)
     with pytest.raises(ValueError, match=r"rest length must be finite and > 0"):
-        body.rest_lengths = [0.0]
-    with pytest.raises(ValueError, match=r"damping needs one value or one per row \(1\)"):
+        body.set_springs(rest_lengths=[0.0])
+    with pytest.raises(ValueError, match=r"damping needs one value or one per spring \(1\)"):
         body.add_springs([[0, 1]], damping=[0.1, 0.2])
-    with pytest.raises(AttributeError, match="read-only"):
-        body.spring_a = [1]
-    assert body.stiffness[0] == 5.0 and body.n_springs == 1  # nothing changed by the failures
+    with pytest.raises(ValueError, match="read-only"):
+        body.edges().a[0] = 1  # the spring set changes through the body's methods only
+    with pytest.raises(AttributeError, match="cannot assign"):
+        body.edges().a = [1]
+    assert (
+        body.edges().stiffness[0] == 5.0 and body.n_springs == 1
+    )  # nothing changed by the failures
 
 
 def test_a_single_force_needs_no_list_and_a_wrong_one_is_named():

@@ -22,7 +22,7 @@ def test_issue_example_builds_a_body_with_array_views():
     assert body.positions.shape == (2, 3) and body.velocities.shape == (2, 3)
     np.testing.assert_array_equal(body.masses, [1.0, 2.0])
     np.testing.assert_array_equal(body.fixed, [True, False])
-    assert body.rest_lengths[0] == 1.0  # None took the current distance
+    assert body.edges().rest_lengths[0] == 1.0  # None took the current distance
 
 
 def test_particle_and_spring_objects_read_and_write_the_arrays():
@@ -34,7 +34,7 @@ def test_particle_and_spring_objects_read_and_write_the_arrays():
     assert particle.velocity[1] == 3.0
     spring = body.springs[0]
     spring.stiffness = 20.0
-    assert body.stiffness[0] == 20.0
+    assert body.edges().stiffness[0] == 20.0
     assert spring.length() == pytest.approx(2.0)
     assert spring.energy() == pytest.approx(0.5 * 20.0 * 1.0**2)
 
@@ -60,7 +60,7 @@ def test_views_survive_many_additions_and_copy_is_independent():
     for i in range(100):
         body.add_particle(msd.Particle(position=(i, 0)))
     body.add_springs([[i, i + 1] for i in range(99)], stiffness=2.0)
-    assert body.n_springs == 99 and np.all(body.rest_lengths == 1.0)
+    assert body.n_springs == 99 and np.all(body.edges().rest_lengths == 1.0)
     copy = body.copy()
     copy.positions[0] = (-5, -5)
     assert body.positions[0, 0] == 0.0
@@ -71,11 +71,17 @@ def test_grid_springs_counts_and_rest_lengths(shape):
     n_axis = sum(math.prod(shape) // n * (n - 1) for n in shape)
     body = msd.Body.grid(shape, spacing=0.5, neighbours=(1,))
     assert body.n_springs == n_axis
-    np.testing.assert_allclose(body.rest_lengths, 0.5)
+    np.testing.assert_allclose(body.edges().rest_lengths, 0.5)
     full = msd.Body.grid(shape, spacing=0.5, neighbours=(1, 2, 3))
-    lengths = np.linalg.norm(full.positions[full.spring_a] - full.positions[full.spring_b], axis=1)
-    np.testing.assert_allclose(full.rest_lengths, lengths)  # at rest: no pre-stress
-    assert set(np.round(full.rest_lengths / 0.5, 6)) <= {1.0, round(2**0.5, 6), round(3**0.5, 6)}
+    lengths = np.linalg.norm(
+        full.positions[full.edges().a] - full.positions[full.edges().b], axis=1
+    )
+    np.testing.assert_allclose(full.edges().rest_lengths, lengths)  # at rest: no pre-stress
+    assert set(np.round(full.edges().rest_lengths / 0.5, 6)) <= {
+        1.0,
+        round(2**0.5, 6),
+        round(3**0.5, 6),
+    }
 
 
 def test_cubic_grid_has_26_neighbours_inside_and_known_spring_count():
@@ -83,10 +89,10 @@ def test_cubic_grid_has_26_neighbours_inside_and_known_spring_count():
     body = msd.Body.grid((n, n, n), neighbours=(1, 2, 3))
     expected = 3 * n * n * (n - 1) + 6 * n * (n - 1) ** 2 + 4 * (n - 1) ** 3
     assert body.n_springs == expected
-    degree = np.bincount(np.concatenate([body.spring_a, body.spring_b]), minlength=len(body))
+    degree = np.bincount(np.concatenate([body.edges().a, body.edges().b]), minlength=len(body))
     inner = np.ravel_multi_index((1, 2, 1), (n, n, n))
     assert degree[inner] == 26 and degree[0] == 7
-    pairs = {tuple(sorted(p)) for p in zip(body.spring_a, body.spring_b)}
+    pairs = {tuple(sorted(p)) for p in zip(body.edges().a, body.edges().b)}
     assert len(pairs) == body.n_springs  # no spring made twice
 
 
@@ -107,8 +113,10 @@ def test_rotate_keeps_shape_and_centre():
     centre = body.center_of_mass()
     body.rotate(msd.rotation_matrix(37, axis=(1, 2, 3)))
     np.testing.assert_allclose(body.center_of_mass(), centre, atol=1e-14)
-    lengths = np.linalg.norm(body.positions[body.spring_a] - body.positions[body.spring_b], axis=1)
-    np.testing.assert_allclose(lengths, body.rest_lengths)
+    lengths = np.linalg.norm(
+        body.positions[body.edges().a] - body.positions[body.edges().b], axis=1
+    )
+    np.testing.assert_allclose(lengths, body.edges().rest_lengths)
 
 
 def test_store_state_takes_the_arrays_of_new_state_and_copies_others():
@@ -143,6 +151,6 @@ def test_store_state_copies_the_arrays_of_new_state_after_particles_were_added()
 @pytest.mark.parametrize("particles", [[7], [0, 7], [3, 8, 40]])
 def test_springs_touching_are_the_springs_with_an_end_among_the_particles(particles) -> None:
     body = msd.Body.grid((6, 9), neighbours=(1, 2))
-    wanted = np.isin(body.spring_a, particles) | np.isin(body.spring_b, particles)
+    wanted = np.isin(body.edges().a, particles) | np.isin(body.edges().b, particles)
     touching = body.springs_touching(np.array(particles))
     np.testing.assert_array_equal(touching, np.flatnonzero(wanted))

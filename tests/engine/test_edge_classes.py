@@ -24,13 +24,13 @@ def shuffled_body(seed: int = 0) -> msd.Body:
     rng = np.random.default_rng(seed)
     grid = msd.Body.grid((5, 4, 6), spacing=0.1, stiffness=40.0, neighbours=(1, 2, 3))
     order = rng.permutation(grid.n_springs)
-    pairs = np.stack([grid.spring_a[order], grid.spring_b[order]], axis=1)
+    pairs = np.stack([grid.edges().a[order], grid.edges().b[order]], axis=1)
     body = msd.Body.from_arrays(
         grid.positions + rng.normal(scale=0.02, size=grid.positions.shape),
         pairs,
         velocities=rng.normal(size=grid.positions.shape),
         stiffness=40.0,
-        rest_lengths=grid.rest_lengths[order],
+        rest_lengths=grid.edges().rest_lengths[order],
     )
     return body
 
@@ -58,12 +58,12 @@ def assert_close_to_numpy(body: msd.Body, kernel: NumbaKernel, springs=None) -> 
 
 def test_class_table_holds_each_springs_values() -> None:
     body = shuffled_body()
-    body.set_springs(slice(None, None, 4), spring_damping=0.3)
+    body.set_springs(slice(None, None, 4), damping=0.3)
     a, _, kinds, k, rest, c = NumbaKernel()._edge_list(body)
     assert kinds.dtype == np.uint8 and len(k) == 6  # 3 rest lengths, with and without dashpot
     assert np.all(np.diff(a.astype(np.int64)) >= 0)  # sorted by the first end
-    order = np.lexsort((body.spring_b, body.spring_a))
-    for table, values in zip((k, rest, c), body.spring_values):
+    order = np.lexsort((body.edges().b, body.edges().a))
+    for table, values in zip((k, rest, c), body.edges().values()):
         np.testing.assert_array_equal(table[kinds], values[order])
     assert len({(k[m], rest[m], c[m]) for m in range(len(k))}) == len(k)  # each class once
 
@@ -76,7 +76,8 @@ def test_wide_classes_and_no_classes_give_the_same_sums(
     if threaded:
         monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
     body = shuffled_body(1)
-    body.stiffness = np.random.default_rng(1).integers(1, 301, body.n_springs) * 0.5
+    body.springs_as_edges()  # values of their own per spring
+    body.set_springs(stiffness=np.random.default_rng(1).integers(1, 301, body.n_springs) * 0.5)
     wide = NumbaKernel()
     assert wide._edge_list(body)[2].dtype == np.uint16
     assert_close_to_numpy(body, wide)
@@ -89,10 +90,10 @@ def test_wide_classes_and_no_classes_give_the_same_sums(
 def sorted_body() -> msd.Body:
     """`shuffled_body` with its springs added sorted by their ends, as the edge loop takes them."""
     shuffled = shuffled_body(3)
-    order = np.lexsort((shuffled.spring_b, shuffled.spring_a))
-    pairs = np.stack([shuffled.spring_a[order], shuffled.spring_b[order]], axis=1)
+    order = np.lexsort((shuffled.edges().b, shuffled.edges().a))
+    pairs = np.stack([shuffled.edges().a[order], shuffled.edges().b[order]], axis=1)
     return msd.Body.from_arrays(
-        shuffled.positions, pairs, rest_lengths=shuffled.rest_lengths[order]
+        shuffled.positions, pairs, rest_lengths=shuffled.edges().rest_lengths[order]
     )
 
 
@@ -102,7 +103,7 @@ def test_past_the_limit_in_the_bodys_order(monkeypatch: pytest.MonkeyPatch) -> N
     monkeypatch.setattr("msdlab.compiled.kernel.SPRING_CLASSES", 2)
     kernel = NumbaKernel()
     _, _, kinds, k, _, _ = kernel._edge_list(body)
-    assert kinds is None and np.shares_memory(k, body.spring_values[0])
+    assert kinds is None and np.shares_memory(k, body.edges().values()[0])
     body.set_springs([4], stiffness=7.0)
     assert_close_to_numpy(body, kernel)
 
@@ -114,16 +115,16 @@ def test_reading_the_values_keeps_the_classes_and_editing_counts() -> None:
     kernel = NumbaKernel()
     classed = forces_by(kernel, body)
     kinds = kernel._edge_list(body)[2]
-    held = body.rest_lengths
+    held = body.edges().rest_lengths
     assert kernel._edge_list(body)[2] is kinds
     assert_same(forces_by(kernel, body), classed)
     with pytest.raises(ValueError, match="read-only"):
         held[6] = 1.0
     for edit in (
         lambda: body.set_springs([6], rest_lengths=held[6] * 1.1),
-        lambda: body.set_springs(rest_lengths=body.rest_lengths * 1.01),
+        lambda: body.set_springs(rest_lengths=body.edges().rest_lengths * 1.01),
         lambda: body.set_springs(slice(3, 5), stiffness=7.0),
-        lambda: setattr(body, "spring_damping", 0.0),
+        lambda: body.set_springs(damping=0.0),
     ):
         version = body.version
         edit()
@@ -132,7 +133,12 @@ def test_reading_the_values_keeps_the_classes_and_editing_counts() -> None:
         kinds = kernel._edge_list(body)[2]
         assert_close_to_numpy(body, kernel)
     version = body.version
-    _ = body.stiffness * 2.0, held.sum(), body.spring_values[0][3], np.unique(body.stiffness)
+    _ = (
+        body.edges().stiffness * 2.0,
+        held.sum(),
+        body.edges().values()[0][3],
+        np.unique(body.edges().stiffness),
+    )
     assert body.version == version
 
 
@@ -149,8 +155,8 @@ def test_springs_edited_between_steps(threaded: bool, monkeypatch: pytest.Monkey
         for step in range(3):
             sim.step()
             body.set_springs([step], stiffness=90.0 + step)  # a new class
-            body.set_springs([5 * step], rest_lengths=body.rest_lengths[5 * step] * 1.25)
-            body.set_springs([7 * step], spring_damping=0.2)
+            body.set_springs([5 * step], rest_lengths=body.edges().rest_lengths[5 * step] * 1.25)
+            body.set_springs([7 * step], damping=0.2)
             fresh = NumbaKernel()
             assert_same(forces_by(sim.dynamics.springs, body), forces_by(fresh, body))
             assert_close_to_numpy(body, sim.dynamics.springs)
@@ -160,7 +166,7 @@ def test_springs_edited_between_steps(threaded: bool, monkeypatch: pytest.Monkey
 
 def test_springs_subset_in_the_bodys_order() -> None:
     body = shuffled_body(4)
-    body.set_springs(slice(None, None, 3), spring_damping=0.4)
+    body.set_springs(slice(None, None, 3), damping=0.4)
     kernel = NumbaKernel()
     forces_by(kernel, body)  # the sorted list and classes are built, and must not be used
     touching = body.springs_touching(np.array([3, 8, 40]))

@@ -11,7 +11,7 @@ from msdlab.scenes import gallery
 def ball_over_net() -> tuple[msd.Body, msd.SphereContact]:
     net = msd.Body.grid((4, 4), spacing=1.0, stiffness=50.0)
     positions = np.c_[net.positions, np.zeros(len(net))]
-    body = msd.Body.from_arrays(positions, np.c_[net.spring_a, net.spring_b], stiffness=50.0)
+    body = msd.Body.from_arrays(positions, np.c_[net.edges().a, net.edges().b], stiffness=50.0)
     ball = body.add_particle(
         msd.Particle(position=(1.45, 1.5, 0.3), velocity=(0.2, 0, -1), mass=2.0)
     )
@@ -59,7 +59,7 @@ def test_gravity_in_the_update_loop_is_gravity_as_a_force(integrator, kernel):
         body, contact = ball_over_net()
         body.masses[:] = np.linspace(0.5, 2.0, len(body))
         body.fixed[[0, 3]] = True
-        body.spring_damping = 0.3
+        body.set_springs(damping=0.3)
         sim = msd.Simulation(body, integrator(), dt=1e-3, forces=[contact, gravity, msd.Ground()])
         sim.run(steps=300)
         runs.append((body.positions.copy(), body.velocities.copy()))

@@ -1,4 +1,5 @@
-"""The grid gather and the edge loop, the two backends of the numba kernel, agree to rounding."""
+"""The lattice loop (gather) and the edge loop of the numba kernel agree to rounding; the
+spring set's kind chooses the loop."""
 
 from __future__ import annotations
 
@@ -6,9 +7,9 @@ import numpy as np
 import pytest
 
 import msdlab as msd
+import msdlab.compiled.kernel as compiled_kernel
 from msdlab import kernels
 from msdlab.compiled import NumbaKernel
-from msdlab.compiled.stencil import grid_stencil
 from msdlab.spring_kernel import SpringKernel
 
 RTOL = 1e-12
@@ -28,6 +29,25 @@ def shaken_grid(shape: tuple[int, ...], neighbours: tuple[int, ...], damping: fl
     body.positions[:] += rng.normal(scale=0.02, size=body.positions.shape)
     body.velocities[:] = rng.normal(size=body.positions.shape)
     return body
+
+
+def laid_out(body: msd.Body) -> msd.Body:
+    """A copy of ``body`` whose springs are an edge list (the edge loop's)."""
+    twin = body.copy()
+    twin.springs_as_edges()
+    return twin
+
+
+def gathers(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    """The names of the gather loops `NumbaKernel` runs from now on, as they are run."""
+    ran: list[str] = []
+    for name in ("gather_serial", "gather_parallel"):
+        loop = getattr(compiled_kernel, name)
+        monkeypatch.setattr(
+            f"msdlab.compiled.kernel.{name}",
+            lambda *args, name=name, loop=loop: ran.append(name) or loop(*args),
+        )
+    return ran
 
 
 def forces_by(kernel: SpringKernel, body: msd.Body) -> tuple[np.ndarray, float, float]:
@@ -70,12 +90,12 @@ def test_gather_matches_edge_loop_and_numpy(
         monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
         monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
     body = shaken_grid(shape, neighbours, damping)
-    gather = NumbaKernel()
-    assert gather.grid_stencil(body) is not None
-    assert_agree(body, gather)
-    edge_loop = NumbaKernel()
-    monkeypatch.setattr(edge_loop, "grid_stencil", lambda body: None)
-    assert_agree(body, edge_loop)
+    ran = gathers(monkeypatch)
+    assert_agree(body, NumbaKernel())
+    assert ran and set(ran) == {"gather_parallel" if threaded else "gather_serial"}
+    ran.clear()
+    assert_agree(laid_out(body), NumbaKernel())
+    assert not ran  # an edge list: the edge loop
 
 
 @pytest.mark.parametrize(("shape", "neighbours"), [((9, 4, 6), (1, 2, 3)), ((170, 100), (1, 2))])
@@ -95,25 +115,6 @@ def test_threads_give_the_same_sums_as_one_thread(
     assert threads[1:] == one_thread[1:]
 
 
-def test_springs_pointing_back_are_gathered() -> None:
-    """A grid whose springs join each particle to the one behind it (ends swapped)."""
-    grid = shaken_grid((4, 5, 3), (1, 2, 3), 0.2)
-    pairs = np.stack([grid.spring_b, grid.spring_a], axis=1)
-    body = msd.Body.from_arrays(
-        grid.positions,
-        pairs,
-        velocities=grid.velocities,
-        stiffness=grid.stiffness,
-        rest_lengths=grid.rest_lengths,
-        damping=0.2,
-    )
-    body.grid_shape = grid.grid_shape
-    kernel = NumbaKernel()
-    assert kernel.grid_stencil(body) is not None
-    assert (grid_stencil(body).offsets == -grid_stencil(grid).offsets).all()
-    assert_agree(body, kernel)
-
-
 def test_coincident_ends_exert_no_force() -> None:
     body = shaken_grid((3, 3, 3), (1, 2, 3), 0.2)
     body.positions[4] = body.positions[5]  # particles 4 and 5 share a spring
@@ -122,41 +123,38 @@ def test_coincident_ends_exert_no_force() -> None:
     assert_agree(body, NumbaKernel())
 
 
-def test_stencil_found_only_for_grid_springs() -> None:
-    grid = msd.Body.grid((4, 3, 5), neighbours=(1, 2, 3))
-    stencil = grid_stencil(grid)
-    assert stencil is not None and len(stencil.offsets) == 13
-    assert stencil.starts[-1] == grid.n_springs
-
-    pairs = np.stack([grid.spring_a, grid.spring_b], axis=1)
-    shuffled = msd.Body.from_arrays(grid.positions, pairs[::-1], rest_lengths=grid.rest_lengths)
-    shuffled.grid_shape = grid.grid_shape  # same shape, springs in another order
-    assert grid_stencil(shuffled) is None
-
-    extra = grid.copy()
-    extra.add_springs([[0, 7]])
-    assert grid_stencil(extra) is None
-    assert grid_stencil(msd.Body.from_arrays(grid.positions, pairs)) is None  # no shape
+def test_the_kind_of_spring_set_chooses_the_loop(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A lattice is gathered; the same springs as an edge list, in grid order or not, go
+    through the edge loop, and so does a lattice once its springs are made an edge list."""
+    ran = gathers(monkeypatch)
+    grid = shaken_grid((4, 3, 5), (1, 2, 3), 0.0)
+    kernel = NumbaKernel()
+    forces_by(kernel, grid)
+    assert ran == ["gather_serial"]
+    edges = grid.edges()
+    pairs = np.stack([edges.a, edges.b], axis=1)
+    for order in (slice(None), slice(None, None, -1)):
+        forces_by(NumbaKernel(), msd.Body.from_arrays(grid.positions, pairs[order]))
+    grid.springs_as_edges()
+    forces_by(kernel, grid)
+    assert ran == ["gather_serial"]
 
 
 @pytest.mark.parametrize("how", ["set_springs", "spring object"])
-def test_edited_spring_values_switch_to_the_edge_loop(how: str) -> None:
+def test_edits_of_single_springs_go_through_the_edge_loop(how: str) -> None:
     body = shaken_grid((4, 4, 4), (1, 2, 3), 0.0)
     kernel = NumbaKernel()
-    assert kernel.grid_stencil(body) is not None
-    held = body.stiffness
+    assert_agree(body, kernel)
+    held = body.springs_as_edges().stiffness
     if how == "set_springs":
         body.set_springs([17], stiffness=90.0)
     else:
         body.springs[17].stiffness = 90.0
-    assert kernel.grid_stencil(body) is None
+    assert held[17] == 90.0
     assert_agree(body, kernel)  # the edit counts at once
     with pytest.raises(ValueError, match="read-only"):
         held[17] = 40.0  # the arrays change only through the body
-    body.set_springs([17], stiffness=40.0)
-    assert kernel.grid_stencil(body) is not None
-    body.spring_damping = 0.5  # uniform again: gathered, dashpots included
-    assert kernel.grid_stencil(body) is not None
+    body.set_springs(damping=0.5)  # dashpots included
     assert_agree(body, kernel)
 
 
@@ -172,10 +170,9 @@ def test_simulation_on_the_gather_follows_the_edge_loop(
         monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_PARTICLES", 0)
     runs = []
     for gathered in (True, False):
-        if not gathered:
-            monkeypatch.setattr(NumbaKernel, "grid_stencil", lambda self, body: None)
         for integrator in (msd.SymplecticEuler(), msd.Verlet(0.01)):
             body = shaken_grid((4, 5, 3), (1, 2, 3), 0.1)
+            body = body if gathered else laid_out(body)
             body.positions[:, 1] += 0.05
             forces = [msd.Gravity((0, -9.81, 0)), msd.Ground()]
             sim = msd.Simulation(body, integrator, dt=1e-3, forces=forces, kernel="numba")
@@ -197,17 +194,16 @@ def test_shuffled_springs_sorted_for_the_edge_loop(
         monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
     grid = shaken_grid((4, 3, 5), (1, 2, 3), 0.0)
     order = np.random.default_rng(2).permutation(grid.n_springs)
-    pairs = np.stack([grid.spring_a[order], grid.spring_b[order]], axis=1)
+    pairs = np.stack([grid.edges().a[order], grid.edges().b[order]], axis=1)
     body = msd.Body.from_arrays(
-        grid.positions, pairs, velocities=grid.velocities, stiffness=grid.stiffness[order]
+        grid.positions, pairs, velocities=grid.velocities, stiffness=grid.edges().stiffness[order]
     )
-    body.set_springs(slice(None, None, 3), spring_damping=0.4)
+    body.set_springs(slice(None, None, 3), damping=0.4)
     kernel = NumbaKernel()
-    assert kernel.grid_stencil(body) is None
     assert_agree(body, kernel)
     body.set_springs([5], stiffness=123.0)
     assert_agree(body, kernel)
-    body.set_springs([7], rest_lengths=body.rest_lengths[7] * 1.5)
+    body.set_springs([7], rest_lengths=body.edges().rest_lengths[7] * 1.5)
     assert_agree(body, kernel)
     touching = body.springs_touching(np.array([3, 8]))
     assert kernel.elastic_energy(body, body.positions, touching) == pytest.approx(

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab.lattice import grid_pair_count, grid_pairs, neighbour_offsets
+from msdlab.lattice import grid_pairs, neighbour_offsets
 
 
 @pytest.mark.parametrize("n", [1, 2, 3, 5, 8])
@@ -17,13 +17,15 @@ def test_cube_with_three_neighbour_shells(n: int) -> None:
     axis, face, diagonal = 3 * n * n * (n - 1), 6 * n * (n - 1) ** 2, 4 * (n - 1) ** 3
     assert len(body) == n**3
     assert body.n_springs == axis + face + diagonal
-    rest = np.sort(body.rest_lengths)
+    rest = np.sort(body.edges().rest_lengths)
     np.testing.assert_allclose(rest[:axis], 0.25, rtol=1e-15)
     np.testing.assert_allclose(rest[axis : axis + face], 0.25 * math.sqrt(2), rtol=1e-15)
     np.testing.assert_allclose(rest[axis + face :], 0.25 * math.sqrt(3), rtol=1e-15)
-    lengths = np.linalg.norm(body.positions[body.spring_a] - body.positions[body.spring_b], axis=1)
-    np.testing.assert_allclose(lengths, body.rest_lengths, rtol=1e-12)  # built at rest
-    assert np.all(body.stiffness == 3.0) and np.all(body.spring_damping == 0.1)
+    lengths = np.linalg.norm(
+        body.positions[body.edges().a] - body.positions[body.edges().b], axis=1
+    )
+    np.testing.assert_allclose(lengths, body.edges().rest_lengths, rtol=1e-12)  # built at rest
+    assert np.all(body.edges().stiffness == 3.0) and np.all(body.edges().damping == 0.1)
     assert msd.elastic_energy(body) == pytest.approx(0.0, abs=1e-25)
 
 
@@ -37,7 +39,7 @@ def test_every_neighbour_pair_once() -> None:
         for q in range(p + 1, len(body))
         if 1 <= np.sum((coords[p] - coords[q]) ** 2) <= 3
     }
-    pairs = {tuple(sorted(pair)) for pair in zip(body.spring_a.tolist(), body.spring_b.tolist())}
+    pairs = {tuple(sorted(pair)) for pair in zip(body.edges().a.tolist(), body.edges().b.tolist())}
     assert pairs == expected and body.n_springs == len(expected)
 
 
@@ -49,11 +51,12 @@ def test_square_grid_and_pair_blocks() -> None:
     bending = nx * (ny - 2) + ny * (nx - 2)
     assert body.n_springs == axis + diagonals + bending
     offsets = neighbour_offsets(2, (1, 2, 4))
-    pairs, kinds = grid_pairs((nx, ny), offsets)
-    assert grid_pair_count((nx, ny), offsets) == len(pairs) == body.n_springs
-    np.testing.assert_array_equal(np.stack([body.spring_a, body.spring_b], 1), pairs)
+    pairs = grid_pairs((nx, ny), offsets)
+    assert body.spring_set.counts.sum() == len(pairs) == body.n_springs
+    kinds = np.repeat(np.arange(len(offsets)), body.spring_set.counts)
+    np.testing.assert_array_equal(np.stack([body.edges().a, body.edges().b], 1), pairs)
     rest = 0.5 * np.sqrt((offsets**2).sum(axis=1))[kinds]
-    np.testing.assert_allclose(body.rest_lengths, rest, rtol=1e-15)
+    np.testing.assert_allclose(body.edges().rest_lengths, rest, rtol=1e-15)
 
 
 def test_grid_arguments_are_checked() -> None:

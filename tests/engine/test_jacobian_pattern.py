@@ -17,7 +17,8 @@ def shaken_grid(seed: int = 0) -> msd.Body:
     body = msd.Body.grid((4, 3, 3), spacing=0.1, stiffness=40.0, neighbours=(1, 2, 3))
     body.positions[:] += rng.normal(scale=0.02, size=body.positions.shape)
     body.velocities[:] = rng.normal(size=body.positions.shape)
-    body.spring_damping = rng.uniform(0.0, 0.5, body.n_springs)
+    body.springs_as_edges()  # values of their own per spring
+    body.set_springs(damping=rng.uniform(0.0, 0.5, body.n_springs))
     body.fixed[[0, 5]] = True
     body.velocities[[0, 5]] = 0.0
     return body
@@ -26,18 +27,18 @@ def shaken_grid(seed: int = 0) -> msd.Body:
 def fresh_jacobians(body: msd.Body, x: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
     """The blocks of `kernels.spring_jacobians` assembled from scratch (COO to CSR)."""
     dim = body.dim
-    d = x[body.spring_a] - x[body.spring_b]
+    d = x[body.edges().a] - x[body.edges().b]
     length = np.linalg.norm(d, axis=1)
     n = d / length[:, None]
     outer = n[:, :, None] * n[:, None, :]
-    transverse = np.maximum(0.0, 1.0 - body.rest_lengths / length)
-    stiff = body.stiffness[:, None, None] * (
+    transverse = np.maximum(0.0, 1.0 - body.edges().rest_lengths / length)
+    stiff = body.edges().stiffness[:, None, None] * (
         outer + transverse[:, None, None] * (np.eye(dim) - outer)
     )
-    damp = body.spring_damping[:, None, None] * outer
+    damp = body.edges().damping[:, None, None] * outer
     shape = (x.size, x.size)
     jx, jv = sp.lil_matrix(shape), sp.lil_matrix(shape)
-    for s, (a, b) in enumerate(zip(body.spring_a, body.spring_b)):
+    for s, (a, b) in enumerate(zip(body.edges().a, body.edges().b)):
         for first, second, sign in ((a, a, -1), (b, b, -1), (a, b, 1), (b, a, 1)):
             rows = slice(first * dim, first * dim + dim)
             cols = slice(second * dim, second * dim + dim)
@@ -106,7 +107,8 @@ def test_each_kernel_sums_the_blocks_a_fresh_assembly_sums(kernel: str, shape: t
     if len(shape) == 2:
         body = msd.Body.grid(shape, spacing=0.1, stiffness=40.0, neighbours=(1, 2))
         body.positions[:] += np.random.default_rng(3).normal(scale=0.03, size=(20, 2))
-        body.set_springs(slice(None, None, 2), spring_damping=0.3)
+        body.springs_as_edges()  # values of their own per spring
+        body.set_springs(slice(None, None, 2), damping=0.3)
     pattern = jacobian.JacobianPattern(body)
     jx, jv = spring_kernel.make_kernel(kernel).jacobians(body, body.positions, pattern)
     fresh_x, fresh_v = fresh_jacobians(body, body.positions)
@@ -117,7 +119,7 @@ def test_each_kernel_sums_the_blocks_a_fresh_assembly_sums(kernel: str, shape: t
 def test_coincident_ends_give_an_isotropic_block(kernel: str) -> None:
     """No direction: the stiffness block of a spring of length 0 is k I, its dashpot's 0."""
     body = msd.Body.from_arrays([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]], [[0, 1]], stiffness=7.0)
-    body.spring_damping = 0.5
+    body.set_springs(damping=0.5)
     body.positions[1] = body.positions[0]
     pattern = jacobian.JacobianPattern(body)
     jx, jv = spring_kernel.make_kernel(kernel).jacobians(body, body.positions, pattern)
@@ -131,7 +133,7 @@ def test_implicit_matrix_is_the_sum_of_the_jacobians(dashpots: bool) -> None:
     """M - h_v ∂F/∂v - h_x ∂F/∂x on the pattern's values, a force's Jacobian included."""
     body = shaken_grid(4)
     if not dashpots:
-        body.spring_damping = 0.0
+        body.set_springs(damping=0.0)
     dynamics = Dynamics(body, [msd.ViscousDamping(0.3)])
     x, v = body.positions, body.velocities
     matrix, jx = dynamics.implicit_matrix(x, v, 0.02, 0.0004)

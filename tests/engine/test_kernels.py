@@ -22,9 +22,10 @@ def deformed_body(dim: int, seed: int = 0) -> msd.Body:
     body = msd.Body.grid(shape, spacing=0.1, stiffness=30.0, neighbours=neighbours)
     body.positions[:] += rng.normal(scale=0.02, size=body.positions.shape)
     body.velocities[:] = rng.normal(size=body.positions.shape)
-    body.stiffness = rng.uniform(10.0, 50.0, body.n_springs)
+    body.springs_as_edges()  # values of their own per spring
+    body.set_springs(stiffness=rng.uniform(10.0, 50.0, body.n_springs))
     body.masses[:] = rng.uniform(0.5, 2.0, len(body))
-    body.spring_damping = np.where(rng.random(body.n_springs) < 0.5, 0.3, 0.0)
+    body.set_springs(damping=np.where(rng.random(body.n_springs) < 0.5, 0.3, 0.0))
     body.fixed[[0, 3]] = True
     return body
 
@@ -81,7 +82,7 @@ def test_public_numpy_functions_match_spring_objects() -> None:
     forces, energy, power = per_spring(body)
     assert_close(kernels.spring_forces(body, x, v)[0], forces, np.abs(forces).max())
     assert kernels.elastic_energy(body, x) == pytest.approx(energy, rel=RTOL)
-    dashpots = kernels.NumpyKernel.spring_forces(body, x, v, np.zeros_like(x)).power
+    dashpots = kernels.NumpyKernel().spring_forces(body, x, v, np.zeros_like(x)).power
     assert dashpots == pytest.approx(power, rel=RTOL)
 
 
@@ -156,7 +157,7 @@ def test_kernel_follows_topology_and_parameter_changes() -> None:
     dynamics = Dynamics(body)
     x, v = body.positions, body.velocities
     dynamics.force(x, v)
-    body.stiffness = body.stiffness * 2.0  # edits of parameters count at once
+    body.set_springs(stiffness=body.edges().stiffness * 2.0)  # edits of parameters count at once
     body.add_springs([[0, len(body) - 1]])  # and new springs
     x, v = body.positions, body.velocities
     expected, _, _ = per_spring(body)

@@ -77,13 +77,13 @@ def test_a_planar_body_moves_the_same_in_2d_and_3d(integrator):
     flat, gravity = random_system(4, 2)
     deep = msd.Body.from_arrays(
         np.c_[flat.positions, np.zeros(len(flat))],
-        np.c_[flat.spring_a, flat.spring_b],
+        np.c_[flat.edges().a, flat.edges().b],
         velocities=np.c_[flat.velocities, np.zeros(len(flat))],
         masses=flat.masses,
         fixed=flat.fixed,
-        stiffness=flat.stiffness,
-        rest_lengths=flat.rest_lengths,
-        damping=flat.spring_damping,
+        stiffness=flat.edges().stiffness,
+        rest_lengths=flat.edges().rest_lengths,
+        damping=flat.edges().damping,
     )
     forces_2d = [msd.Gravity(gravity), msd.Ground(-3.0), msd.Drag(0.2)]
     forces_3d = [msd.Gravity([*gravity, 0.0]), msd.Ground(-3.0), msd.Drag(0.2)]

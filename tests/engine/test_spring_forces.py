@@ -49,7 +49,7 @@ def forces(body: msd.Body, x: np.ndarray | None = None, v: np.ndarray | None = N
 def dashpot_power(body: msd.Body) -> float:
     """The power (W) the dashpots take, from the numpy kernel's pass over the springs."""
     x = body.positions
-    return kernels.NumpyKernel.spring_forces(body, x, body.velocities, np.zeros_like(x)).power
+    return kernels.NumpyKernel().spring_forces(body, x, body.velocities, np.zeros_like(x)).power
 
 
 @given(random_bodies())

@@ -29,7 +29,7 @@ def falling_body(dim: int, size: int) -> msd.Body:
     """A grid just above a floor at 0.1 m, moving randomly, with dashpots and fixed particles."""
     neighbours = (1, 2, 3) if dim == 3 else (1, 2)
     body = msd.Body.grid((size,) * dim, spacing=0.1, stiffness=200.0, neighbours=neighbours)
-    body.spring_damping = 0.05
+    body.set_springs(damping=0.05)
     body.positions[:, 1] += 0.15
     body.velocities[:] = np.random.default_rng(1).normal(size=body.velocities.shape)
     body.fixed[:: 7 * size] = True

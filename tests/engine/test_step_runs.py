@@ -13,7 +13,8 @@ from msdlab.dynamics import Dynamics
 
 def grid() -> msd.Body:
     body = msd.Body.grid((4, 3, 3), spacing=0.1, stiffness=40.0, neighbours=(1, 2, 3))
-    body.set_springs(slice(None, None, 2), spring_damping=0.2)
+    body.springs_as_edges()  # values of their own per spring
+    body.set_springs(slice(None, None, 2), damping=0.2)
     body.velocities[:] = np.random.default_rng(0).normal(size=body.positions.shape)
     body.fixed[0] = True
     return body

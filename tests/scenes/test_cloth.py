@@ -42,8 +42,8 @@ def test_it_stays_bounded_with_a_stable_integrator(integrator):
     assert np.all(np.isfinite(x))
     # Hanging from (0, 8, 10) and (10, 8, 10), nothing can drop further than the cloth is long.
     assert x[..., 2].min() > 10.0 - 1.3 * np.hypot(10.0, 8.0)
-    d = x[-1, sim.body.spring_a] - x[-1, sim.body.spring_b]
-    assert np.max(np.linalg.norm(d, axis=1) / sim.body.rest_lengths) < 1.5
+    d = x[-1, sim.body.edges().a] - x[-1, sim.body.edges().b]
+    assert np.max(np.linalg.norm(d, axis=1) / sim.body.edges().rest_lengths) < 1.5
 
 
 def test_energy_decays_with_damping_and_is_kept_without():

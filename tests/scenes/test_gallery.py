@@ -145,8 +145,8 @@ def test_bodies_in_hard_walls_stay_inside_and_keep_their_springs(scene, model):
     past = 0.0 if model == "physical" else 10.0  # the page's walls let a frame's move through
     assert np.all((x >= -past) & (x <= (600.0 + past, 400.0 + past)))
     assert x[-1, :, 1].min() < 2.0  # landed on the floor (the page's walls: within 2 px)
-    d = x[-1, sim.body.spring_a] - x[-1, sim.body.spring_b]
-    strain = np.linalg.norm(d, axis=1) / sim.body.rest_lengths - 1.0
+    d = x[-1, sim.body.edges().a] - x[-1, sim.body.edges().b]
+    strain = np.linalg.norm(d, axis=1) / sim.body.edges().rest_lengths - 1.0
     assert np.max(np.abs(strain)) < 0.35
 
 

@@ -16,7 +16,7 @@ def test_grid_is_the_briefs():
     assert len(x) == 8000
     np.testing.assert_allclose(x.min(axis=0), (-1.0, 1.5, -1.0))
     np.testing.assert_allclose(x.max(axis=0), (0.9, 3.4, 0.9))
-    np.testing.assert_allclose(sim.body.rest_lengths.min(), 0.1)  # one grid spacing, 2/N
+    np.testing.assert_allclose(sim.body.edges().rest_lengths.min(), 0.1)  # one grid spacing, 2/N
     assert (sim.dt, sim.integrator.damping) == (0.4, 0.01)
 
 
@@ -50,8 +50,8 @@ def test_with_26_neighbours_it_keeps_its_shape(landed):
     side = 5 * 2.0 / 6
     assert height(trajectory.positions[-1]) == pytest.approx(side, rel=0.05)
     x = trajectory.positions[-1]
-    lengths = np.linalg.norm(x[sim.body.spring_a] - x[sim.body.spring_b], axis=1)
-    assert np.max(np.abs(lengths / sim.body.rest_lengths - 1)) < 0.05
+    lengths = np.linalg.norm(x[sim.body.edges().a] - x[sim.body.edges().b], axis=1)
+    assert np.max(np.abs(lengths / sim.body.edges().rest_lengths - 1)) < 0.05
 
 
 def test_with_axis_springs_only_the_rotated_cube_collapses():

@@ -20,8 +20,8 @@ def test_the_net_is_built_as_the_report_describes():
     assert len(body) == 7 * 7 + 1
     assert body.fixed.sum() == 24  # the perimeter of a 7×7 net
     assert body.n_springs == 2 * 7 * 6
-    np.testing.assert_allclose(body.rest_lengths, 0.95)
-    np.testing.assert_allclose(body.stiffness, 999.0)
+    np.testing.assert_allclose(body.edges().rest_lengths, 0.95)
+    np.testing.assert_allclose(body.edges().stiffness, 999.0)
     np.testing.assert_allclose(body.positions[BALL], (3.0, 3.0, 1.5))
     assert body.masses[BALL] == 1.0
     assert body.masses[0] == pytest.approx(0.02)  # nodes have their own mass, not the ball's

@@ -32,7 +32,8 @@ def jelly(shape=(3, 4, 2), neighbours=(1, 2, 3), spacing=0.5, stiffness=0.5):
 
 
 def springs_of(body):
-    return np.stack([body.spring_a, body.spring_b], axis=1), body.rest_lengths.copy()
+    edges = body.edges()
+    return np.stack([edges.a, edges.b], axis=1), edges.rest_lengths.copy()
 
 
 DEGREES_AS_RADIANS = (
@@ -250,7 +251,7 @@ def compare_with_engine(task3, got, body, x, what):
         return
     springs, rest = springs_of(body)
     worst = int(np.argmax(np.linalg.norm(got - expected, axis=1)))
-    mistake = named(task3, got, x, springs, rest, body.stiffness[0])
+    mistake = named(task3, got, x, springs, rest, body.edges().stiffness[0])
     expect(
         False,
         saw=f"{what}: particle {worst} gets a = {vec(got[worst])}, eq. (1.1)-(1.2) give "

@@ -19,7 +19,7 @@ KINDS = {1: "axis", 2: "face-diagonal", 3: "body-diagonal"}
 
 def engine_pairs(shape, neighbours):
     body = oracles.grid_body(shape, 1.0, 1.0, neighbours)
-    return {frozenset(p) for p in zip(body.spring_a.tolist(), body.spring_b.tolist())}, body
+    return {frozenset(p) for p in zip(body.edges().a.tolist(), body.edges().b.tolist())}, body
 
 
 def student_springs(task4, shape, spacing, neighbours):
@@ -164,7 +164,9 @@ def springs_at_fault(task4):
     lengths = {frozenset(p): r for p, r in zip(springs.tolist(), rest.tolist())}
     wrong_rest = any(
         not np.isclose(lengths.get(frozenset(p), -1.0), r)
-        for p, r in zip(zip(body.spring_a.tolist(), body.spring_b.tolist()), body.rest_lengths)
+        for p, r in zip(
+            zip(body.edges().a.tolist(), body.edges().b.tolist()), body.edges().rest_lengths
+        )
     )
     if len(springs) != len(expected) or set(lengths) != expected or wrong_rest:
         return "your grid_springs is wrong (see its checks), and the cube is built with it"

@@ -34,7 +34,7 @@ def test_any_grid_shape_and_neighbours(task4, shape, neighbours, spacing):
     springs = np.asarray(springs, dtype=np.int64).reshape(-1, 2)
     rest = as_array(rest, "grid_springs (rest lengths)")
     body = oracles.grid_body(shape, spacing, 1.0, neighbours)
-    expected = {frozenset(p) for p in zip(body.spring_a.tolist(), body.spring_b.tolist())}
+    expected = {frozenset(p) for p in zip(body.edges().a.tolist(), body.edges().b.tolist())}
     found = [frozenset(p) for p in springs.tolist()]
     positions = body.positions
 

@@ -25,7 +25,7 @@ def test_the_page_gets_the_body_and_float32_positions():
         np.frombuffer(view.positions, np.float32).reshape(-1, 2), sim.body.positions
     )
     pairs = np.frombuffer(view.springs, np.int32).reshape(-1, 2)
-    np.testing.assert_array_equal(pairs[:, 0], sim.body.spring_a)
+    np.testing.assert_array_equal(pairs[:, 0], sim.body.edges().a)
     assert len(view.scene["world"]["edges"]) == 4  # the gallery's walls
 
 
@@ -142,7 +142,7 @@ def test_sliders_change_what_the_engine_uses_between_steps():
     names = [s["name"] for s in view.settings]
     assert names == ["stiffness", "damping", "gravity", "dt"]
     ask(view, type="set", name="stiffness", value=0.2)
-    np.testing.assert_allclose(sim.body.stiffness, 0.2)
+    np.testing.assert_allclose(sim.body.edges().stiffness, 0.2)
     ask(view, type="set", name="gravity", value=0.3)
     np.testing.assert_allclose(sim.forces[0].g, (0.0, -0.3))
     ask(view, type="set", name="damping", value=0.0)

@@ -41,7 +41,7 @@ def report() -> None:
         state = {
             "held": live.grab.particle,
             "positions": sim.body.positions.tolist(),
-            "stiffness": float(np.mean(sim.body.stiffness)),
+            "stiffness": float(np.mean(sim.body.edges().stiffness)),
             "running": live.running,
             "steps": sim.step_count,
         }

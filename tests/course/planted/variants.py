@@ -841,7 +841,8 @@ BUGS += [
         4,
         "    index = np.arange(np.prod(shape)).reshape(shape)\n",
         "    body = msd.Body.grid(shape, spacing, neighbours=squared_distances)\n"
-        "    return np.stack([body.spring_a, body.spring_b], axis=1), body.rest_lengths.copy()\n"
+        "    edges = body.edges()\n"
+        "    return np.stack([edges.a, edges.b], axis=1), edges.rest_lengths.copy()\n"
         "    index = np.arange(np.prod(shape)).reshape(shape)\n",
         "grid_springs_each_pair_once",
         "asks for your own implementation",
