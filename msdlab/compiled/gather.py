@@ -14,6 +14,7 @@ triple of offsets) and their memory (`stencil.Scratch`) are made in `stencil`.
 """
 
 import math
+from collections.abc import Callable
 
 import numba
 import numpy as np
@@ -262,63 +263,44 @@ def _totals(squares, powers):
     return math.sqrt(squares.max()), power
 
 
-@numba.njit(cache=True, error_model="numpy")
-def gather_serial(x, v, layout, triples, memory, out, add):
-    """One thread: `gather_parallel`'s work in the same order, so the same sums."""
-    pad, damped = memory.pad, np.any(triples.damping != 0.0)
-    memory.forces[:, :] = 0.0
-    memory.squared[:] = 0.0
-    for p in range(len(x)):  # loops, not slices: numba compiles them much faster
-        for q in range(x.shape[1]):
-            memory.positions[q, p + pad] = x[p, q]
-            if damped:
-                memory.velocities[q, p + pad] = v[p, q]
-    units = (
-        layout.shape[0]
-        if layout.shape[0] > 1
-        else (layout.shape[1] + layout.rows - 1) // layout.rows
-    )
-    squares, powers = np.zeros(units), np.zeros(units)
-    for phase in range(3):
-        for unit in range(phase, units, 3):
-            squares[unit], powers[unit] = _push_unit(memory, layout, triples, unit)
-    for p in range(len(x) if add else 0):
-        for q in range(x.shape[1]):
-            out[p, q] += memory.forces[q, p + pad]
-    return _totals(squares, powers)
+def _compile(parallel: bool) -> Callable:
+    """`gather` compiled for threads (``parallel``) or for one thread, which does the same
+    work in the same order, so the same sums."""
+    loop = numba.prange if parallel else range
+
+    @numba.njit(cache=True, parallel=parallel, error_model="numpy")
+    def gather(x, v, layout, triples, memory, out, add):
+        """Add to ``out`` (N, d) the forces of a lattice's springs, each computed once, from
+        the particle behind (`_push_unit`); return the largest stretch |d|/l and the
+        dashpot power (W), summed over the units in order. ``layout``, ``triples`` and
+        ``memory`` are the lattice's `stencil.Layout`, `stencil.Triples` and
+        `stencil.Scratch`; without ``add`` the forces stay in ``memory.forces`` for the
+        caller to add in a loop of its own (see `advance`).
+
+        The threads push every third unit at once, in three rounds, so no two write the
+        same particle.
+        """
+        positions, velocities, forces, squared, pad = memory  # arrays, not the tuple, in loops
+        damped = np.any(triples.damping != 0.0)
+        for p in loop(len(x)):
+            for q in range(x.shape[1]):
+                positions[q, p + pad] = x[p, q]
+                if damped:
+                    velocities[q, p + pad] = v[p, q]
+            forces[0, p + pad] = forces[1, p + pad] = forces[2, p + pad] = squared[p + pad] = 0.0
+        n0, n1, rows = layout.shape[0], layout.shape[1], layout.rows
+        units = n0 if n0 > 1 else (n1 + rows - 1) // rows
+        squares, powers = np.zeros(units), np.zeros(units)
+        for phase in range(3):
+            for u in loop((units - phase + 2) // 3):
+                unit = phase + 3 * u
+                squares[unit], powers[unit] = _push_unit(memory, layout, triples, unit)
+        for p in loop(len(x) if add else 0):
+            for q in range(x.shape[1]):
+                out[p, q] += forces[q, p + pad]
+        return _totals(squares, powers)
+
+    return gather
 
 
-@numba.njit(cache=True, parallel=True, error_model="numpy")
-def gather_parallel(x, v, layout, triples, memory, out, add):
-    """Add to ``out`` (N, d) the forces of a lattice's springs, each computed once, from
-    the particle behind (`_push_unit`); return the largest stretch |d|/l and the dashpot
-    power (W), summed over the units in order. ``layout``, ``triples`` and ``memory``
-    are the lattice's `stencil.Layout`, `stencil.Triples` and `stencil.Scratch`; without
-    ``add`` the forces stay in ``memory.forces`` for the caller to add in a loop of its
-    own (see `advance.compile_advance`).
-
-    The threads push every third unit at once, in three rounds, so no two
-    write the same particle.
-    """
-    positions, velocities, forces, squared, pad = memory  # arrays, not the tuple, in prange
-    damped = np.any(triples.damping != 0.0)
-    for p in numba.prange(len(x)):
-        for q in range(x.shape[1]):
-            positions[q, p + pad] = x[p, q]
-            if damped:
-                velocities[q, p + pad] = v[p, q]
-        forces[0, p + pad] = forces[1, p + pad] = forces[2, p + pad] = squared[p + pad] = 0.0
-    units = (
-        layout.shape[0]
-        if layout.shape[0] > 1
-        else (layout.shape[1] + layout.rows - 1) // layout.rows
-    )
-    squares, powers = np.zeros(units), np.zeros(units)
-    for phase in range(3):
-        for u in numba.prange((units - phase + 2) // 3):
-            unit = phase + 3 * u
-            squares[unit], powers[unit] = _push_unit(memory, layout, triples, unit)
-    for p in numba.prange(len(x) if add else 0):
-        for q in range(x.shape[1]):
-            out[p, q] += forces[q, p + pad]
-    return _totals(squares, powers)
+gather_serial, gather_parallel = _compile(False), _compile(True)

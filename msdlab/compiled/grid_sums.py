@@ -7,6 +7,7 @@ stiffness and rest length of offset m.
 """
 
 import math
+from collections.abc import Callable
 
 import numba
 import numpy as np
@@ -36,23 +37,22 @@ def _plane_sum(x, shape, offsets, stiffness, rest_lengths, m, plane):
     return total
 
 
-@numba.njit(cache=True, error_model="numpy")
-def grid_sum_serial(x, shape, offsets, stiffness, rest_lengths):
-    """One thread: `grid_sum_parallel`'s sums, in the same order."""
-    sums = np.zeros((len(offsets), shape[0]))
-    for m in range(len(offsets)):
-        for plane in range(max(0, -offsets[m, 0]), shape[0] - max(0, offsets[m, 0])):
-            sums[m, plane] = _plane_sum(x, shape, offsets, stiffness, rest_lengths, m, plane)
-    return sums.sum()
+def _compile(parallel: bool) -> Callable:
+    """`grid_sum` compiled for threads (``parallel``) or for one thread (the same sums)."""
+    loop = numba.prange if parallel else range
+
+    @numba.njit(cache=True, parallel=parallel, error_model="numpy")
+    def grid_sum(x, shape, offsets, stiffness, rest_lengths):
+        """The energy (J) of all springs (see `_plane_sum`), with the ``stiffness`` (N/m)
+        and ``rest_lengths`` (m) of each offset (M,); the threads take planes, and the
+        sums are added in a fixed order."""
+        sums = np.zeros((len(offsets), shape[0]))
+        for m in range(len(offsets)):
+            for plane in loop(max(0, -offsets[m, 0]), shape[0] - max(0, offsets[m, 0])):
+                sums[m, plane] = _plane_sum(x, shape, offsets, stiffness, rest_lengths, m, plane)
+        return sums.sum()
+
+    return grid_sum
 
 
-@numba.njit(cache=True, parallel=True, error_model="numpy")
-def grid_sum_parallel(x, shape, offsets, stiffness, rest_lengths):
-    """The energy (J) of all springs (see `_plane_sum`), with the ``stiffness`` (N/m) and
-    ``rest_lengths`` (m) of each offset (M,); the threads take planes, and the sums are
-    added in a fixed order."""
-    sums = np.zeros((len(offsets), shape[0]))
-    for m in range(len(offsets)):
-        for plane in numba.prange(max(0, -offsets[m, 0]), shape[0] - max(0, offsets[m, 0])):
-            sums[m, plane] = _plane_sum(x, shape, offsets, stiffness, rest_lengths, m, plane)
-    return sums.sum()
+grid_sum_serial, grid_sum_parallel = _compile(False), _compile(True)
