@@ -20,7 +20,7 @@ def keep_acceleration(
     x: np.ndarray, v: np.ndarray, a: np.ndarray, dt: float
 ) -> tuple[np.ndarray, np.ndarray]:
     """The update that returns the acceleration a (m/s²) in place of the new positions:
-    through a kernel's fused advance, a = F/m alone in one compiled loop."""
+    through the backend's `advance`, a = F/m alone (on numba, in one compiled loop)."""
     return a, v
 
 
@@ -32,11 +32,11 @@ class Dynamics:
     acceleration. Integrators call `acceleration` or `advance` (and `force`,
     `jacobians` or `implicit_matrix`, `masses`, `free` for implicit methods).
 
-    ``kernel`` picks the spring kernel (`msdlab.spring_kernel`): "numba" (compiled,
+    ``kernel`` picks the backend (`msdlab.spring_kernel`): "numba" (compiled,
     threaded) or "numpy" (readable); the default is ``MSDLAB_KERNEL`` or "numba".
     Both apply the same `msdlab.equations`; nothing here depends on which runs:
-    the springs' forces, energy and Jacobians come from the kernel, the rest
-    (a = F/m, the uniform fields, the other forces) is computed here.
+    the springs' forces, energy and Jacobians and a step's a = F/m and update come
+    from the backend; the uniform fields and the other forces are gathered here.
     """
 
     def __init__(self, body: Body, forces: Sequence[Force] = (), kernel: str | None = None) -> None:

@@ -150,6 +150,7 @@ class NumpyKernel:
 
     name = "numpy"
     finite = staticmethod(finite)
+    damping_work = staticmethod(equations.damping_work)
     ground_clamp = staticmethod(ground_clamp)
 
     def __init__(self) -> None:

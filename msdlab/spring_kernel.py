@@ -2,12 +2,13 @@
 
 A backend computes, for all springs of a body at once, what `Spring.force` computes for
 one (eq. 1.1-1.2 with the dashpot), their energy and Jacobians, and steps the particles
-with an integrator's update; it also checks the state and clamps particles to the
-ground, booking the energy that takes out. `SpringKernel` is the whole contract, six
-methods, none optional; nothing else asks a backend for more, and nothing asks which one
-runs: `kernels.NumpyKernel` (readable, whole arrays, the reference every backend is tested
-against) or `msdlab.compiled.NumbaKernel` (compiled loops, the default). Both apply the
-same `msdlab.equations`. What the methods return is named in `msdlab.kernel_results`.
+with an integrator's update; it also checks the state, sums the work of an integrator's
+velocity factor and clamps particles to the ground, booking the energy that takes out.
+`SpringKernel` is the whole contract, seven methods, none optional; nothing else asks a
+backend for more, and nothing asks which one runs: `kernels.NumpyKernel` (readable, whole
+arrays, the reference every backend is tested against) or `msdlab.compiled.NumbaKernel`
+(compiled loops, the default). Both apply the same `msdlab.equations`. What the methods
+return is named in `msdlab.kernel_results`.
 """
 
 from __future__ import annotations
@@ -75,6 +76,12 @@ class SpringKernel(Protocol):
         g = ``field`` (d,) in m/s². The numpy backend does it in three lines on arrays;
         the numba backend runs the springs' pass, a and the update in compiled loops.
         """
+
+    def damping_work(
+        self, masses: np.ndarray, v_before: np.ndarray, v_after: np.ndarray, factor: float
+    ) -> float:
+        """`equations.damping_work` (J): the work of an integrator's velocity factor per step,
+        which the ledger books for an integrator that does not book its own."""
 
     def ground_clamp(
         self,

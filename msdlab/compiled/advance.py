@@ -6,17 +6,27 @@ the spring loops left pending in the same pass. The update is handed to numba as
 written (`register_jitable`), and the loop calls it as a closure variable: numba inlines
 it, and keys the loop's disk cache by the update's own code, so msdlab's integrators'
 loops are compiled once per machine; a user's update is compiled once per process.
+`advance_particles` keeps one loop per update for the process and runs it, or runs the
+update on whole arrays if numba cannot compile it.
 """
 
 from __future__ import annotations
 
 import types
+import warnings
 from collections.abc import Callable
 
 import numba
+import numpy as np
 from numba.extending import register_jitable
 
+from .. import equations
+from ..body import Body
 from .equations import acceleration
+
+# One compiled loop per update function, threaded or not, for the whole process; None for
+# an update numba cannot compile (it runs on arrays).
+_LOOPS: dict[tuple[Callable, bool], Callable | None] = {}
 
 
 @numba.njit(cache=True, inline="always")
@@ -69,4 +79,55 @@ def _copy(update: Callable) -> Callable:
     imported by name, so the loop's cache key holds its code, not its name."""
     return types.FunctionType(
         update.__code__, update.__globals__, update.__name__, update.__defaults__
+    )
+
+
+def advance_particles(
+    update: Callable,
+    body: Body,
+    x: np.ndarray,
+    v: np.ndarray,
+    forces: np.ndarray,
+    partial: np.ndarray,
+    field: np.ndarray,
+    dt: float,
+    coefficients: tuple[float, ...],
+    threads: bool,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The new positions and velocities: ``update`` with a = (F + m·g)/m, F = ``forces`` plus
+    the ``partial`` forces, in the compiled loop of `compile_advance` (on the ``threads``
+    or not). An update numba cannot compile warns once and runs on whole arrays."""
+    if (update, threads) not in _LOOPS:
+        _LOOPS[update, threads] = compile_advance(update, threads)
+    loop = _LOOPS[update, threads]
+    if loop is not None:
+        x_new, v_new = body.new_state()
+        try:
+            loop(
+                x,
+                v,
+                forces,
+                partial,
+                field,
+                body.masses,
+                body.fixed,
+                dt,
+                coefficients,
+                x_new,
+                v_new,
+            )
+            return x_new, v_new
+        except numba.core.errors.NumbaError as error:
+            _LOOPS[update, False] = _LOOPS[update, True] = None
+            warnings.warn(
+                f"numba cannot compile {update.__qualname__} ({type(error).__name__}); "
+                "it runs on whole numpy arrays instead, with the same result, more slowly",
+                RuntimeWarning,
+                stacklevel=5,
+            )
+    for part in partial:  # on arrays, in the order of the compiled loop
+        forces = forces + part
+    masses, free = body.masses[:, None], ~body.fixed[:, None]
+    return update(
+        x, v, equations.acceleration(forces + masses * field, masses, free), dt, *coefficients
     )

@@ -2,19 +2,17 @@
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numba
 import numpy as np
 
-from .. import equations
 from ..body import Body
 from ..kernel_results import Advanced, Jacobians, SpringSums
 from ..lattice import LatticeSprings
 from ..springs import EdgeSprings
-from .advance import compile_advance
+from .advance import advance_particles
 from .contact import ground_clamp
 from .edges import (
     elastic_energy_parallel,
@@ -26,7 +24,7 @@ from .edges import (
 )
 from .gather import gather_parallel, gather_serial
 from .grid_sums import grid_sum_parallel, grid_sum_serial
-from .reductions import PARALLEL_MIN_PARTICLES, finite
+from .reductions import PARALLEL_MIN_PARTICLES, damping_work, finite
 from .stencil import NO_PLAN, padded_shape, plan
 
 if TYPE_CHECKING:
@@ -48,11 +46,6 @@ SPRING_CLASSES = 65_536
 # forces by coordinate seen transposed) and the threads' buffers (T, N, d) still to add to it.
 Pending = tuple[np.ndarray, np.ndarray]
 
-# One compiled loop per update function (threaded or not), for the whole process.
-_ADVANCES: dict[tuple[Callable, bool], Callable] = {}
-
-_FAILED: set[Callable] = set()  # updates numba cannot compile: they run on arrays
-
 
 class NumbaKernel:
     """The compiled spring kernel for one body, with what it needs kept between calls.
@@ -63,7 +56,8 @@ class NumbaKernel:
     buffer per extra thread. What is kept is rebuilt when the springs change
     (``body.version``, which every edit of the springs counts). ``springs``
     (indices) restricts a computation to some springs, on one thread, in the
-    body's order. `finite` runs on the threads for a body big enough to share out.
+    body's order. `finite` and `damping_work` run on the threads for a body big enough
+    to share out.
     """
 
     def __init__(self) -> None:
@@ -81,6 +75,7 @@ class NumbaKernel:
 
     name = "numba"
     finite = staticmethod(finite)
+    damping_work = staticmethod(damping_work)
     ground_clamp = staticmethod(ground_clamp)  # `interaction.Ground`'s clamp, if present
 
     def spring_forces(
@@ -211,44 +206,10 @@ class NumbaKernel:
             self._forces.fill(0.0)
             stretch, power, _ = self._spring_forces(body, x, v, self._forces, None, reduce=True)
             total, partial = self._forces, forces[np.newaxis]
-        x_new, v_new = self._advance(update, body, x, v, total, partial, field, dt, coefficients)
-        return Advanced(x_new, v_new, stretch, power)
-
-    def _advance(
-        self,
-        update: Callable,
-        body: Body,
-        x: np.ndarray,
-        v: np.ndarray,
-        forces: np.ndarray,
-        partial: np.ndarray,
-        field: np.ndarray,
-        dt: float,
-        coefficients: tuple[float, ...],
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """The update with F = ``forces`` plus the ``partial`` forces (see
-        `advance.compile_advance`): the new positions and velocities."""
         threads = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
-        compiled = None if update in _FAILED else _ADVANCES.get((update, threads))
-        if compiled is None and update not in _FAILED:
-            compiled = _ADVANCES[update, threads] = compile_advance(update, threads)
-        if compiled is not None:
-            x_new, v_new = body.new_state()
-            try:
-                masses, fixed = body.masses, body.fixed
-                compiled(
-                    x, v, forces, partial, field, masses, fixed, dt, coefficients, x_new, v_new
-                )
-                return x_new, v_new
-            except numba.core.errors.NumbaError as error:
-                _FAILED.add(update)
-                warnings.warn(
-                    f"numba cannot compile {update.__qualname__} ({type(error).__name__}); "
-                    "it runs on whole numpy arrays instead, with the same result, more slowly",
-                    RuntimeWarning,
-                    stacklevel=5,
-                )
-        return _advance_on_arrays(update, body, x, v, forces, partial, field, dt, coefficients)
+        state = (update, body, x, v, total, partial, field, dt, coefficients)
+        x_new, v_new = advance_particles(*state, threads)
+        return Advanced(x_new, v_new, stretch, power)
 
     def _edge_list(self, body: Body) -> tuple[np.ndarray | None, ...]:
         """Ends a, b of all springs sorted by (a, b), each one's class (or None) and the
@@ -304,23 +265,3 @@ class NumbaKernel:
         if self._order is not None:
             kinds = kinds[self._order]
         return kinds, *(np.ascontiguousarray(column) for column in table.T)
-
-
-def _advance_on_arrays(
-    update: Callable,
-    body: Body,
-    x: np.ndarray,
-    v: np.ndarray,
-    forces: np.ndarray,
-    partial: np.ndarray,
-    field: np.ndarray,
-    dt: float,
-    coefficients: tuple[float, ...],
-) -> tuple[np.ndarray, np.ndarray]:
-    """`NumbaKernel._advance` for an update numba cannot compile: on whole arrays, with the
-    threads' partial forces added in the order of the compiled loop."""
-    for part in partial:
-        forces = forces + part  # in the order of `edges.spring_forces_parallel`
-    masses, free = body.masses[:, None], ~body.fixed[:, None]
-    a = equations.acceleration(forces + masses * field, masses, free)
-    return update(x, v, a, dt, *coefficients)

@@ -234,6 +234,12 @@ def test_the_fused_advance_is_its_own_forces_then_the_update_bit_for_bit(
     assert (step.stretch, step.power) == sums
 
 
+def test_damping_work(backend: spring_kernel.SpringKernel, body: msd.Body) -> None:
+    v_new = np.random.default_rng(6).normal(size=body.velocities.shape)
+    arrays = (body.masses, body.velocities, v_new, 0.97)
+    assert backend.damping_work(*arrays) == pytest.approx(REFERENCE.damping_work(*arrays), rel=RTOL)
+
+
 @pytest.mark.parametrize("friction", [0.0, 0.3])
 def test_ground_clamp(backend: spring_kernel.SpringKernel, body: msd.Body, friction: float) -> None:
     """The same particles are put on the plane (a tilted one, above the middle of the body)

@@ -17,10 +17,10 @@ from msdlab.compiled import advance
 STEP_ONCE = """
 import json
 import msdlab as msd
-from msdlab.compiled import kernel
+from msdlab.compiled import advance
 cube = msd.Body.grid((3, 3, 3), spacing=0.1, stiffness=500.0)
 msd.Simulation(cube, msd.Verlet(0.01), dt=1e-3, forces=[msd.Gravity((0, -9.81, 0))]).step()
-(loop,) = [f for (update, _), f in kernel._ADVANCES.items() if update is msd.Verlet.update]
+(loop,) = [f for (update, _), f in advance._LOOPS.items() if update is msd.Verlet.update]
 print(json.dumps({"misses": sum(loop.stats.cache_misses.values()),
                   "hits": sum(loop.stats.cache_hits.values())}))
 """

@@ -1,5 +1,5 @@
-"""Sums over the end of a step: the damping work is the work of its kick, and the kernels'
-finiteness checks see a NaN or infinity anywhere."""
+"""The kernels' sums over the end of a step: the numba kernel's compiled passes give the
+numpy kernel's readable results (to rounding), and a NaN or infinity anywhere is seen."""
 
 import numpy as np
 import pytest
@@ -9,13 +9,17 @@ from msdlab.compiled import reductions
 from msdlab.spring_kernel import make_kernel
 
 
-def test_damping_work_is_the_work_of_its_kick() -> None:
-    """A factor f per step kicks v by (f - 1)·v: its work at the mean of the step's velocities."""
+def test_damping_work_is_the_readable_sum_to_rounding(kernel: str) -> None:
     rng = np.random.default_rng(1)
-    masses, v, v_new = rng.random(1000) + 0.5, *rng.normal(size=(2, 1000, 3))
-    kick = (0.99 - 1.0) * v
-    expected = -msd.energy.contact_work(masses, kick, v, v_new)
-    assert msd.energy.damping_work(masses, v, v_new, 0.99) == pytest.approx(expected, rel=1e-12)
+    masses, v, v_new = (
+        rng.random(1000) + 0.5,
+        rng.normal(size=(1000, 3)),
+        rng.normal(size=(1000, 3)),
+    )
+    expected = msd.energy.damping_work(masses, v, v_new, 0.99)
+    body = msd.Body.from_arrays(np.zeros((1000, 3)), masses=masses)
+    got = msd.Dynamics(body, kernel=kernel).springs.damping_work(masses, v, v_new, 0.99)
+    assert got == pytest.approx(expected, rel=1e-12)
 
 
 @pytest.mark.parametrize("order", ["C", "F"])
@@ -45,3 +49,22 @@ def test_finite_sees_a_bad_coordinate_anywhere(count: int, where: str) -> None:
 def test_finite_refuses_arrays_of_different_sizes() -> None:
     with pytest.raises(ValueError, match="same shape"):
         reductions.finite(np.zeros((4, 3)), np.zeros((5, 3)))
+
+
+@pytest.mark.parametrize(
+    "count", [3 * reductions.BLOCK + 17, reductions.PARALLEL_MIN_PARTICLES + 5]
+)
+def test_damping_work_sums_its_blocks_in_order(count: int) -> None:
+    """One thread or several (past `PARALLEL_MIN_PARTICLES`): the blocks in the same order."""
+    rng = np.random.default_rng(count)
+    masses, v, v_new = (
+        rng.random(count) + 0.5,
+        rng.normal(size=(count, 3)),
+        rng.normal(size=(count, 3)),
+    )
+    total = 0.0
+    for block in range(-(-count // reductions.BLOCK)):
+        total += reductions._kick_dots(masses, v, v_new, block)
+    got = reductions.damping_work(masses, v, v_new, 0.97)
+    assert got == (1.0 - 0.97) * (0.5 * total)
+    assert got == pytest.approx(msd.energy.damping_work(masses, v, v_new, 0.97), rel=1e-12)
