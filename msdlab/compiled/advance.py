@@ -54,10 +54,11 @@ def compile_advance(update: Callable, threads: bool) -> Callable | None:
     if not isinstance(update, types.FunctionType):
         return None
     scalar = register_jitable(_copy(update))
+    rows = numba.prange if threads else range  # in the cache's key: one loop of each kind
 
     @numba.njit(parallel=threads, cache=cached(update))
     def advance(x, v, forces, partial, field, masses, fixed, dt, coefficients, x_new, v_new):
-        for i in numba.prange(len(masses)):
+        for i in rows(len(masses)):
             for q in range(x.shape[1]):
                 a = particle_acceleration(i, q, forces, partial, field, masses, fixed)
                 x_new[i, q], v_new[i, q] = scalar(x[i, q], v[i, q], a, dt, *coefficients)

@@ -52,3 +52,37 @@ def test_a_users_update_is_compiled_in_its_process_only():
 
     assert not advance.cached(user_update)
     assert advance.cached(msd.Verlet.update)
+
+
+# A process compiles Verlet's update loop, threaded or not, on a small state, and reports
+# whether numba loaded it from its disk cache.
+COMPILE_ONE = """
+import json, sys
+import numpy as np
+import msdlab as msd
+from msdlab.compiled.advance import compile_advance
+loop = compile_advance(msd.Verlet.update, threads=sys.argv[1] == "threads")
+x = np.zeros((4, 3))
+loop(x, x, x, np.zeros((0, 4, 3)), np.zeros(3), np.ones(4), np.zeros(4, bool), 1e-3, (0.01,),
+     np.empty_like(x), np.empty_like(x))
+print(json.dumps(sum(loop.stats.cache_hits.values())))
+"""
+
+
+def test_the_threaded_and_the_one_thread_loop_are_cached_apart(tmp_path, kernel):
+    """A one-thread loop is never the threaded loop loaded from the cache (that one costs a
+    wake-up of the threads on every call, 20 µs on a small body)."""
+    if kernel != "numba":
+        pytest.skip("the numba kernel's loops")
+    environment = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    hits = []
+    for kind in ("threads", "one thread", "one thread"):
+        done = subprocess.run(
+            [sys.executable, "-c", COMPILE_ONE, kind],
+            env=environment,
+            capture_output=True,
+            text=True,
+        )
+        assert done.returncode == 0, done.stderr
+        hits.append(json.loads(done.stdout.splitlines()[-1]))
+    assert hits == [0, 0, 1]
