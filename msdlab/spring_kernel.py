@@ -73,7 +73,7 @@ class SpringKernel(Protocol):
         """``update(x, v, a, dt, *coefficients)`` with a = (F + m·g)/m, 0 for fixed particles.
 
         F is the spring forces plus ``forces`` (N, d) in N, the other forces, if given;
-        g = ``field`` (d,) in m/s². The numpy backend does it in three lines on arrays;
+        g = ``field`` (d,) in m/s². The numpy backend does it in a few lines on arrays;
         the numba backend runs the springs' pass, a and the update in compiled loops.
         """
 
