@@ -34,8 +34,10 @@ class Spring(Bound):
         f_a = k (l - |x_a - x_b|) n  -  c ((v_a - v_b) · n) n,     f_b = -f_a
 
     ``rest_length=None`` takes the distance between the particles when the spring
-    is added to a body. `Spring.force` and the spring kernels (`msdlab.kernels`,
-    `msdlab.compiled`) all apply `equations.spring_force`.
+    is added to a body. `Spring.force` and the numpy kernel (`msdlab.kernels`) apply
+    `equations.spring_force`; the compiled loops (`msdlab.compiled`) its size along n,
+    `equations.spring_tension`, times d/|d|. In a body, the object reads and writes
+    spring ``index`` of the body's spring set (`Body.set_springs`).
     """
 
     a = Field("a", "Index of the first particle.", kind=int)

@@ -20,6 +20,7 @@ import numba
 import numpy as np
 
 from .equations import dashpot_power, spring_tension
+from .stencil import Layout, Scratch, Triples
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -64,7 +65,7 @@ def _push_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, spring
     is read and its force written once for three springs. ``columns[masks[j], p - first]``
     is 1 where p has neighbour j, 0 where it would leave p's grid row.
     ``springs`` holds the springs' stiffness, rest length, dashpot and 1/rest²
-    (3,) each; ``squared[p]`` keeps the largest |d|²/l² seen (a running maximum
+    (three numbers each); ``squared[p]`` keeps the largest |d|²/l² seen (a running maximum
     would keep the loop scalar). Returns the dashpot power (W) of these
     springs; with dashpots the loop stays scalar. Indices are unsigned: numba
     then needs no negative-index test, which would also keep the loop scalar.
@@ -73,11 +74,7 @@ def _push_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, spring
     f0, f1, f2 = fs
     ma, mb, mc = masks  # rows of `columns`
     sa, sb, sc = shifts
-    stiffness, rest, damping, inverse_rest_squared = springs
-    ka, kb, kc = stiffness[0], stiffness[1], stiffness[2]
-    ra, rb, rc = rest[0], rest[1], rest[2]
-    ca, cb, cc = damping[0], damping[1], damping[2]
-    wa, wb, wc = inverse_rest_squared[0], inverse_rest_squared[1], inverse_rest_squared[2]
+    (ka, kb, kc), (ra, rb, rc), (ca, cb, cc), (wa, wb, wc) = springs
     kept_a, kept_b, kept_c = scales[0], scales[1], scales[2]
     power = 0.0
     if ca == 0.0 and cb == 0.0 and cc == 0.0:  # no sum across springs: vector registers
@@ -198,36 +195,39 @@ def _push_rows(memory, layout, triples, plane, rows, scales):
     loops run over all of them at once, with the column masks for the particles
     whose neighbour would be past the end of their row.
     """
-    xs, vs, fs, pad = memory.positions, memory.velocities, memory.forces, memory.pad
+    positions, velocities, forces, squared, pad = memory
+    xs = (positions[0], positions[1], positions[2])  # rows, contiguous: vector registers
+    vs = (velocities[0], velocities[1], velocities[2])
+    fs = (forces[0], forces[1], forces[2])
     columns = layout.columns
     n0, n1, n2 = layout.shape[0], layout.shape[1], layout.shape[2]
+    ahead, along, masks, stiffness, rest, damping, inverse = triples  # once: not per triple
     power = 0.0
-    for t in range(len(triples.ahead)):
-        o0, o1 = triples.ahead[t, 0], triples.ahead[t, 1]
+    for t in range(len(ahead)):
+        o0, o1 = ahead[t, 0], ahead[t, 1]
         lo, hi = max(rows[0], -o1), min(rows[1], n1 - o1)  # rows whose neighbours exist
         if not (0 <= plane + o0 < n0 and lo < hi):
             continue
         shift = (o0 * n1 + o1) * n2
         first, stop = (plane * n1 + lo) * n2 + pad, (plane * n1 + hi) * n2 + pad
-        along, masks = triples.along[t], triples.masks[t]
-        shifts = (shift + along[0], shift + along[1], shift + along[2])
-        springs = (
-            triples.stiffness[t],
-            triples.rest_lengths[t],
-            triples.damping[t],
-            triples.inverse_rest_squared[t],
-        )
-        if masks[1] == len(columns) - 1:  # one spring (in the first place, see `Triples`)
-            one = (springs[0][0], springs[1][0], springs[2][0], springs[3][0])
+        shifts = (shift + along[t, 0], shift + along[t, 1], shift + along[t, 2])
+        if masks[t, 1] == len(columns) - 1:  # one spring (in the first place, see `Triples`)
+            one = (stiffness[t, 0], rest[t, 0], damping[t, 0], inverse[t, 0])
+            column = columns[masks[t, 0]]
             power += _push_one(
-                xs, vs, fs, memory.squared, columns[masks[0]], first, stop, shifts[0], one,
-                scales[0], pad,
-            )  # fmt: skip
+                xs, vs, fs, squared, column, first, stop, shifts[0], one, scales[0], pad
+            )
             _react_one(xs, fs, scales[0], first, stop, shifts[0], pad)
             continue
-        masks3 = (masks[0], masks[1], masks[2])
+        three = (masks[t, 0], masks[t, 1], masks[t, 2])
+        springs = (
+            (stiffness[t, 0], stiffness[t, 1], stiffness[t, 2]),
+            (rest[t, 0], rest[t, 1], rest[t, 2]),
+            (damping[t, 0], damping[t, 1], damping[t, 2]),
+            (inverse[t, 0], inverse[t, 1], inverse[t, 2]),
+        )  # numbers, not views: each view of an array costs a reference count
         power += _push_three(
-            xs, vs, fs, memory.squared, columns, masks3, first, stop, shifts, springs, scales, pad
+            xs, vs, fs, squared, columns, three, first, stop, shifts, springs, scales, pad
         )
         _react(xs, fs, scales, first, stop, shifts, pad)
     return power
@@ -269,18 +269,24 @@ def _compile(parallel: bool) -> Callable:
     loop = numba.prange if parallel else range
 
     @numba.njit(cache=True, parallel=parallel, error_model="numpy")
-    def gather(x, v, layout, triples, memory, out, add):
+    def gather(x, v, out, add, *lattice):
         """Add to ``out`` (N, d) the forces of a lattice's springs, each computed once, from
         the particle behind (`_push_unit`); return the largest stretch |d|/l and the
-        dashpot power (W), summed over the units in order. ``layout``, ``triples`` and
-        ``memory`` are the lattice's `stencil.Layout`, `stencil.Triples` and
-        `stencil.Scratch`; without ``add`` the forces stay in ``memory.forces`` for the
-        caller to add in a loop of its own (see `advance`).
+        dashpot power (W), summed over the units in order. ``lattice`` is the fields of
+        its `stencil.Layout`, `stencil.Triples` and `stencil.Scratch`, in that order
+        (plain arrays and numbers: a call then costs no typing of named tuples); without
+        ``add`` the forces stay in the scratch's forces for the caller to add in a loop of
+        its own (see `advance`).
 
         The threads push every third unit at once, in three rounds, so no two write the
         same particle.
         """
-        positions, velocities, forces, squared, pad = memory  # arrays, not the tuple, in loops
+        layout, triples, memory = (
+            Layout(*lattice[:3]),
+            Triples(*lattice[3:10]),
+            Scratch(*lattice[10:]),
+        )
+        positions, velocities, forces, squared, pad = lattice[10:]  # arrays, in loops
         damped = np.any(triples.damping != 0.0)
         for p in loop(len(x)):
             for q in range(x.shape[1]):

@@ -114,7 +114,7 @@ class NumbaKernel:
             threads = big and numba.get_num_threads() > 1  # asked only when it matters
             gather = gather_parallel if threads else gather_serial
             memory = kept.memory
-            stretch, power = gather(x, v, kept.layout, kept.triples, memory, out, reduce)
+            stretch, power = gather(x, v, out, reduce, *kept.arguments)
             if reduce:
                 return stretch, power, (out, none)
             by_coordinate = memory.forces[: x.shape[1], memory.pad : memory.pad + len(x)]

@@ -121,21 +121,23 @@ def scratch(lattice: LatticeSprings, n_particles: int) -> Scratch:
 
 class Plan(NamedTuple):
     """What the gather of ``lattice`` at ``version`` (`Body.version`) on ``particles``
-    particles reads: its `Layout`, `Triples` and `Scratch`, and its number of ``springs``."""
+    particles reads: its `Layout`, `Triples` and `Scratch` (``memory``), their fields in
+    one tuple (``arguments``, the gather's), and the number of ``springs``."""
 
     lattice: LatticeSprings | None
     version: int
     particles: int
-    layout: Layout
-    triples: Triples
-    memory: Scratch
+    memory: Scratch | None
+    arguments: tuple
     springs: int
 
 
-NO_PLAN = Plan(None, -1, -1, *(None,) * 3, 0)  # type: ignore[arg-type]
+NO_PLAN = Plan(None, -1, -1, None, (), 0)
 
 
 def plan(lattice: LatticeSprings, version: int, n_particles: int) -> Plan:
     """The gather's `Plan` for ``lattice``, edited ``version`` times, on ``n_particles``."""
+    grid, triples = layout(lattice)
     memory = scratch(lattice, n_particles)
-    return Plan(lattice, version, n_particles, *layout(lattice), memory, lattice.count)
+    arguments = (*grid, *triples, *memory)
+    return Plan(lattice, version, n_particles, memory, arguments, lattice.count)
