@@ -7,7 +7,10 @@ checks (hidden ones included). Machine time is the processor time (user and syst
 ``msdlab grade`` and of every process below it (the judges, their forkserver, the
 sandboxes), read from ``/proc`` ten times a second, each process's last reading kept: it
 counts only this run's work, whatever else the machine runs (a process's last tenth of a
-second can be missed). Wall time is shown too, with the load average before and after.
+second can be missed), in all and by part: the grader (``msdlab grade`` itself: intake,
+gradebook, views), the judges (the checks, pytest, the engine's side of the calls), the
+sandboxes (the submissions' code and its side of the calls). Wall time is shown too,
+with the load average before and after.
 
     python benchmarks/class_grading.py                      # 100 students, 2 at a time
     python benchmarks/class_grading.py --count 6 --endless 1 --task-timeout 10
@@ -45,16 +48,42 @@ def make_class(root: Path, count: int, endless: int) -> list[str]:
     return folders
 
 
-def machine_time(process: subprocess.Popen) -> float:
-    """Processor seconds of ``process`` and everything below it, until it ends."""
+def machine_time(process: subprocess.Popen) -> dict[str, float]:
+    """Processor seconds of ``process`` and everything below it, until it ends, by the part
+    of grading each process does (`part_of`)."""
     seen: dict[tuple[int, str], float] = {}
+    parts: dict[tuple[int, str], str] = {}
     while process.poll() is None:
         for pid in processes.descendants(process.pid):
             start = _start_time(pid)
-            if start is not None:
-                seen[(pid, start)] = max(seen.get((pid, start), 0.0), processes.cpu_of([pid]))
+            if start is None:
+                continue
+            if (pid, start) not in parts:
+                parts[(pid, start)] = "grader" if pid == process.pid else part_of(pid)
+            seen[(pid, start)] = max(seen.get((pid, start), 0.0), processes.cpu_of([pid]))
         time.sleep(POLL_SECONDS)
-    return sum(seen.values())
+    spent = dict.fromkeys(PARTS, 0.0)
+    for key, seconds in seen.items():
+        spent[parts[key]] += seconds
+    return spent
+
+
+PARTS = ("grader", "judges", "sandboxes", "other")
+
+
+def part_of(pid: int) -> str:
+    """Which part of grading process ``pid`` is, from its command line: a sandbox (bubblewrap
+    and the submission's process), a judge (forked from the forkserver, or started afresh
+    as pytest), or other (the forkserver's resource tracker)."""
+    try:
+        command = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode()
+    except OSError:
+        return "other"
+    if "sandbox_child" in command or command.startswith("bwrap"):
+        return "sandboxes"
+    if "forkserver" in command or "pytest" in command:
+        return "judges"
+    return "other"
 
 
 def _start_time(pid: int) -> str | None:
@@ -77,7 +106,8 @@ def run(count: int, endless: int, jobs: int, task_timeout: float) -> None:
         load = os.getloadavg()[0]
         started = time.perf_counter()
         process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-        seconds = machine_time(process)
+        spent = machine_time(process)
+        seconds = sum(spent.values())
         wall = time.perf_counter() - started
         errors = process.stderr.read().decode(errors="replace")
         rows = list(csv.DictReader(out.open(encoding="utf-8")))
@@ -88,6 +118,8 @@ def run(count: int, endless: int, jobs: int, task_timeout: float) -> None:
         print(f"{count} correct + {endless} endless students, --jobs {jobs}, "
               f"--task-timeout {task_timeout:g}: exit {process.returncode}")  # fmt: skip
         print(f"machine time {seconds:7.1f} s, {seconds / (count + endless):5.2f} s a student")
+        for part, used in spent.items():
+            print(f"  {part:<10} {used:7.1f} s, {used / (count + endless):5.2f} s a student")
         print(f"wall time    {wall:7.1f} s, {wall / (count + endless):5.2f} s a student")
         print(f"load average {load:.1f} before, {os.getloadavg()[0]:.1f} after, "
               f"{os.cpu_count()} processors")  # fmt: skip
