@@ -420,3 +420,25 @@ def test_a_message_cannot_close_the_instructors_code_block():
     _, inside, after = saw.split("\n`````\n")  # one fence longer than the message's ````
     assert "![seen]" in inside and "```` and ` too" in inside and not after.strip()
     assert "Handed in: `` hand-ins/`odd` ``" in text
+
+
+def test_a_run_renders_its_views_once_at_its_end_over_the_whole_class(tmp_path, monkeypatch):
+    """Not after every commit: that grows with the square of the class."""
+    checks = tmp_path / "checks"
+    checks.mkdir()
+    (checks / "test_nothing.py").write_text("def test_nothing():\n    pass\n")
+    class_ = [folder_of_tasks(tmp_path / "class" / name, 1) for name in ("ann", "ben", "cy")]
+    renderings = []
+    rendering = render.render
+
+    def counted(connection, out, *arguments, **options):
+        renderings.append(len(gradebook_db.read_records(connection)))
+        return rendering(connection, out, *arguments, **options)
+
+    monkeypatch.setattr(render, "render", counted)
+    out = tmp_path / "grades.csv"
+    arguments = [*map(str, class_), "--out", str(out), "--checks", str(checks), "--jobs", "2"]
+    assert main(["grade", *arguments, "--isolation", "process"]) == 0
+    assert renderings == [3]
+    rows = {row["id"] for row in csv.DictReader(out.open(encoding="utf-8"))}
+    assert rows == {"(max points)", "ann", "ben", "cy"}
