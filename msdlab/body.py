@@ -34,7 +34,7 @@ class Body:
         self.spring_set: EdgeSprings | LatticeSprings = EdgeSprings.empty()
         self.positions, self.velocities = np.zeros((0, dim or 3)), np.zeros((0, dim or 3))
         self.masses, self.fixed = np.zeros(0), np.zeros(0, bool)
-        self._incidence: tuple[int, np.ndarray, np.ndarray] = (-1, *np.zeros((2, 0), int))
+        self._incidence: tuple[int, ...] = (-1,)  # version, `springs.incidence`
 
     def __setattr__(self, name: str, value: object) -> None:
         """``body.positions = ...`` (or velocities, masses, fixed): checked, then written
@@ -216,9 +216,18 @@ class Body:
 
     def springs_touching(self, particles: np.ndarray) -> np.ndarray:
         """Indices of the springs with an end in ``particles`` (sorted, unique)."""
-        if self._incidence[0] != self.version:  # the CSR lists of `springs.incidence`
+        return touching(*self._lists()[:2], particles)
+
+    def neighbours(self, particles: np.ndarray) -> np.ndarray:
+        """Indices of the particles a spring joins to ``particles``, not among them."""
+        start, _, partners = self._lists()
+        return np.setdiff1d(touching(start, partners, particles), particles)
+
+    def _lists(self) -> tuple[np.ndarray, ...]:
+        """The CSR lists of `springs.incidence`, made again after an edit."""
+        if self._incidence[0] != self.version:
             self._incidence = (self.version, *incidence(self.edges(), self.n_particles))
-        return touching(*self._incidence[1:], particles)
+        return self._incidence[1:]
 
     def __repr__(self) -> str:
         kind = f"{self.dim}-D" if self.dim else "empty"

@@ -96,23 +96,25 @@ def edge_springs(
     return EdgeSprings(a, b, *(np.broadcast_to(value, len(a)).copy() for value in values))
 
 
-def incidence(edges: EdgeSprings, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """CSR lists of the springs touching each of ``n`` particles, (start, springs): particle
-    i's are ``springs[start[i]:start[i+1]]``."""
-    ends = np.concatenate([edges.a, edges.b])
+def incidence(edges: EdgeSprings, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """CSR lists of the springs touching each of ``n`` particles and of the particles at
+    their other ends, (start, springs, partners): particle i's are
+    ``springs[start[i]:start[i+1]]`` and ``partners[start[i]:start[i+1]]``."""
+    ends, others = np.concatenate([edges.a, edges.b]), np.concatenate([edges.b, edges.a])
     start = np.zeros(n + 1, dtype=np.int64)
     np.cumsum(np.bincount(ends, minlength=n), out=start[1:])
-    return start, np.argsort(ends, kind="stable") % max(edges.count, 1)
+    order = np.argsort(ends, kind="stable")
+    return start, order % max(edges.count, 1), others[order]
 
 
-def touching(start: np.ndarray, springs: np.ndarray, particles: np.ndarray) -> np.ndarray:
-    """Indices of the springs with an end in ``particles`` (sorted, unique), from the CSR
-    lists of `incidence`."""
+def touching(start: np.ndarray, listed: np.ndarray, particles: np.ndarray) -> np.ndarray:
+    """The entries (sorted, unique) of ``particles``' CSR lists ``listed`` (the springs or the
+    partners of `incidence`)."""
     if len(particles) == 1:  # one slice (a wall's bounce asks for one particle at a time)
-        return np.unique(springs[start[particles[0]] : start[particles[0] + 1]])
+        return np.unique(listed[start[particles[0]] : start[particles[0] + 1]])
     counts = start[particles + 1] - start[particles]
     first = np.repeat(start[particles] - (np.cumsum(counts) - counts), counts)
-    return np.unique(springs[first + np.arange(counts.sum())])
+    return np.unique(listed[first + np.arange(counts.sum())])
 
 
 def read_only(*arrays: np.ndarray) -> None:

@@ -31,10 +31,7 @@ def lead(state: StepState, particles: np.ndarray, target: np.ndarray) -> float:
     neighbours at the step's end it falls short by a term of first order, 6 % of a hand's
     work on the gallery's mesh).
     """
-    body = state.body
-    touching = body.springs_touching(particles)
-    edges = body.edges()
-    ends = np.setdiff1d(np.union1d(edges.a[touching], edges.b[touching]), particles)
+    ends = state.body.neighbours(particles)
     now = state.x[ends]
     state.x[ends] = 0.5 * (state.x_old[ends] + now)
     state.v[particles] = state.v_old[particles]

@@ -55,16 +55,16 @@ def strain_scale(body, frames: np.ndarray, floor: float = 0.05) -> float:
     |strain| over ten sampled frames, at least ``floor`` so a body at rest stays pale."""
     if not body.n_springs:
         return floor
-    sample = frames[:: max(1, len(frames) // 10)]
-    return max(floor, float(max(np.percentile(np.abs(strains(body, f)), 99) for f in sample)))
+    sample, edges = frames[:: max(1, len(frames) // 10)], body.edges()
+    return max(floor, float(max(np.percentile(np.abs(strains(edges, f)), 99) for f in sample)))
 
 
 def sag_scale(body, frames: np.ndarray, up: str) -> float:
     """The sag drawn at full colour for ``frames`` (F, N, 3): 15 % of the body's size, or the
     deepest sag below the rim of the first frame if deeper, so runs of one scene share a scale."""
-    rim = rim_height(body, frames[0], up)
+    rim, edges = rim_height(body, frames[0], up), body.edges()
     size = float(np.max(np.ptp(frames[0], axis=0)))
-    return max(0.15 * size, float(max(sags(body, f, up, rim).max(initial=0) for f in frames)))
+    return max(0.15 * size, float(max(sags(edges, f, up, rim).max(initial=0) for f in frames)))
 
 
 @dataclass

@@ -24,6 +24,7 @@ from mpl_toolkits.mplot3d import proj3d
 from ..body import Body
 from ..interaction import SphereContact
 from ..simulation import Simulation
+from ..springs import EdgeSprings
 from .lines import SpringLines, SpringLines3D
 from .upright import UPS, resolve_up
 
@@ -34,17 +35,17 @@ _U, _V = np.meshgrid(np.linspace(0, 2 * np.pi, 13), np.linspace(0, np.pi, 7))
 _UNIT_SPHERE = np.stack([np.cos(_U) * np.sin(_V), np.sin(_U) * np.sin(_V), np.cos(_V)])
 
 
-def strains(body: Body, positions: np.ndarray) -> np.ndarray:
-    """Strain of each spring, |x_a - x_b| / rest length - 1 (> 0 stretched, < 0 squeezed)."""
-    edges = body.edges()
+def strains(edges: EdgeSprings, positions: np.ndarray) -> np.ndarray:
+    """Strain of each spring of ``edges`` (`Body.edges`) at ``positions`` (N, d):
+    |x_a - x_b| / rest length - 1 (> 0 stretched, < 0 squeezed)."""
     d = positions[edges.a] - positions[edges.b]
     return np.sqrt(np.einsum("ij,ij->i", d, d)) / edges.rest_lengths - 1.0
 
 
-def sags(body: Body, positions: np.ndarray, up: str, rim: float) -> np.ndarray:
-    """Depth of each spring's middle below the height ``rim`` along the ``up`` axis (> 0 below)."""
+def sags(edges: EdgeSprings, positions: np.ndarray, up: str, rim: float) -> np.ndarray:
+    """Depth of each spring's middle (``edges``, `Body.edges`) below the height ``rim`` along
+    the ``up`` axis (> 0 below)."""
     axis = UPS.index(up)
-    edges = body.edges()
     middles = 0.5 * (positions[edges.a, axis] + positions[edges.b, axis])
     return rim - middles
 
@@ -107,7 +108,7 @@ class BodyView:
         if up not in UPS:
             raise ValueError(f"unknown vertical axis {up!r}; choose one of {', '.join(UPS)}")
         check_colour(colour, body)
-        self.ax, self.body = ax, body
+        self.ax, self.body, self.edges = ax, body, body.edges()  # a lattice laid out once
         self.is_3d = body.dim == 3
         if self.is_3d != hasattr(ax, "get_proj"):
             kind = "3-D" if self.is_3d else "2-D"
@@ -156,8 +157,8 @@ class BodyView:
     def values(self, positions: np.ndarray) -> np.ndarray:
         """What the springs' colour shows at ``positions``: strain or sag."""
         if self.colour == "sag":
-            return sags(self.body, positions, self.up, self.rim)
-        return strains(self.body, positions)
+            return sags(self.edges, positions, self.up, self.rim)
+        return strains(self.edges, positions)
 
     def update(self, positions: np.ndarray) -> list:
         """Redraw for ``positions`` (N, d); return the changed artists (not the dots of
@@ -215,8 +216,7 @@ class BodyView:
                 axis.set_major_locator(MaxNLocator(2))
 
     def _segments(self, positions: np.ndarray) -> np.ndarray:
-        edges = self.body.edges()
-        return np.stack([positions[edges.a], positions[edges.b]], axis=1)
+        return np.stack([positions[self.edges.a], positions[self.edges.b]], axis=1)
 
     def _ball(self, centre: np.ndarray, radius: float) -> Artist:
         if not self.is_3d:

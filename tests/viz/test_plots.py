@@ -23,7 +23,7 @@ def close_figures():
 def test_strain_is_relative_stretch():
     body = msd.Body.from_arrays([[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]], [[0, 1], [0, 2]])
     body.set_springs(rest_lengths=[1.0, 2.0])
-    np.testing.assert_allclose(viz.strains(body, body.positions), [1.0, -0.5])
+    np.testing.assert_allclose(viz.strains(body.edges(), body.positions), [1.0, -0.5])
 
 
 def test_2d_body_springs_carry_their_strains(tmp_path):
@@ -64,7 +64,9 @@ def test_body_view_follows_new_positions():
     drawing.update(sim.body.positions)
     *_, z = drawing.free.get_data_3d()
     np.testing.assert_allclose(z, sim.body.positions[~sim.body.fixed, 2])
-    np.testing.assert_allclose(drawing.springs.values, viz.strains(sim.body, sim.body.positions))
+    np.testing.assert_allclose(
+        drawing.springs.values, viz.strains(sim.body.edges(), sim.body.positions)
+    )
 
 
 def test_wrong_axes_or_vertical_axis_are_refused():
