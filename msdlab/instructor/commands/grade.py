@@ -55,7 +55,8 @@ from .. import intake
 from ..intake import copied_numbers
 from ..judging import grading, sandbox
 from ..judging.cluster_grading import grade_all_on_cluster
-from ..outputs import class_report, feedback, render
+from ..judging.temporary_paths import scrub
+from ..outputs import class_report, render
 from ..points import gradebook, gradebook_db
 from ..rules import adjustments, final_points, problems, term_options
 from . import similarity
@@ -391,7 +392,7 @@ class Session:
         when = handed.time.isoformat(timespec="seconds") if handed and handed.time else None
         result = gradebook_db.Result(
             grade.submission, intake.escaped(str(entry.source)), status,
-            [feedback.scrub(note) for note in grade.notes], grade.report,
+            [scrub(note) for note in grade.notes], grade.report,
             self.prints.get(grade.submission), when, handed.source if handed else None,
             raw.seconds if raw else None, raw.attempts if raw else 1, hint,
         )  # fmt: skip
@@ -479,7 +480,7 @@ def grader_failure(failed: list[grading.Grade]) -> str:
     return (
         f"msdlab grade: could not grade {len(failed)} submission{plural} ({names}), the "
         f"grader's failure and no fault of their authors, who got no feedback file: "
-        f"{feedback.scrub(note)}. Run the same command with --resume to grade only those."
+        f"{scrub(note)}. Run the same command with --resume to grade only those."
     )
 
 

@@ -20,25 +20,12 @@ from typing import TYPE_CHECKING
 from ...course import TASKS
 from ...course.report import CheckResult, without_mistake
 from ..judging.grading import Grade
+from ..judging.temporary_paths import scrub
 from ..points.gradebook_db import ABSENT, GRADER_FAILED
 
-if TYPE_CHECKING:  # the gradebook uses `scrub`
+if TYPE_CHECKING:
     from ..points.gradebook import Gradebook
     from ..points.gradebook_db import Record
-
-_TEMPORARY = re.compile(
-    r"[^\s'\"()]*msdlab-(?:grade|intake|sandbox|check)-[^/\s'\"()]*((?:/[^/\s'\"():,;]+)*)"
-)
-
-
-def scrub(text: str) -> str:
-    """``text`` without the grader's temporary paths: a file there is named by its name."""
-
-    def name(match: re.Match) -> str:
-        rest = match.group(1).rstrip(".")
-        return rest.rsplit("/", 1)[-1] if rest and rest != "/submission" else "the submission"
-
-    return _TEMPORARY.sub(name, text)
 
 
 def for_student(grade: Grade) -> str:

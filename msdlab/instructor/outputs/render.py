@@ -22,6 +22,7 @@ from ...course import TASKS
 from ...course.report import CheckReport
 from .. import intake
 from ..judging.grading import Grade
+from ..judging.temporary_paths import scrub
 from ..points import gradebook_db
 from ..points.gradebook import Gradebook, check_column
 from ..points.gradebook_db import GRADED, GRADER_FAILED, Record
@@ -73,7 +74,7 @@ def row_of(record: Record) -> dict[str, str]:
     row["points"] = ""  # from the task points, settled again
     row["handed_in"] = record.handed_in or ""
     row["handed_in_from"] = record.handed_in_from or ""
-    row["notes"] = feedback.scrub("; ".join(record.notes))
+    row["notes"] = scrub("; ".join(record.notes))
     row["fingerprint"] = (record.fingerprint or "") if record.status == GRADED else ""
     for check in record.checks:
         row[check_column(check.task, check.name)] = str(check.earned)

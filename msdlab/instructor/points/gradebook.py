@@ -22,8 +22,8 @@ from ...course import TASKS
 from ...course.report import CheckReport
 from ..intake import MAX_POINTS_ID, Entry, escaped
 from ..judging.grading import Grade
+from ..judging.temporary_paths import scrub
 from ..outputs.csv_files import read_csv, write_csv
-from ..outputs.feedback import scrub
 from ..rules.final_points import COLUMNS as FINAL_COLUMNS
 
 FIRST = ["id", "source", *(f"task{t}" for t in TASKS), *FINAL_COLUMNS, "total"]
