@@ -38,7 +38,10 @@ class Body:
 
     def __setattr__(self, name: str, value: object) -> None:
         """``body.positions = ...`` (or velocities, masses, fixed): checked, then written
-        into the body's array in place; other attributes are set as usual."""
+        into the body's array in place; a new ``spring_set`` adds one to ``version``; other
+        attributes are set as usual."""
+        if name == "spring_set" and name in vars(self):
+            vars(self)["version"] += 1
         if name not in STATE or name not in vars(self):
             return super().__setattr__(name, value)
         if name in ("positions", "velocities"):
@@ -134,7 +137,7 @@ class Body:
         """Make the springs an edge list, to edit single springs or add some; return it."""
         edges = self.spring_set.edges()
         if edges is not self.spring_set:
-            self.spring_set, self.version = edges, self.version + 1
+            self.spring_set = edges
         return edges
 
     def new_state(self) -> tuple[np.ndarray, np.ndarray]:

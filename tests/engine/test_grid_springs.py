@@ -182,3 +182,20 @@ def test_a_grid_without_springs_takes_an_edge_list() -> None:
     body.add_springs([[0, 1], [1, 2]], stiffness=2.0)
     assert isinstance(body.spring_set, EdgeSprings) and body.n_springs == 2
     np.testing.assert_allclose(body.edges().rest_lengths, 0.5)
+
+
+@pytest.mark.parametrize("kernel", ["numpy", "numba"])
+def test_a_new_spring_set_counts_as_an_edit(kernel):
+    """Assigning ``body.spring_set`` adds one to the version, so what was kept for the old
+    springs (a kernel's edge list, the incidence lists) is made again."""
+    body = msd.Body.grid((3, 3), spacing=1.0, stiffness=10.0)
+    sim = msd.Simulation(body, msd.SymplecticEuler(), dt=1e-3, kernel=kernel)
+    sim.step()
+    assert len(body.springs_touching(np.array([4]))) == 4
+    version = body.version
+    body.spring_set = EdgeSprings.empty()
+    assert body.version == version + 1
+    assert len(body.springs_touching(np.array([4]))) == 0
+    body.positions = body.positions + 0.1 * np.eye(2)[np.arange(9) % 2]  # stretched, no springs
+    sim.step()
+    np.testing.assert_array_equal(body.velocities, 0.0)
