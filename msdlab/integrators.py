@@ -20,14 +20,17 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from functools import cache
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
 from threadpoolctl import ThreadpoolController
 
 from .dynamics import Dynamics
-from .energy import damping_work
-from .equations import kinetic_energy
+from .equations import damping_work, kinetic_energy
+
+if TYPE_CHECKING:
+    from .spring_kernel import SpringKernel
 
 State = tuple[np.ndarray, np.ndarray]
 
@@ -48,18 +51,29 @@ class Integrator(ABC):
         return 1.0
 
     def dissipated_energy(
-        self, v: np.ndarray, masses: np.ndarray, v_new: np.ndarray | None = None
+        self,
+        v: np.ndarray,
+        masses: np.ndarray,
+        v_new: np.ndarray | None = None,
+        *,
+        kernel: SpringKernel | None = None,
     ) -> float:
         """Energy (J) the scheme removes on purpose in the step from velocities ``v`` to
-        ``v_new``: the work of the kick (factor - 1)·v of `velocity_factor`
-        (`energy.damping_work`), or (1 - factor²)·½ Σ m v² when ``v_new`` is not given;
-        0 for a factor of 1."""
+        ``v_new``, which the energy ledger books every step.
+
+        Here: the work of the kick (factor - 1)·v of `velocity_factor`, summed by the
+        ``kernel`` that steps the body (`SpringKernel.damping_work`; the simulation passes
+        its own, None is `equations.damping_work`), or (1 - factor²)·½ Σ m v² when ``v_new``
+        is not given; 0 for a factor of 1. A scheme that takes energy out another way
+        overrides this method, keeping its parameters (it may ignore ``kernel``).
+        """
         factor = self.velocity_factor
         if factor == 1.0:
             return 0.0
         if v_new is None:
             return float((1.0 - factor**2) * kinetic_energy(masses, v))
-        return damping_work(masses, v, v_new, factor)
+        work = damping_work if kernel is None else kernel.damping_work
+        return work(masses, v, v_new, factor)
 
     def velocity_at_positions(self, v: np.ndarray, a: np.ndarray, dt: float) -> np.ndarray:
         """The velocity at the time of the positions, for energy measurements; ``v`` here.

@@ -186,28 +186,17 @@ class Simulation:
         """Add to `dissipated` the energy (J) each mechanism took out in the step from the
         body's state, velocities ``v``, to velocities ``v_new``: the dashpots and the
         dissipative forces at the power of the step's pass there (`Dynamics.opening`), the
-        integrator's damping (`_integrator_damping`), and the constraints
-        (``removed``: (ledger name, energy) of each)."""
+        integrator's damping (`Integrator.dissipated_energy`, summed by the backend), and
+        the constraints (``removed``: (ledger name, energy) of each)."""
         dynamics, dt = self.dynamics, self._dt
         powers = dynamics.opening or dynamics.powers_now()  # the integrator's pass, if it took one
         for name, power in powers.items():
             self.dissipated[name] += power * dt
-        self.dissipated["integrator"] += self._integrator_damping(v, v_new)
+        self.dissipated["integrator"] += self.integrator.dissipated_energy(
+            v, self.body.masses, v_new, kernel=dynamics.springs
+        )
         for name, energy in removed:
             self.dissipated[name] += energy
-
-    def _integrator_damping(self, v: np.ndarray, v_new: np.ndarray) -> float:
-        """Energy (J) the integrator took out on purpose from velocities ``v`` to ``v_new``:
-        its own `Integrator.dissipated_energy` if it books its own, else the work of its
-        `velocity_factor`, summed by the backend (compiled: 0.5 µs on 64 particles, where
-        numpy's sum takes 5)."""
-        integrator, masses = self.integrator, self.body.masses
-        if type(integrator).dissipated_energy is not Integrator.dissipated_energy:
-            return integrator.dissipated_energy(v, masses, v_new)
-        factor = integrator.velocity_factor
-        return (
-            0.0 if factor == 1.0 else self.dynamics.springs.damping_work(masses, v, v_new, factor)
-        )
 
     def run(
         self,

@@ -28,6 +28,7 @@ import numpy as np
 from .. import equations, kernels
 from ..dynamics import Dynamics
 from ..integrators import Integrator, State
+from ..spring_kernel import SpringKernel
 
 WALL_RULES = ("hard", "periodic")
 
@@ -88,7 +89,12 @@ class FrameEuler(Integrator):
         return x_new, u + dt * equations.acceleration(springs, masses, free)
 
     def dissipated_energy(
-        self, v: np.ndarray, masses: np.ndarray, v_new: np.ndarray | None = None
+        self,
+        v: np.ndarray,
+        masses: np.ndarray,
+        v_new: np.ndarray | None = None,
+        *,
+        kernel: SpringKernel | None = None,
     ) -> float:
         """Kinetic energy the per-frame factor removes: (1 - damping²)·½ Σ m v²."""
         kinetic = 0.5 * np.sum(masses * np.einsum("ij,ij->i", v, v))

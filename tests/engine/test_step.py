@@ -218,7 +218,7 @@ def test_a_floor_with_its_own_apply_is_used() -> None:
 class OwnLedger(msd.Verlet):
     """A Verlet that books its damping its own way."""
 
-    def dissipated_energy(self, v, masses, v_new=None) -> float:
+    def dissipated_energy(self, v, masses, v_new=None, *, kernel=None) -> float:
         return 1.0
 
 
@@ -228,3 +228,28 @@ def test_an_integrator_books_its_own_damping(ledger: bool) -> None:
     sim = msd.Simulation(body, OwnLedger(0.1), forces=[msd.Gravity(GRAVITY)], ledger=ledger)
     sim.run(steps=3)
     assert sim.dissipated.get("integrator", 0.0) == (3.0 if ledger else 0.0)
+
+
+@pytest.mark.parametrize("kernel", ["numba", "numpy"])
+def test_the_integrators_damping_is_summed_by_the_simulations_backend(kernel: str) -> None:
+    """`Integrator.dissipated_energy` by default: the work of the velocity factor, summed by
+    the backend the simulation passes it, the same number as `equations.damping_work`."""
+    gravity = msd.Gravity(GRAVITY)
+    sim = msd.Simulation(falling_body(3, 4), msd.Verlet(0.1), forces=[gravity], kernel=kernel)
+    sums = []
+    work = sim.dynamics.springs.damping_work
+
+    def summing(*arguments: object) -> float:
+        sums.append(work(*arguments))
+        return sums[-1]
+
+    sim.dynamics.springs.damping_work = summing
+    sim.run(steps=3)
+    assert len(sums) == 3
+    assert sim.dissipated["integrator"] == pytest.approx(sum(sums), rel=1e-15) != 0.0
+    v, v_new = np.ones((4, 3)), np.full((4, 3), 0.5)
+    masses = np.arange(1.0, 5.0)
+    expected = msd.energy.damping_work(masses, v, v_new, 0.9)
+    for backend in (None, sim.dynamics.springs):
+        lost = msd.Verlet(0.1).dissipated_energy(v, masses, v_new, kernel=backend)
+        assert lost == pytest.approx(expected, rel=1e-14)

@@ -42,6 +42,7 @@ import numpy as np
 from ...course.delegation import DelegationRefused
 from ...course.report import WHERE
 from ...integrators import Integrator
+from ...spring_kernel import SpringKernel
 from . import processes, wire
 
 CHILD = Path(__file__).with_name("sandbox_child.py")
@@ -662,10 +663,15 @@ class RemoteIntegrator(RemoteObject, Integrator):
         return self._call_method("step", x, v, dt, dynamics)
 
     def dissipated_energy(
-        self, v: np.ndarray, masses: np.ndarray, v_new: np.ndarray | None = None
+        self,
+        v: np.ndarray,
+        masses: np.ndarray,
+        v_new: np.ndarray | None = None,
+        *,
+        kernel: SpringKernel | None = None,
     ) -> float:
         if self._engine_default("dissipated_energy"):
-            return Integrator.dissipated_energy(self, v, masses, v_new)
+            return Integrator.dissipated_energy(self, v, masses, v_new, kernel=kernel)
         return self._call_method("dissipated_energy", v, masses, v_new)
 
     @property
