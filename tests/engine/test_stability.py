@@ -54,6 +54,72 @@ def test_explicit_euler_is_stable_with_enough_damping():
     assert msd.stability_limit(msd.ExplicitEuler(), mode) == pytest.approx(2.0 / 100, rel=1e-6)
 
 
+class Frozen(msd.Integrator):
+    """A student's integrator that moves nothing: stable at every dt."""
+
+    def step(self, x, v, dt, dynamics):
+        return x.copy(), v.copy()
+
+
+class ForwardEuler(msd.Integrator):
+    """Explicit Euler as a student writes it: unstable at any dt without damping."""
+
+    def step(self, x, v, dt, dynamics):
+        return x + dt * v, v + dt * dynamics.acceleration(x, v)
+
+
+class Growing(msd.Integrator):
+    """A student's integrator that adds a thousandth every step: unstable at every dt."""
+
+    def step(self, x, v, dt, dynamics):
+        return 1.001 * x, 1.001 * v
+
+
+def fine_scan_limit(integrator: msd.Integrator, mode: msd.Mode) -> float:
+    """The stable limit from a fine scan: 40 trial dts a decade from 10⁻⁶/ω to the first
+    unstable one, bisected to a relative 10⁻¹⁰ (0 below 10⁻⁵/ω, inf above 1000/ω)."""
+    stable = 0.0
+    for dt in np.logspace(-6, 3, 361) / mode.omega:
+        if msd.stability.spectral_radius(integrator, mode, dt) > 1.0 + 1e-12:
+            break
+        stable = dt
+    else:
+        return math.inf
+    if stable < 1e-5 / mode.omega:
+        return 0.0
+    low, high = stable, dt
+    while high - low > 1e-10 * low:
+        middle = 0.5 * (low + high)
+        unstable = msd.stability.spectral_radius(integrator, mode, middle) > 1.0 + 1e-12
+        low, high = (low, middle) if unstable else (middle, high)
+    return low
+
+
+@pytest.mark.parametrize(
+    "integrator",
+    [
+        msd.SymplecticEuler(),
+        msd.Verlet(),
+        msd.Verlet(0.6),
+        msd.VelocityVerlet(),
+        msd.RK4(),
+        msd.ExplicitEuler(),
+        msd.ImplicitEuler(),
+        Frozen(),
+        ForwardEuler(),
+        Growing(),
+    ],
+    ids=lambda integrator: type(integrator).__name__,
+)
+@pytest.mark.parametrize("mode", [msd.Mode(3.0), msd.Mode(40.0, 2.0)], ids=repr)
+def test_the_search_finds_the_limit_of_a_fine_scan(integrator, mode):
+    """The scan of 4 trial dts a decade and its bisection find the limit a scan of 40 a decade
+    finds, to the relative 10⁻⁸ the search promises."""
+    fine = fine_scan_limit(integrator, mode)
+    found = msd.stability_limit(integrator, mode)
+    assert found == pytest.approx(fine, rel=1e-8) if 0 < fine < math.inf else found == fine
+
+
 def test_stiffest_mode_of_two_bodies_is_the_analytic_frequency():
     body = msd.Body.from_arrays(
         [[0.0, 0.0], [1.0, 0.0]], [[0, 1]], masses=[1.0, 2.0], stiffness=10.0
