@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from msdlab.course import oracles
+from msdlab.course.experiments import cube_ratio
 from msdlab.course.feedback import Recognised, as_array, expect, matching_variant, num, percent
 
 pytestmark = pytest.mark.task4
@@ -138,8 +139,8 @@ def cube_mistake(task4):
     if springs_mistake(task4):
         return None
     try:
-        axis_only = float(task4.drop_rotated_cube((0.0, 0.0, 1.0), 45.0, (1,)))
-        every = float(task4.drop_rotated_cube((0.0, 0.0, 1.0), 45.0, (1, 2, 3)))
+        axis_only = cube_ratio(task4, (0.0, 0.0, 1.0), 45.0, (1,))
+        every = cube_ratio(task4, (0.0, 0.0, 1.0), 45.0, (1, 2, 3))
     except Exception:  # the checks say what is wrong
         return None
     if axis_only != every:
@@ -310,7 +311,7 @@ def rest_length_cause(rest, distance, spacing):
 def test_rotated_cube_holds_its_shape(task4):
     """Tilted 45° about z, a cube with 1, √2, √3 springs stands; with axis springs only it folds."""
     axis, angle = (0.0, 0.0, 1.0), 45.0
-    held = float(task4.drop_rotated_cube(axis, angle, (1, 2, 3)))
+    held = cube_ratio(task4, axis, angle, (1, 2, 3))
     expect(
         held > 0.9,
         saw=f"with 26 neighbours, tilted {angle}° about z, the cube kept {percent(held)} of its "
@@ -318,7 +319,7 @@ def test_rotated_cube_holds_its_shape(task4):
         cause=springs_at_fault(task4)
         or "missing diagonal springs or wrong rest lengths, or a different experiment",
     )
-    folded = float(task4.drop_rotated_cube(axis, angle, (1,)))
+    folded = cube_ratio(task4, axis, angle, (1,))
     expect(
         folded < 0.3,
         saw=f"with axis springs only the tilted cube kept {percent(folded)} of its thickness; "
