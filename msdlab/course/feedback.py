@@ -18,7 +18,7 @@ check itself.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -42,11 +42,15 @@ class Recognised(str):
     usual cause of such a failure but the student's mistake, said as such."""
 
 
-def expect(condition: object, saw: str, cause: str = "") -> None:
+def expect(condition: object, saw: str, cause: str | Callable[[], str] = "") -> None:
     """Raise `CheckFailed` unless ``condition`` holds: "<saw>. Usual cause: <cause>.", or for a
-    `Recognised` cause "<saw>. Your result is exactly what this mistake gives: <cause>."."""
+    `Recognised` cause "<saw>. Your result is exactly what this mistake gives: <cause>.".
+
+    A cause that takes work to find (running the submission again) is given as a function
+    of no arguments, called only when the check fails."""
     if not bool(condition):
         message = saw.rstrip(". ") + "."
+        cause = cause() if callable(cause) else cause
         if isinstance(cause, Recognised):
             raise CheckFailed(f"{message} {MISTAKE_SENTENCE.format(cause)}", mistake=str(cause))
         if cause:

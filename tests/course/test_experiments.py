@@ -1,4 +1,4 @@
-"""A submission's experiments run once per setting."""
+"""A submission's experiments run once per setting, and a cause is looked for only on failure."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ from types import ModuleType
 import pytest
 
 from msdlab.course.experiments import cube_ratio
+from msdlab.course.feedback import CheckFailed, Recognised, expect
 
 
 def counting_task(results):
@@ -50,3 +51,21 @@ def test_a_failing_run_is_not_kept_each_check_sees_its_failure():
         cube_ratio(task, (1.0, 0.0, 0.0), 30.0, (1,))
     assert cube_ratio(task, (1.0, 0.0, 0.0), 30.0, (1,)) == 0.3
     assert len(calls) == 3
+
+
+def test_a_cause_given_as_a_function_is_looked_for_only_when_the_check_fails():
+    looked = []
+
+    def cause():
+        looked.append(True)
+        return Recognised("counting from 0")
+
+    expect(True, saw="the answer is 42", cause=cause)
+    assert not looked
+    with pytest.raises(CheckFailed) as failed:
+        expect(False, saw="the answer is 41", cause=cause)
+    assert looked == [True]
+    assert failed.value.mistake == "counting from 0"
+    assert "the answer is 41." in str(failed.value)
+    with pytest.raises(CheckFailed, match=r"Usual cause: an off-by-one\.$"):
+        expect(False, saw="the answer is 41", cause=lambda: "an off-by-one")

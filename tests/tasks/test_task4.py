@@ -316,15 +316,17 @@ def test_rotated_cube_holds_its_shape(task4):
         held > 0.9,
         saw=f"with 26 neighbours, tilted {angle}° about z, the cube kept {percent(held)} of its "
         "thickness; the diagonal springs give it the shear stiffness to stand",
-        cause=springs_at_fault(task4)
-        or "missing diagonal springs or wrong rest lengths, or a different experiment",
+        cause=lambda: (
+            springs_at_fault(task4)
+            or "missing diagonal springs or wrong rest lengths, or a different experiment"
+        ),
     )
     folded = cube_ratio(task4, axis, angle, (1,))
     expect(
         folded < 0.3,
         saw=f"with axis springs only the tilted cube kept {percent(folded)} of its thickness; "
         "it has no shear stiffness and should fold flat",
-        cause=springs_at_fault(task4) or "drop_rotated_cube ignores squared_distances",
+        cause=lambda: springs_at_fault(task4) or "drop_rotated_cube ignores squared_distances",
     )
 
 
