@@ -32,6 +32,17 @@ class Patched(Plain):
 
 class Factor(Plain):
     velocity_factor = 0.5
+
+class Spoiler(msd.Integrator):
+    def step(self, x, v, dt, dynamics):
+        first = dynamics.acceleration(x, v)
+        first[:] = 0.0  # spoils the array it was given
+        return x + dt * v, v + dt * dynamics.acceleration(x, v)
+
+class Mover(msd.Integrator):
+    def step(self, x, v, dt, dynamics):
+        x += 0.25  # moves the positions it was given, then asks
+        return x + dt * v, v + dt * dynamics.acceleration(x, v)
 """
 
 
@@ -65,6 +76,55 @@ def test_a_simulation_step_is_one_round_trip(remote, monkeypatch):
     body = msd.Body.grid((2, 2, 2), 0.5, neighbours=(1,))
     local = msd.Simulation(body, here["Plain"](), 0.01, [msd.Gravity((0.0, -1.0, 0.0))])
     assert np.array_equal(run.positions, local.run(steps=20).positions)
+
+
+def served_calls(remote: RemoteImplementation, monkeypatch: pytest.MonkeyPatch) -> list[dict]:
+    """The calls the submission makes back to the grader from now on."""
+    calls: list[dict] = []
+    serve = remote.sandbox._serve
+
+    def counting(request: dict) -> bytes:
+        if request["op"] == "call":
+            calls.append(request)
+        return serve(request)
+
+    monkeypatch.setattr(remote.sandbox, "_serve", counting)
+    return calls
+
+
+def local_step(name: str, x, v, dt, dynamics):
+    """The step of the submission's class ``name`` run in this process."""
+    here: dict = {}
+    exec(textwrap.dedent(INTEGRATORS), here)
+    return here[name]().step(x.copy(), v.copy(), dt, dynamics)
+
+
+def step_case():
+    body = msd.Body.grid((2, 2, 2), 0.5, neighbours=(1, 2))
+    x = body.positions + 0.05 * np.random.default_rng(3).standard_normal(body.positions.shape)
+    v = np.random.default_rng(4).standard_normal(x.shape)
+    return msd.Dynamics(body, [msd.Gravity((0.0, -1.0, 0.0))]), x, v
+
+
+def test_the_acceleration_at_the_steps_state_comes_with_the_step(remote, monkeypatch):
+    """The grader sends the engine's a(x, v) with the step: the submission's calls at that
+    state need no round trip, and each gets its own copy (spoiling one spoils no other)."""
+    dynamics, x, v = step_case()
+    calls = served_calls(remote, monkeypatch)
+    x_new, v_new = remote.task(5).Spoiler().step(x.copy(), v.copy(), 0.1, dynamics)
+    assert calls == []
+    expected = local_step("Spoiler", x, v, 0.1, dynamics)
+    assert np.array_equal(x_new, expected[0]) and np.array_equal(v_new, expected[1])
+    assert not np.array_equal(v_new, v)  # the second answer was not the spoiled first
+
+
+def test_an_acceleration_asked_at_another_state_is_the_engines_there(remote, monkeypatch):
+    dynamics, x, v = step_case()
+    calls = served_calls(remote, monkeypatch)
+    x_new, v_new = remote.task(5).Mover().step(x.copy(), v.copy(), 0.1, dynamics)
+    assert len(calls) == 1  # a call back: x was moved after the grader sent a(x, v)
+    expected = local_step("Mover", x, v, 0.1, dynamics)
+    assert np.array_equal(x_new, expected[0]) and np.array_equal(v_new, expected[1])
 
 
 @pytest.mark.parametrize(("name", "factor", "lost"), [("Own", 2.0, 1.5), ("Patched", 3.0, 0.0)])

@@ -173,6 +173,7 @@ class Server:
         self.objects: dict[int, Any] = {}
         self.modules: dict[int, Any] = {}
         self.grader_objects: dict[int, GraderObject] = {}
+        self.hint: dict | None = None  # the grader's answer to a callback it foresaw (a step's)
 
     def serve(self) -> None:
         while True:
@@ -198,7 +199,11 @@ class Server:
                 args, kwargs = self.local(request["args"]), self.local(request["kwargs"])
                 _refuse_delegation(request.get("refuse"), self.folder)
                 before = _array_arguments(args, kwargs)
-                value = target(*args, **kwargs)
+                self.hint = request.get("hint")
+                try:
+                    value = target(*args, **kwargs)
+                finally:
+                    self.hint = None
                 changed = _changed_arguments(before, args, kwargs)
                 if changed:
                     return {"ok": value, "args": changed}
@@ -262,6 +267,23 @@ class Server:
             data = self.wire.encode({"error": _describe(error, self.folder)})
         self.wire.write_all(self.out_fd, data)
 
+    def foreseen(self, owner: tuple[int, str] | None, args: tuple, kwargs: dict) -> Any:
+        """The grader's answer to the call ``args`` of the member ``owner`` (its object's
+        reference, its name) if the grader sent it with the request being served (`hint`:
+        a step's ``dynamics.acceleration`` at the state the step starts from), else None."""
+        import numpy
+
+        hint = self.hint
+        if hint is None or kwargs or len(args) != 2 or owner != (hint["ref"].id, hint["name"]):
+            return None
+        try:
+            given = [numpy.asarray(a, dtype=float) for a in args]
+        except (TypeError, ValueError):
+            return None
+        if all(numpy.array_equal(a, b) for a, b in zip(given, hint["args"])):
+            return hint["ok"].copy()
+        return None
+
     def callback(self, message: dict) -> Any:
         """Send a request to the grader (during a call) and return its answer."""
         self.send(message)
@@ -277,6 +299,7 @@ class GraderObject:
     def __init__(self, server: Server, ref: Any) -> None:
         self._server, self._ref = server, ref
         self._methods: dict[str, GraderObject] = {}
+        self._owner: tuple[int, str] | None = None  # (object's reference, name) of a method
 
     def __getattr__(self, name: str) -> Any:
         if name.startswith("_"):
@@ -285,10 +308,14 @@ class GraderObject:
             return self._methods[name]
         value = self._server.callback({"op": "getattr", "ref": self._ref, "name": name})
         if isinstance(value, GraderObject):
+            value._owner = (self._ref.id, name)
             self._methods[name] = value
         return value
 
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        foreseen = self._server.foreseen(self._owner, args, kwargs)
+        if foreseen is not None:
+            return foreseen
         message = {"op": "call", "ref": self._ref, "args": args, "kwargs": kwargs}
         return self._server.callback(message)
 
