@@ -30,21 +30,33 @@ def spring_force(
         n = d / |d|,   ṡ = w·n,   f_a = [k (l - |d|) - c ṡ] n,   f_b = -f_a
 
     ṡ is how fast the spring lengthens. Coincident ends (d = 0) have no
-    direction and get no force.
+    direction and get no force. The terms are `spring_state`'s.
     """
-    length = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-    safe = length + (length == 0.0)  # 1 where d = 0, which then makes f_a = 0
-    rate = (w[0] * d[0] + w[1] * d[1] + w[2] * d[2]) / safe
-    scale = spring_tension(stiffness, rest, length, damping, rate) / safe  # |f_a| / |d|
+    scale = spring_state(stiffness, rest, damping, d, w)[3]  # |f_a| / |d|
     return scale * d[0], scale * d[1], scale * d[2]
 
 
-def spring_tension(
-    stiffness: float, rest: float, length: float, damping: float, rate: float
-) -> float:
-    """The signed size (N) of `spring_force` along n: k (l - |d|) - c ṡ, positive pushing
-    the ends apart (the grid gather of the numba kernel sums it by offset)."""
-    return stiffness * (rest - length) - damping * rate
+def spring_state(
+    stiffness: float,
+    rest: float,
+    damping: float,
+    d: tuple[float, float, float],
+    w: tuple[float, float, float] | None = None,
+) -> tuple[float, float, float, float]:
+    """The terms of `spring_force`, each written once for every kernel: the length |d| (m),
+    the length n = d/|d| divides by (m), the lengthening rate ṡ = w·n (m/s) and |f_a|/|d|
+    (N/m), so that f_a = (|f_a|/|d|)·d with the tension k (l - |d|) - c ṡ.
+
+    ``d`` = x_a - x_b, ``w`` = v_a - v_b (three coordinates each), or None for a spring
+    without a dashpot (ṡ = 0; compiled loops then skip reading the velocities).
+    Coincident ends (d = 0) have no direction: n is divided by 1 there, so n, ṡ and the
+    force are 0.
+    """
+    length = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+    safe = length + (length == 0.0)  # 1 where d = 0
+    rate = 0.0 if w is None else (w[0] * d[0] + w[1] * d[1] + w[2] * d[2]) / safe
+    tension = stiffness * (rest - length) - damping * rate  # positive: pushes the ends apart
+    return length, safe, rate, tension / safe
 
 
 def spring_energy(stiffness: float, rest: float, length: float) -> float:
@@ -57,14 +69,15 @@ def dashpot_power(damping: float, rate: float) -> float:
     return damping * rate**2
 
 
-def transverse_stiffness(stiffness: float, rest: float, length: float) -> float:
+def transverse_stiffness(stiffness: float, rest: float, length: float, safe: float) -> float:
     """Stiffness k·max(0, 1 - l/|d|) (N/m) of a spring across its direction n.
 
     With it the spring's Jacobian block is B = k n nᵀ + k_t (I - n nᵀ); it is 0
     for a compressed spring (as Baraff & Witkin do, so that -∂F/∂x stays
-    positive semi-definite).
+    positive semi-definite). Coincident ends (|d| = 0, divided by ``safe`` = 1 instead, see
+    `spring_state`) have no direction: k_t = k, B = k I.
     """
-    return stiffness * np.maximum(0.0, 1.0 - rest / length)
+    return stiffness * np.maximum(0.0, 1.0 - rest * (length > 0.0) / safe)
 
 
 def acceleration(force: float, mass: float, free: bool) -> float:

@@ -33,7 +33,12 @@ def spring_vectors(body: Body, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def vectors(edges: EdgeSprings, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """`spring_vectors` of the springs ``edges``."""
     d = x.take(edges.a, axis=0) - x.take(edges.b, axis=0)
-    return d, np.sqrt(np.einsum("ij,ij->i", d, d))
+    return d, equations.spring_state(0.0, 0.0, 0.0, three(d))[0]
+
+
+def three(vectors: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The three coordinates of (E, d) ``vectors``, (E,) each, the third 0 in 2-D."""
+    return (*vectors.T, 0.0)[:3]
 
 
 def spring_forces(
@@ -63,11 +68,10 @@ def elastic_energy(body: Body, x: np.ndarray, springs: np.ndarray | None = None)
 def energy(edges: EdgeSprings, x: np.ndarray, springs: np.ndarray | None = None) -> float:
     """`elastic_energy` of the springs ``edges``."""
     pick = slice(None) if springs is None else springs
-    d = x[edges.a[pick]] - x[edges.b[pick]]
-    length = np.sqrt(np.einsum("ij,ij->i", d, d))
-    return float(
-        np.sum(equations.spring_energy(edges.stiffness[pick], edges.rest_lengths[pick], length))
-    )
+    stiffness, rest = edges.stiffness[pick], edges.rest_lengths[pick]
+    d = three(x[edges.a[pick]] - x[edges.b[pick]])
+    length = equations.spring_state(stiffness, rest, 0.0, d)[0]
+    return float(np.sum(equations.spring_energy(stiffness, rest, length)))
 
 
 def spring_jacobians(
@@ -86,12 +90,12 @@ def jacobians(edges: EdgeSprings, x: np.ndarray, pattern: JacobianPattern) -> Ja
     Both enter as -B on the (a, a) and (b, b) blocks and +B on (a, b) and (b, a).
     """
     dim = x.shape[1]
-    d, length = vectors(edges, x)
-    safe = np.where(length > 0, length, np.inf)  # coincident ends: n = 0, B = k I
-    n = d / safe[:, None]
-    outer = n[:, :, None] * n[:, None, :]
+    d = x.take(edges.a, axis=0) - x.take(edges.b, axis=0)
     stiffness, rest, damping = edges.values()
-    across = equations.transverse_stiffness(stiffness, rest, safe)[:, None, None]
+    length, safe, _, _ = equations.spring_state(stiffness, rest, 0.0, three(d))
+    n = d / safe[:, None]  # 0 for coincident ends: B = k I
+    outer = n[:, :, None] * n[:, None, :]
+    across = equations.transverse_stiffness(stiffness, rest, length, safe)[:, None, None]
     stiff = (stiffness[:, None, None] - across) * outer + across * np.eye(dim)
     return Jacobians(
         *pattern.jacobians(stiff, damping[:, None, None] * outer if damping.any() else None)
@@ -182,16 +186,13 @@ class NumpyKernel:
             a, b, stiffness, rest, damping = (
                 values[springs] for values in (a, b, stiffness, rest, damping)
             )
-        d = x.take(a, axis=0) - x.take(b, axis=0)
-        length = np.sqrt(np.einsum("ij,ij->i", d, d))
-        power, w = 0.0, np.zeros_like(d[:1])  # without dashpots v_a - v_b is not needed
+        d = (*(x.take(a, axis=0) - x.take(b, axis=0)).T, 0.0)[:3]  # the third 0 in 2-D
+        w = None  # v_a - v_b, needed only with dashpots
         if damping.any():
-            w = v.take(a, axis=0) - v.take(b, axis=0)
-            safe = np.where(length > 0, length, np.inf)  # coincident ends: no rate
-            rate = np.einsum("ij,ij->i", w, d) / safe
-            power = float(np.sum(equations.dashpot_power(damping, rate)))
-        along = (*d.T, 0.0)[:3], (*w.T, 0.0)[:3]  # three coordinates each, the third 0 in 2-D
-        f = equations.spring_force(stiffness, rest, damping, *along)
+            w = (*(v.take(a, axis=0) - v.take(b, axis=0)).T, 0.0)[:3]
+        length, _, rate, _ = equations.spring_state(stiffness, rest, damping, d, w)
+        power = 0.0 if w is None else float(np.sum(equations.dashpot_power(damping, rate)))
+        f = equations.spring_force(stiffness, rest, damping, d, w)
         for q in range(x.shape[1]):  # eq. (1.1): f on each a, -f on each b
             out[:, q] += np.bincount(a, f[q], len(x)) - np.bincount(b, f[q], len(x))
         stretch = float((length / rest).max()) if len(length) else 0.0

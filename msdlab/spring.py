@@ -35,8 +35,8 @@ class Spring(Bound):
 
     ``rest_length=None`` takes the distance between the particles when the spring
     is added to a body. `Spring.force` and the numpy kernel (`msdlab.kernels`) apply
-    `equations.spring_force`; the compiled loops (`msdlab.compiled`) its size along n,
-    `equations.spring_tension`, times d/|d|. In a body, the object reads and writes
+    `equations.spring_force`; the compiled loops (`msdlab.compiled`) its terms,
+    `equations.spring_state`, one spring at a time. In a body, the object reads and writes
     spring ``index`` of the body's spring set (`Body.set_springs`).
     """
 

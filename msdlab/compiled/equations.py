@@ -4,25 +4,22 @@ The same functions, not copies: each is `msdlab.equations`'s own code, handed to
 ``numba.njit``, so the compiled loops compute exactly what the numpy kernel does.
 """
 
-import types
-from collections.abc import Callable
-
 import numba
 
 from .. import equations
 
+_inlined = numba.njit(cache=True, inline="always")
 
-def _compiled(function: Callable, **helpers: Callable) -> Callable:
-    """``function``'s own code compiled by numba, its calls to other equations (``helpers``)
-    going to their compiled forms: numba cannot call a plain Python function."""
-    scope = {**function.__globals__, **helpers}
-    twin = types.FunctionType(function.__code__, scope, function.__name__, function.__defaults__)
-    return numba.njit(cache=True, inline="always")(twin)
+spring_state = _inlined(equations.spring_state)
+spring_energy = _inlined(equations.spring_energy)
+dashpot_power = _inlined(equations.dashpot_power)
+transverse_stiffness = _inlined(equations.transverse_stiffness)
+acceleration = _inlined(equations.acceleration)
+ground_contact = _inlined(equations.ground_contact)
 
 
-spring_tension = _compiled(equations.spring_tension)
-spring_energy = _compiled(equations.spring_energy)
-dashpot_power = _compiled(equations.dashpot_power)
-transverse_stiffness = _compiled(equations.transverse_stiffness)
-acceleration = _compiled(equations.acceleration)
-ground_contact = _compiled(equations.ground_contact)
+@numba.njit(cache=True, inline="always")
+def separation(x, i, j):
+    """d = x_i - x_j (m) of positions ``x`` (N, d), three coordinates (the third 0 in 2-D)."""
+    d2 = x[i, 2] - x[j, 2] if x.shape[1] == 3 else 0.0
+    return x[i, 0] - x[j, 0], x[i, 1] - x[j, 1], d2

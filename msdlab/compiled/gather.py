@@ -1,7 +1,7 @@
 """The grid gather: the spring forces of a grid body by offset, with no list of springs.
 
 Each particle computes its springs to the neighbours ahead of it (half the
-stencil, so each spring once, with `equations.spring_tension`, the size of
+stencil, so each spring once, with `equations.spring_state`, the terms of
 `equations.spring_force`), adds their forces to itself and, in a second loop, their opposites to the
 neighbours. The positions are copied by coordinate so that the inner loops
 walk contiguous memory on vector registers, over whole grid rows (those whose
@@ -9,7 +9,8 @@ neighbour would leave its row masked out), three offsets at a time (a
 particle's position is read and its force written once for three springs).
 The threads take grid planes, every third one at once in three rounds, so
 that no two write the same particle; one thread takes them in the same order,
-with the same sums. The layout these loops read (`stencil.Layout`, named arrays per
+with the same sums. The energy (`grid_sum`) visits each offset's springs in grid
+order, the threads taking planes. The layout these loops read (`stencil.Layout`, named arrays per
 triple of offsets) and their memory (`stencil.Scratch`) are made in `stencil`.
 """
 
@@ -19,7 +20,7 @@ from collections.abc import Callable
 import numba
 import numpy as np
 
-from .equations import dashpot_power, spring_tension
+from .equations import dashpot_power, separation, spring_energy, spring_state
 from .stencil import Layout, Scratch, Triples
 
 
@@ -29,13 +30,9 @@ def _pull(y0, y1, y2, x0, x1, x2, q, there, k, rest):
     that neighbour does not exist): f/|d| of eq. (1.2) (N/m), d = y - x_q (3 components)
     and |d|² (m²). The force on the particle is (f/|d|)·d, on ``q`` its opposite.
     """
-    d0, d1, d2 = y0 - x0[q], y1 - x1[q], y2 - x2[q]
-    length_squared = d0 * d0 + d1 * d1 + d2 * d2
-    length = math.sqrt(length_squared)
-    safe = length if length > 0.0 else 1.0  # coincident ends: no direction, no force
-    scale = there * spring_tension(k, rest, safe, 0.0, 0.0) / safe
-    scale = scale if length > 0.0 else 0.0
-    return scale, d0, d1, d2, there * length_squared
+    d = (y0 - x0[q], y1 - x1[q], y2 - x2[q])
+    length, _, _, scale = spring_state(k, rest, 0.0, d)
+    return there * scale, d[0], d[1], d[2], there * length * length
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -43,15 +40,9 @@ def _pull_damped(y0, y1, y2, u0, u1, u2, xs, vs, q, there, k, rest, c):
     """`_pull` with the dashpot c (N·s/m) on velocities u and vs; also returns its power (W)."""
     x0, x1, x2 = xs
     v0, v1, v2 = vs
-    d0, d1, d2 = y0 - x0[q], y1 - x1[q], y2 - x2[q]
-    length_squared = d0 * d0 + d1 * d1 + d2 * d2
-    length = math.sqrt(length_squared)
-    safe = length if length > 0.0 else 1.0
-    rate = ((u0 - v0[q]) * d0 + (u1 - v1[q]) * d1 + (u2 - v2[q]) * d2) / safe
-    power = there * dashpot_power(c, rate)
-    scale = there * spring_tension(k, rest, safe, c, rate) / safe
-    scale = scale if length > 0.0 else 0.0
-    return scale, d0, d1, d2, there * length_squared, power
+    d = (y0 - x0[q], y1 - x1[q], y2 - x2[q])
+    length, _, rate, scale = spring_state(k, rest, c, d, (u0 - v0[q], u1 - v1[q], u2 - v2[q]))
+    return there * scale, d[0], d[1], d[2], there * length * length, there * dashpot_power(c, rate)
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -254,6 +245,24 @@ def _push_unit(memory, layout, triples, unit):
 
 
 @numba.njit(cache=True, error_model="numpy")
+def _plane_sum(x, shape, offsets, stiffness, rest_lengths, m, plane):
+    """Σ over the springs of offset m from the particles of grid ``plane``: their energy
+    ½ k (|d| - l)² (J), d = x_p - x_q, with k = ``stiffness[m]`` (N/m) and
+    l = ``rest_lengths[m]`` (m)."""
+    n1, n2 = shape[1], shape[2]
+    o1, o2 = offsets[m, 1], offsets[m, 2]
+    k, rest = stiffness[m], rest_lengths[m]
+    shift = (offsets[m, 0] * n1 + o1) * n2 + o2
+    total = 0.0
+    for row in range(max(0, -o1), n1 - max(0, o1)):
+        start = (plane * n1 + row) * n2
+        for p in range(start + max(0, -o2), start + n2 - max(0, o2)):
+            length = spring_state(k, rest, 0.0, separation(x, p, p + shift))[0]
+            total += spring_energy(k, rest, length)
+    return total
+
+
+@numba.njit(cache=True, error_model="numpy")
 def _totals(squares, powers):
     """The largest stretch |d|/l from the units' largest squared ones, and the units'
     dashpot powers (W) added in order: the same on one thread or several."""
@@ -263,9 +272,9 @@ def _totals(squares, powers):
     return math.sqrt(squares.max()), power
 
 
-def _compile(parallel: bool) -> Callable:
-    """`gather` compiled for threads (``parallel``) or for one thread, which does the same
-    work in the same order, so the same sums."""
+def _compile(parallel: bool) -> tuple[Callable, Callable]:
+    """`gather` and `grid_sum` compiled for threads (``parallel``) or for one thread, which
+    does the same work in the same order, so the same sums."""
     loop = numba.prange if parallel else range
 
     @numba.njit(cache=True, parallel=parallel, error_model="numpy")
@@ -306,7 +315,19 @@ def _compile(parallel: bool) -> Callable:
                 out[p, q] += forces[q, p + pad]
         return _totals(squares, powers)
 
-    return gather
+    @numba.njit(cache=True, parallel=parallel, error_model="numpy")
+    def grid_sum(x, shape, offsets, stiffness, rest_lengths):
+        """The energy (J) of all springs (see `_plane_sum`), with the ``stiffness`` (N/m)
+        and ``rest_lengths`` (m) of each offset (M,); the threads take planes, and the
+        sums are added in a fixed order."""
+        sums = np.zeros((len(offsets), shape[0]))
+        for m in range(len(offsets)):
+            for plane in loop(max(0, -offsets[m, 0]), shape[0] - max(0, offsets[m, 0])):
+                sums[m, plane] = _plane_sum(x, shape, offsets, stiffness, rest_lengths, m, plane)
+        return sums.sum()
+
+    return gather, grid_sum
 
 
-gather_serial, gather_parallel = _compile(False), _compile(True)
+gather_serial, grid_sum_serial = _compile(False)
+gather_parallel, grid_sum_parallel = _compile(True)

@@ -18,12 +18,10 @@ from .edges import (
     elastic_energy_parallel,
     elastic_energy_serial,
     jacobian_blocks,
-    spring_classes,
     spring_forces_parallel,
     spring_forces_serial,
 )
-from .gather import gather_parallel, gather_serial
-from .grid_sums import grid_sum_parallel, grid_sum_serial
+from .gather import gather_parallel, gather_serial, grid_sum_parallel, grid_sum_serial
 from .reductions import PARALLEL_MIN_PARTICLES, damping_work, finite
 from .stencil import NO_PLAN, padded_shape, plan
 
@@ -36,10 +34,6 @@ PARALLEL_MIN_SPRINGS = 50_000
 
 # The gather wakes the threads four times a step: it waits for more springs (about 28³ grid).
 PARALLEL_MIN_GATHERED = 250_000
-
-# At most this many distinct (stiffness, rest length, dashpot) triples are kept as a table
-# with a class number per spring (uint8 up to 256, else uint16); past it, the values per spring.
-SPRING_CLASSES = 65_536
 
 
 # Spring forces not all added up: an (N, d) array of them (the force buffer, or the gather's
@@ -69,9 +63,7 @@ class NumbaKernel:
         self._gather = NO_PLAN  # see `stencil.plan`
         self._laid_out: tuple[object, int, EdgeSprings] = (None, -1, EdgeSprings.empty())
         self._forces = np.zeros((0, 0))  # the spring forces of `advance` (scratch)
-        self._order: np.ndarray | None = None
-        self._classes_version = -1
-        self._classes: tuple[np.ndarray | None, ...] = (None,)  # see `_edge_list`
+        self._values: tuple[np.ndarray, ...] = ()  # see `_edge_list`
 
     name = "numba"
     finite = staticmethod(finite)
@@ -121,7 +113,7 @@ class NumbaKernel:
             return stretch, power, (by_coordinate.T, none)
         if springs is not None:
             a, b, k, rest, c = (array[springs] for array in self.edges(body).arrays())
-            return *spring_forces_serial(x, v, a, b, None, k, rest, c, out), (out, none)
+            return *spring_forces_serial(x, v, a, b, k, rest, c, out), (out, none)
         arrays = self._edge_list(body)
         if not self._parallel(body):
             if not reduce:
@@ -153,7 +145,7 @@ class NumbaKernel:
 
     def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
         """Energy (J) stored in the springs (or in the given ones) at positions x; a
-        lattice's summed by offset (`grid_sums`)."""
+        lattice's summed by offset (`gather.grid_sum`)."""
         lattice = body.spring_set
         if springs is None and isinstance(lattice, LatticeSprings):
             grid_sum = grid_sum_parallel if self._parallel(body) else grid_sum_serial
@@ -161,9 +153,9 @@ class NumbaKernel:
         edges = self.edges(body)
         arrays = (edges.a, edges.b, edges.stiffness, edges.rest_lengths)
         if springs is not None:
-            return elastic_energy_serial(x, *(array[springs] for array in arrays))
+            return elastic_energy_serial(x, *(array[springs] for array in arrays), 1)
         if not self._parallel(body):
-            return elastic_energy_serial(x, *arrays)
+            return elastic_energy_serial(x, *arrays, 1)
         return elastic_energy_parallel(x, *arrays, self._threads)
 
     def jacobians(self, body: Body, x: np.ndarray, pattern: JacobianPattern) -> Jacobians:
@@ -211,57 +203,23 @@ class NumbaKernel:
         x_new, v_new = advance_particles(*state, threads)
         return Advanced(x_new, v_new, stretch, power)
 
-    def _edge_list(self, body: Body) -> tuple[np.ndarray | None, ...]:
-        """Ends a, b of all springs sorted by (a, b), each one's class (or None) and the
-        stiffness, rest length and dashpot of each class (or of each spring).
+    def _edge_list(self, body: Body) -> tuple[np.ndarray, ...]:
+        """Ends a, b of all springs sorted by (a, b), and the stiffness, rest length and
+        dashpot of each, in that order.
 
         In that order consecutive springs share or neighbour their particles,
         so the edge loop reads and writes memory it has just used, whatever
         order the springs were added in (a shuffled 60³ grid: several times
-        faster). The ends (uint32: half the memory traffic of int64) and the
-        order are kept per topology; the classes (`edges.spring_classes`) are found
-        again when the values are edited. Past
-        `SPRING_CLASSES` distinct values the loop reads them per spring: the
-        body's arrays, or copies in the sorted order.
+        faster). The ends (uint32: half the memory traffic of int64) are kept per
+        topology; the values are the body's own arrays, or copies in the sorted order.
         """
+        edges = self.edges(body)
         if self._version != body.version:
             index = np.uint32 if body.n_particles < 2**32 else np.uint64
-            edges = self.edges(body)
             order = np.lexsort((edges.b, edges.a))
-            self._order = None if np.array_equal(order, np.arange(len(order))) else order
-            ends = (edges.a, edges.b)
-            if self._order is not None:
-                ends = tuple(end[order] for end in ends)
-            self._a, self._b = (end.astype(index) for end in ends)
+            in_order = np.array_equal(order, np.arange(len(order)))
+            sorted_ = (array if in_order else array[order] for array in edges.arrays())
+            a, b, *values = sorted_
+            self._a, self._b, self._values = a.astype(index), b.astype(index), tuple(values)
             self._version = body.version
-            self._classes_version = -1
-        values = self.edges(body).values()
-        if body.version != self._classes_version:
-            self._classes = self._classify(values)
-            self._classes_version = body.version
-        if self._classes[0] is None and self._order is None:
-            return self._a, self._b, None, *values
-        return self._a, self._b, *self._classes
-
-    def _classify(self, values: tuple[np.ndarray, ...]) -> tuple[np.ndarray | None, ...]:
-        """Each sorted spring's class (uint8 or uint16) and the stiffness (N/m), rest length
-        (m) and dashpot (N·s/m) of each class; (None,) past `SPRING_CLASSES` classes,
-        with the values in the sorted order if they are not in the body's.
-
-        The classes are found in the body's order (`edges.spring_classes`, reading memory
-        in order), then put in the sorted order: one small array to permute, not three.
-        """
-        most = min(len(values[0]), SPRING_CLASSES)
-        slots = np.zeros(1 << max(4, (2 * most).bit_length()), np.int32)
-        kinds = np.empty(len(values[0]), np.uint16)
-        table = np.empty((most, 3), np.int64)
-        classes = spring_classes(*(array.view(np.int64) for array in values), slots, kinds, table)
-        if classes < 0:
-            if self._order is None:
-                return (None,)
-            return None, *(array[self._order] for array in values)
-        table = table[:classes].view(np.float64)
-        kinds = kinds.astype(np.uint8) if classes <= 256 else kinds
-        if self._order is not None:
-            kinds = kinds[self._order]
-        return kinds, *(np.ascontiguousarray(column) for column in table.T)
+        return self._a, self._b, *self._values

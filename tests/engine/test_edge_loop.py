@@ -1,4 +1,4 @@
-"""The edge loop's spring classes: a table of the distinct (k, l, c), a small index per spring."""
+"""The edge loop's springs, sorted by their ends: each with its own values, kept until an edit."""
 
 from __future__ import annotations
 
@@ -56,35 +56,16 @@ def assert_close_to_numpy(body: msd.Body, kernel: NumbaKernel, springs=None) -> 
     assert actual[2] == pytest.approx(expected[2], rel=RTOL, abs=RTOL * scale)
 
 
-def test_class_table_holds_each_springs_values() -> None:
+def test_sorted_springs_keep_each_springs_values() -> None:
     body = shuffled_body()
     body.set_springs(slice(None, None, 4), damping=0.3)
-    a, _, kinds, k, rest, c = NumbaKernel()._edge_list(body)
-    assert kinds.dtype == np.uint8 and len(k) == 6  # 3 rest lengths, with and without dashpot
+    a, b, k, rest, c = NumbaKernel()._edge_list(body)
     assert np.all(np.diff(a.astype(np.int64)) >= 0)  # sorted by the first end
     order = np.lexsort((body.edges().b, body.edges().a))
-    for table, values in zip((k, rest, c), body.edges().values()):
-        np.testing.assert_array_equal(table[kinds], values[order])
-    assert len({(k[m], rest[m], c[m]) for m in range(len(k))}) == len(k)  # each class once
-
-
-@pytest.mark.parametrize("threaded", [False, True])
-def test_wide_classes_and_no_classes_give_the_same_sums(
-    threaded: bool, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """300 stiffnesses: 16-bit classes; with the limit below that, the values per spring."""
-    if threaded:
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
-    body = shuffled_body(1)
-    body.springs_as_edges()  # values of their own per spring
-    body.set_springs(stiffness=np.random.default_rng(1).integers(1, 301, body.n_springs) * 0.5)
-    wide = NumbaKernel()
-    assert wide._edge_list(body)[2].dtype == np.uint16
-    assert_close_to_numpy(body, wide)
-    monkeypatch.setattr("msdlab.compiled.kernel.SPRING_CLASSES", 256)
-    unclassed = NumbaKernel()
-    assert unclassed._edge_list(body)[2] is None
-    assert_same(forces_by(unclassed, body), forces_by(wide, body))
+    np.testing.assert_array_equal(b, body.edges().b[order])
+    for sorted_values, values in zip((k, rest, c), body.edges().values()):
+        np.testing.assert_array_equal(sorted_values, values[order])
+    assert_close_to_numpy(body, NumbaKernel())
 
 
 def sorted_body() -> msd.Body:
@@ -97,27 +78,27 @@ def sorted_body() -> msd.Body:
     )
 
 
-def test_past_the_limit_in_the_bodys_order(monkeypatch: pytest.MonkeyPatch) -> None:
-    """Springs already sorted, more classes than allowed: the loop reads the body's arrays."""
+def test_springs_in_order_are_read_from_the_body() -> None:
+    """Springs already sorted: the loop reads the body's own arrays, no copies."""
     body = sorted_body()
-    monkeypatch.setattr("msdlab.compiled.kernel.SPRING_CLASSES", 2)
     kernel = NumbaKernel()
-    _, _, kinds, k, _, _ = kernel._edge_list(body)
-    assert kinds is None and np.shares_memory(k, body.edges().values()[0])
+    _, _, k, _, _ = kernel._edge_list(body)
+    assert np.shares_memory(k, body.edges().values()[0])
     body.set_springs([4], stiffness=7.0)
     assert_close_to_numpy(body, kernel)
 
 
-def test_reading_the_values_keeps_the_classes_and_editing_counts() -> None:
-    """Reading a spring array, or holding it, is no edit: the classes are kept. The arrays
-    are read-only; an edit goes through `Body.set_springs` (or a whole array) and counts."""
-    body = sorted_body()
+def test_reading_the_values_keeps_the_sorted_springs_and_editing_counts() -> None:
+    """Reading a spring array, or holding it, is no edit: the sorted springs are kept. The
+    arrays are read-only; an edit goes through `Body.set_springs` (or a whole array) and
+    counts."""
+    body = shuffled_body(3)
     kernel = NumbaKernel()
-    classed = forces_by(kernel, body)
-    kinds = kernel._edge_list(body)[2]
+    before = forces_by(kernel, body)
+    kept = kernel._edge_list(body)[2]
     held = body.edges().rest_lengths
-    assert kernel._edge_list(body)[2] is kinds
-    assert_same(forces_by(kernel, body), classed)
+    assert kernel._edge_list(body)[2] is kept
+    assert_same(forces_by(kernel, body), before)
     with pytest.raises(ValueError, match="read-only"):
         held[6] = 1.0
     for edit in (
@@ -129,8 +110,8 @@ def test_reading_the_values_keeps_the_classes_and_editing_counts() -> None:
         version = body.version
         edit()
         assert body.version == version + 1
-        assert kernel._edge_list(body)[2] is not kinds
-        kinds = kernel._edge_list(body)[2]
+        assert kernel._edge_list(body)[2] is not kept
+        kept = kernel._edge_list(body)[2]
         assert_close_to_numpy(body, kernel)
     version = body.version
     _ = (
@@ -144,31 +125,29 @@ def test_reading_the_values_keeps_the_classes_and_editing_counts() -> None:
 
 @pytest.mark.parametrize("threaded", [False, True])
 def test_springs_edited_between_steps(threaded: bool, monkeypatch: pytest.MonkeyPatch) -> None:
-    """Springs edited between steps count at the next step, on the classes and past their
-    limit, as if the body had been built with the new values."""
+    """Springs edited between steps count at the next step, as if the body had been built
+    with the new values."""
     if threaded:
         monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
-    for limit in (65_536, 4):
-        monkeypatch.setattr("msdlab.compiled.kernel.SPRING_CLASSES", limit)
-        body = shuffled_body(2)
-        sim = msd.Simulation(body, msd.Verlet(0.01), dt=1e-3, kernel="numba")
-        for step in range(3):
-            sim.step()
-            body.set_springs([step], stiffness=90.0 + step)  # a new class
-            body.set_springs([5 * step], rest_lengths=body.edges().rest_lengths[5 * step] * 1.25)
-            body.set_springs([7 * step], damping=0.2)
-            fresh = NumbaKernel()
-            assert_same(forces_by(sim.dynamics.springs, body), forces_by(fresh, body))
-            assert_close_to_numpy(body, sim.dynamics.springs)
-        body.springs[9].stiffness = 3.0  # and through a Spring object
-        assert_same(forces_by(sim.dynamics.springs, body), forces_by(NumbaKernel(), body))
+    body = shuffled_body(2)
+    sim = msd.Simulation(body, msd.Verlet(0.01), dt=1e-3, kernel="numba")
+    for step in range(3):
+        sim.step()
+        body.set_springs([step], stiffness=90.0 + step)
+        body.set_springs([5 * step], rest_lengths=body.edges().rest_lengths[5 * step] * 1.25)
+        body.set_springs([7 * step], damping=0.2)
+        fresh = NumbaKernel()
+        assert_same(forces_by(sim.dynamics.springs, body), forces_by(fresh, body))
+        assert_close_to_numpy(body, sim.dynamics.springs)
+    body.springs[9].stiffness = 3.0  # and through a Spring object
+    assert_same(forces_by(sim.dynamics.springs, body), forces_by(NumbaKernel(), body))
 
 
 def test_springs_subset_in_the_bodys_order() -> None:
     body = shuffled_body(4)
     body.set_springs(slice(None, None, 3), damping=0.4)
     kernel = NumbaKernel()
-    forces_by(kernel, body)  # the sorted list and classes are built, and must not be used
+    forces_by(kernel, body)  # the sorted list is built, and must not be used
     touching = body.springs_touching(np.array([3, 8, 40]))
     assert_close_to_numpy(body, kernel, touching)
     assert_close_to_numpy(body, kernel, touching[::-1])
