@@ -121,23 +121,25 @@ def scratch(lattice: LatticeSprings, n_particles: int) -> Scratch:
 
 class Plan(NamedTuple):
     """What the gather of ``lattice`` at ``version`` (`Body.version`) on ``particles``
-    particles reads: its `Layout`, `Triples` and `Scratch` (``memory``), their fields in
-    one tuple (``arguments``, the gather's), and the number of ``springs``."""
+    particles reads: the fields of its `Layout`, `Triples` and `Scratch` in one tuple
+    (``arguments``, the gather's), its scratch ``forces`` by coordinate, seen as (N, d),
+    and its number of ``springs``."""
 
     lattice: LatticeSprings | None
     version: int
     particles: int
-    memory: Scratch | None
     arguments: tuple
+    forces: np.ndarray
     springs: int
 
 
-NO_PLAN = Plan(None, -1, -1, None, (), 0)
+NO_PLAN = Plan(None, -1, -1, (), np.zeros((0, 0)), 0)
 
 
 def plan(lattice: LatticeSprings, version: int, n_particles: int) -> Plan:
     """The gather's `Plan` for ``lattice``, edited ``version`` times, on ``n_particles``."""
     grid, triples = layout(lattice)
     memory = scratch(lattice, n_particles)
+    forces = memory.forces[: len(lattice.shape), memory.pad : memory.pad + n_particles].T
     arguments = (*grid, *triples, *memory)
-    return Plan(lattice, version, n_particles, memory, arguments, lattice.count)
+    return Plan(lattice, version, n_particles, arguments, forces, lattice.count)

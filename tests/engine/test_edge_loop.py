@@ -59,7 +59,7 @@ def assert_close_to_numpy(body: msd.Body, kernel: NumbaKernel, springs=None) -> 
 def test_sorted_springs_keep_each_springs_values() -> None:
     body = shuffled_body()
     body.set_springs(slice(None, None, 4), damping=0.3)
-    a, b, k, rest, c = NumbaKernel()._edge_list(body)
+    a, b, k, rest, c = NumbaKernel()._sorted_edges(body)
     assert np.all(np.diff(a.astype(np.int64)) >= 0)  # sorted by the first end
     order = np.lexsort((body.edges().b, body.edges().a))
     np.testing.assert_array_equal(b, body.edges().b[order])
@@ -82,7 +82,7 @@ def test_springs_in_order_are_read_from_the_body() -> None:
     """Springs already sorted: the loop reads the body's own arrays, no copies."""
     body = sorted_body()
     kernel = NumbaKernel()
-    _, _, k, _, _ = kernel._edge_list(body)
+    _, _, k, _, _ = kernel._sorted_edges(body)
     assert np.shares_memory(k, body.edges().values()[0])
     body.set_springs([4], stiffness=7.0)
     assert_close_to_numpy(body, kernel)
@@ -95,9 +95,9 @@ def test_reading_the_values_keeps_the_sorted_springs_and_editing_counts() -> Non
     body = shuffled_body(3)
     kernel = NumbaKernel()
     before = forces_by(kernel, body)
-    kept = kernel._edge_list(body)[2]
+    kept = kernel._sorted_edges(body)[2]
     held = body.edges().rest_lengths
-    assert kernel._edge_list(body)[2] is kept
+    assert kernel._sorted_edges(body)[2] is kept
     assert_same(forces_by(kernel, body), before)
     with pytest.raises(ValueError, match="read-only"):
         held[6] = 1.0
@@ -110,8 +110,8 @@ def test_reading_the_values_keeps_the_sorted_springs_and_editing_counts() -> Non
         version = body.version
         edit()
         assert body.version == version + 1
-        assert kernel._edge_list(body)[2] is not kept
-        kept = kernel._edge_list(body)[2]
+        assert kernel._sorted_edges(body)[2] is not kept
+        kept = kernel._sorted_edges(body)[2]
         assert_close_to_numpy(body, kernel)
     version = body.version
     _ = (
