@@ -1,27 +1,21 @@
 """The numba backend: the same `msdlab.equations`, compiled into loops.
 
-`kernels.NumpyKernel` applies the equations to (E, d) arrays of all springs,
-then sums them per particle. `NumbaKernel` compiles the same functions
-(`equations`, here) into loops, in one module per loop:
+`kernel.NumbaKernel` has the methods of `kernels.NumpyKernel`, in the same order, on
+compiled loops that call the equations (`equations`: `msdlab.equations`'s own
+functions, compiled) one spring or particle at a time:
 
-- `edges`: the edge loop over the springs, sorted by their ends, for any body;
-- `gather`: grid bodies (`stencil`) whose springs share their values per
-  offset go by offset instead, with no list of springs;
-- `advance`: an integrator's update function (for example
-  `integrators.Verlet.update`) compiled into one loop over the particles that
-  computes a = F/m (plus gravity's g) and the update together; numba compiles the
-  function itself, and keeps msdlab's integrators' loops in its disk cache (a user's
-  update is compiled once per process). The spring forces not
-  yet summed (the edge loop's threads' buffers, or the gather's forces by
-  coordinate) are added in that loop too, not in a pass of their own;
-- `contact`: the ground's clamp, one loop over the particles;
-- `reductions`: the finiteness check of the state;
-- `kernel`: `NumbaKernel`, which keeps what a body needs between calls and
-  picks the loops.
+- `edges`: the edge loop over an edge list's springs, sorted by their ends: forces,
+  energy, Jacobian blocks;
+- `gather`: the lattice loop (`lattice.LatticeSprings`, the springs of `Body.grid`),
+  by neighbour offset with no list of springs, laid out by `stencil`: forces, energy;
+- `advance`: an integrator's update function (for example `integrators.Verlet.update`)
+  compiled into one loop over the particles with a = F/m, which also adds the spring
+  forces the spring loop left to it;
+- `reductions` and `contact`: the finiteness check, the damping work, the ground's clamp.
 
-The spring loops are compiled on first use and cached on disk (``cache=True``),
-so compiling is paid once per machine and numba version. Set the number of
-threads with ``NUMBA_NUM_THREADS`` or `numba.set_num_threads`.
+The loops are compiled on first use and cached on disk (``cache=True``), so compiling
+is paid once per machine and numba version. Set the number of threads with
+``NUMBA_NUM_THREADS`` or `numba.set_num_threads`.
 """
 
 from .kernel import NumbaKernel

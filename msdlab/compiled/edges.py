@@ -47,7 +47,8 @@ def _add_spring_forces(x, v, a, b, k, rest, c, first, stop, out, three):
         j = b[u]
         d = (y0 - x[j, 0], y1 - x[j, 1], y2 - x[j, 2] if three else 0.0)
         if c[u] != 0.0:  # the velocities are read only for a dashpot
-            length, _, rate, scale = spring_state(k[u], rest[u], c[u], d, separation(v, i, j))
+            w = (v[i, 0] - v[j, 0], v[i, 1] - v[j, 1], v[i, 2] - v[j, 2] if three else 0.0)
+            length, _, rate, scale = spring_state(k[u], rest[u], c[u], d, w)
             power += dashpot_power(c[u], rate)
         else:
             length, _, _, scale = spring_state(k[u], rest[u], 0.0, d)
