@@ -103,20 +103,9 @@ def advance_particles(
     loop = _LOOPS[update, threads]
     if loop is not None:
         x_new, v_new = body.new_state()
+        arrays = (x, v, forces, partial, field, body.masses, body.fixed)
         try:
-            loop(
-                x,
-                v,
-                forces,
-                partial,
-                field,
-                body.masses,
-                body.fixed,
-                dt,
-                coefficients,
-                x_new,
-                v_new,
-            )
+            loop(*arrays, dt, coefficients, x_new, v_new)
             return x_new, v_new
         except numba.core.errors.NumbaError as error:
             _LOOPS[update, False] = _LOOPS[update, True] = None
