@@ -100,6 +100,8 @@ def advance_particles(
     or not). An update numba cannot compile warns once and runs on whole arrays."""
     if (update, threads) not in _LOOPS:
         _LOOPS[update, threads] = compile_advance(update, threads)
+        if not isinstance(update, types.FunctionType) and (update, not threads) not in _LOOPS:
+            warnings.warn(_not_compiled(update), RuntimeWarning, stacklevel=5)
     loop = _LOOPS[update, threads]
     if loop is not None:
         x_new, v_new = body.new_state()
@@ -120,4 +122,19 @@ def advance_particles(
     masses, free = body.masses[:, None], ~body.fixed[:, None]
     return update(
         x, v, equations.acceleration(forces + masses * field, masses, free), dt, *coefficients
+    )
+
+
+def _not_compiled(update: Callable) -> str:
+    """Why the update ``update``, not a plain function, runs on arrays, and how to compile it."""
+    name = getattr(update, "__qualname__", type(update).__name__)
+    fix = (
+        "make it a @staticmethod (an update takes x, v, a, dt and coefficients, not self)"
+        if isinstance(update, types.MethodType)
+        else "pass a plain function def update(x, v, a, dt, *coefficients)"
+    )
+    return (
+        f"numba compiles only plain functions, and the update {name} is a "
+        f"{type(update).__name__}: it runs on whole numpy arrays instead, with the same "
+        f"result, more slowly; to compile it, {fix}"
     )

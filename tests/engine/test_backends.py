@@ -262,3 +262,29 @@ def test_ground_clamp(backend: spring_kernel.SpringKernel, body: msd.Body, frict
     assert_close(v, v_ref)
     np.testing.assert_array_equal(x[body.fixed], x_old[body.fixed])
     assert removed == pytest.approx(removed_ref, rel=RTOL)
+
+
+class MethodUpdate(msd.Integrator):
+    """An integrator whose update is an ordinary method (it takes self)."""
+
+    def update(self, x: float, v: float, a: float, dt: float) -> tuple[float, float]:
+        return msd.SymplecticEuler.update(x, v, a, dt)
+
+    def step(
+        self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: msd.Dynamics
+    ) -> tuple[np.ndarray, np.ndarray]:
+        return dynamics.advance(self.update, x, v, dt)
+
+
+def test_an_update_that_is_a_method_says_how_to_compile_it(body: msd.Body) -> None:
+    """A method taking self is no plain function: numba cannot compile it. It runs on arrays
+    with the same result, and says once that a @staticmethod compiles."""
+    sim = msd.Simulation(body.copy(), MethodUpdate(), kernel="numba", max_stretch=None)
+    reference = msd.Simulation(body.copy(), msd.SymplecticEuler(), kernel="numpy")
+    with pytest.warns(RuntimeWarning, match=r"update MethodUpdate\.update .*@staticmethod"):
+        sim.run(steps=3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sim.run(steps=2)
+    reference.run(steps=5)
+    assert_close(sim.body.positions, reference.body.positions)
