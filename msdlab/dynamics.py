@@ -43,13 +43,16 @@ class Dynamics:
         self.body = body
         self.forces = list(forces)
         self.springs: SpringKernel = make_kernel(kernel)
+        self.springs.load(body.positions, body.velocities)  # the state it steps
         self.chosen = self.springs
         # the kernel of a step while a debugger traces the program (`Simulation.step`)
         self.readable = NumpyKernel() if kernel_left_to_msdlab(kernel) else None
         self.max_stretch = 0.0  # largest |d|/l seen in the last force evaluation
-        # The power (W) each mechanism takes out at the body's state, by ledger name: the
-        # dashpots' ("dashpot") and each force's, from the last pass there (None: none yet).
+        # The power (W) each mechanism takes out at the state a step starts from, by ledger
+        # name: the dashpots' ("dashpot") and each force's, from the last pass there.
         self.opening: dict[str, float] | None = None
+        # The new (x, v) the backend's last `advance` made: arrays no one else holds.
+        self.advanced: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
         self._pattern: JacobianPattern | None = None
 
     @property
@@ -75,7 +78,8 @@ class Dynamics:
         for force in self.forces:
             _count(powers, force.ledger_name, force.add_to(self.body, x, v, total))
         self.max_stretch = sums.stretch
-        if x is self.body.positions and v is self.body.velocities:
+        start = self.springs.state()  # a pass there is the one a step starts with
+        if x is start[0] and v is start[1]:
             self.opening = powers
         return total
 
@@ -95,7 +99,7 @@ class Dynamics:
         backend on whole arrays, the numba backend compiled into one loop with the springs'
         pass and a. The uniform fields go in as g, the other forces as an array.
 
-        A pass at the body's own state (where a step starts) keeps the power each mechanism
+        A pass at the state the backend steps (where a step starts) keeps the power each mechanism
         takes out there in `opening`, for the energy ledger: the dashpots' from the
         backend's pass over the springs, each force's from its `Force.add_to`.
         """
@@ -110,15 +114,23 @@ class Dynamics:
             _count(powers, force.ledger_name, force.add_to(self.body, x, v, others))
         step = self.springs.advance(update, self.body, x, v, field, dt, coefficients, others)
         self.max_stretch, powers["dashpot"] = step.stretch, step.power
-        if x is self.body.positions and v is self.body.velocities:
+        self.advanced = (step.x, step.v)
+        start = self.springs.state()  # a pass there is the one a step starts with
+        if x is start[0] and v is start[1]:
             self.opening = powers
         return step.x, step.v
 
     def powers_now(self) -> dict[str, float]:
-        """The power (W) each mechanism takes out at the body's state, by ledger name, from a
-        pass of its own there (kept in `opening`)."""
-        self.force(self.body.positions, self.body.velocities)
+        """The power (W) each mechanism takes out at the state the backend steps, by ledger
+        name, from a pass of its own there (kept in `opening`)."""
+        self.force(*self.springs.state())
         return self.opening
+
+    def choose(self, kernel: SpringKernel) -> None:
+        """Step with ``kernel`` from now on, from the state the one in use had."""
+        if kernel is not self.springs:
+            kernel.load(*self.springs.state())
+            self.springs = kernel
 
     def acceleration_of(
         self,

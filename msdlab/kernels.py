@@ -20,6 +20,7 @@ import numpy as np
 
 from . import equations
 from .body import Body
+from .host_state import HostState
 from .jacobian import JacobianPattern
 from .kernel_results import Advanced, Jacobians, SpringSums, Update
 from .springs import EdgeSprings
@@ -145,11 +146,12 @@ def ground_clamp(
     return float(np.sum(removed))
 
 
-class NumpyKernel:
+class NumpyKernel(HostState):
     """The readable kernel (`spring_kernel.SpringKernel`): the equations on whole arrays.
 
     It reads a body's springs as an edge list: an edge list's own arrays, or a
-    lattice laid out once per edit (``body.version``) and kept here.
+    lattice laid out once per edit (``body.version``) and kept here. The state it steps
+    is the host's arrays (`HostState`).
     """
 
     name = "numpy"

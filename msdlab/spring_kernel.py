@@ -4,11 +4,14 @@ A backend computes, for all springs of a body at once, what `Spring.force` compu
 one (eq. 1.1-1.2 with the dashpot), their energy and Jacobians, and steps the particles
 with an integrator's update; it also checks the state, sums the work of an integrator's
 velocity factor and clamps particles to the ground, booking the energy that takes out.
-`SpringKernel` is the whole contract, seven methods, none optional; nothing else asks a
-backend for more, and nothing asks which one runs: `kernels.NumpyKernel` (readable, whole
-arrays, the reference every backend is tested against) or `msdlab.compiled.NumbaKernel`
-(compiled loops, the default). Both apply the same `msdlab.equations`. What the methods
-return is named in `msdlab.kernel_results`.
+It holds the state it steps: the simulation loads the body's positions and velocities
+into it (`load`) and asks for them (`state`) where it needs arrays. `SpringKernel` is the
+whole contract, nine methods, none optional; nothing else asks a backend for more, and
+nothing asks which one runs: `kernels.NumpyKernel` (readable, whole arrays, the reference
+every backend is tested against) or `msdlab.compiled.NumbaKernel` (compiled loops, the
+default). Both apply the same `msdlab.equations`, and both keep the host's arrays as the
+state (`host_state.HostState`: loading and asking copy nothing). What the methods return
+is named in `msdlab.kernel_results`.
 """
 
 from __future__ import annotations
@@ -38,6 +41,18 @@ class SpringKernel(Protocol):
     """
 
     name: str
+
+    def load(self, x: np.ndarray, v: np.ndarray) -> None:
+        """Step from positions ``x`` (m) and velocities ``v`` (m/s), host arrays (N, d): the
+        body's state when a public call of the simulation starts, the step's end state after
+        each step. A CPU backend keeps the arrays; a GPU one would copy them to the device
+        unless they are the ones its `state` handed out."""
+
+    def state(self) -> tuple[np.ndarray, np.ndarray]:
+        """The positions (m) and velocities (m/s) being stepped, as host arrays (N, d), for
+        the integrator's step, the constraints, a recorded frame and the body at the end of
+        a public call. A CPU backend returns the arrays loaded; a GPU one would copy them
+        back from the device."""
 
     def spring_forces(
         self,

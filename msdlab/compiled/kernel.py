@@ -9,6 +9,7 @@ import numba
 import numpy as np
 
 from ..body import Body
+from ..host_state import HostState
 from ..kernel_results import Advanced, Jacobians, SpringSums
 from ..lattice import LatticeSprings
 from ..springs import EdgeSprings
@@ -36,7 +37,7 @@ PARALLEL_MIN_SPRINGS = 50_000
 PARALLEL_MIN_GATHERED = 250_000
 
 
-class NumbaKernel:
+class NumbaKernel(HostState):
     """The numba backend (`spring_kernel.SpringKernel`), with what a body needs kept between
     calls, made again when its springs are edited (``body.version``).
 

@@ -288,3 +288,14 @@ def test_an_update_that_is_a_method_says_how_to_compile_it(body: msd.Body) -> No
         sim.run(steps=2)
     reference.run(steps=5)
     assert_close(sim.body.positions, reference.body.positions)
+
+
+@pytest.mark.parametrize("name", spring_kernel.KERNELS)
+def test_a_cpu_backend_steps_the_arrays_it_is_given(name: str) -> None:
+    """`load` and `state`: the backend holds the state it steps; on the CPU backends the
+    arrays themselves, loaded and handed back without a copy."""
+    backend = spring_kernel.make_kernel(name)
+    x, v = np.zeros((4, 3)), np.ones((4, 3))
+    backend.load(x, v)
+    state = backend.state()
+    assert state[0] is x and state[1] is v

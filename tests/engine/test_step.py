@@ -253,3 +253,69 @@ def test_the_integrators_damping_is_summed_by_the_simulations_backend(kernel: st
     for backend in (None, sim.dynamics.springs):
         lost = msd.Verlet(0.1).dissipated_energy(v, masses, v_new, kernel=backend)
         assert lost == pytest.approx(expected, rel=1e-14)
+
+
+def edit_in_place(body: msd.Body) -> None:
+    """What the live view's drag and reset do: write into the body's arrays."""
+    body.positions[3] += (0.0, 0.5, 0.0)
+    body.velocities[3] = (1.0, 0.0, 0.0)
+
+
+def assign_whole(body: msd.Body) -> None:
+    """What the scenes and notebooks do: assign whole arrays."""
+    body.positions = body.positions + (0.0, 0.5, 0.0)
+    body.velocities = np.zeros_like(body.velocities)
+
+
+@pytest.mark.parametrize("edit", [edit_in_place, assign_whole])
+@pytest.mark.parametrize("call", ["step", "run", "run with frames apart"])
+def test_edits_of_the_body_between_calls_are_where_the_next_step_starts(edit, call) -> None:
+    """The backend holds the state while it steps; the body's state, edited between two
+    public calls, is what the next call steps from, whichever call came before."""
+    bodies = [falling_body(3, 4), falling_body(3, 4)]
+    sims = [
+        msd.Simulation(body, msd.Verlet(0.01), forces=[msd.Gravity(GRAVITY)]) for body in bodies
+    ]
+    for sim in sims:
+        if call == "step":
+            sim.step()
+        else:
+            sim.run(steps=4, record_every=1 if call == "run" else 3)
+    edit(bodies[0])
+    reference = falling_body(3, 4)
+    reference.positions, reference.velocities = bodies[1].positions, bodies[1].velocities
+    edit(reference)
+    x, v = reference.positions.copy(), reference.velocities.copy()
+    x_new, v_new = msd.Verlet(0.01).step(x, v, sims[0].dt, sims[0].dynamics)
+    sims[0].step()
+    free = ~bodies[0].fixed
+    np.testing.assert_array_equal(bodies[0].positions[free], x_new[free])
+    np.testing.assert_array_equal(bodies[0].velocities[free], v_new[free])
+
+
+def test_a_run_stores_its_state_in_the_body_at_frames_for_callbacks_and_at_the_end() -> None:
+    body = falling_body(3, 4)
+    sim = msd.Simulation(body, msd.Verlet(0.01), forces=[msd.Gravity(GRAVITY)])
+    seen = []
+
+    def watch(sim: msd.Simulation) -> None:
+        seen.append(sim.body.positions.copy())
+        sim.body.velocities[3] = 0.0  # an edit in a callback is kept
+
+    run = sim.run(steps=7, record_every=3, callback=watch)
+    np.testing.assert_array_equal(body.positions, run.positions[-1])
+    np.testing.assert_array_equal(body.positions, seen[-1])
+    assert len(seen) == 7 and not np.array_equal(seen[0], seen[1])
+    assert not body.velocities[3].any()
+    state = sim.dynamics.springs.state()
+    assert state[0] is body.positions and state[1] is body.velocities  # on the CPU: no copies
+
+
+def test_a_run_that_diverges_leaves_the_last_good_state_in_the_body() -> None:
+    body = falling_body(3, 4)
+    sim = msd.Simulation(body, msd.Verlet(0.0), dt=0.04, forces=[msd.Gravity(GRAVITY)])
+    with pytest.raises(msd.SimulationDiverged) as diverged:
+        sim.run(steps=2000, record_every=1000)
+    assert np.isfinite(body.positions).all() and np.isfinite(body.velocities).all()
+    assert sim.step_count == diverged.value.step > 1
+    assert not np.array_equal(body.positions, diverged.value.trajectory.positions[0])

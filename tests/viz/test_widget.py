@@ -199,6 +199,20 @@ def test_step_pauses_and_reset_goes_back_to_the_start():
     assert sim.step_count == 0 and sim.time == 0.0
 
 
+def test_a_step_after_reset_starts_from_the_start():
+    """Reset writes the start into the body's arrays; the next step steps from there."""
+    sim = gallery.mesh()
+    view = LiveView(sim)
+    for _ in range(3):
+        ask(view, type="step")
+    ask(view, type="reset")
+    ask(view, type="step")
+    fresh = gallery.mesh()
+    fresh.step()
+    np.testing.assert_array_equal(sim.body.positions, fresh.body.positions)
+    np.testing.assert_array_equal(sim.body.velocities, fresh.body.velocities)
+
+
 def test_the_thread_steps_at_its_own_pace_and_stops():
     view = viz.widget.live(gallery.mesh(), steps_per_second=60)
     try:
