@@ -89,7 +89,8 @@ class SpringKernel(Protocol):
 
         F is the spring forces plus ``forces`` (N, d) in N, the other forces, if given;
         g = ``field`` (d,) in m/s². The numpy backend does it in a few lines on arrays;
-        the numba backend runs the springs' pass, a and the update in compiled loops.
+        the numba backend runs the springs' pass, a and the update in compiled loops. The new
+        x and v are arrays no one else holds (the simulation keeps them as the state).
         """
 
     def damping_work(
