@@ -51,8 +51,9 @@ class SpringKernel(Protocol):
     def state(self) -> tuple[np.ndarray, np.ndarray]:
         """The positions (m) and velocities (m/s) being stepped, as host arrays (N, d), for
         the integrator's step, the constraints, a recorded frame and the body at the end of
-        a public call. A CPU backend returns the arrays loaded; a GPU one would copy them
-        back from the device."""
+        a public call. A CPU backend returns the arrays loaded; a GPU one would return its
+        arrays in managed memory, which the host reads without a copy (the architecture
+        page's GPU backend)."""
 
     def spring_forces(
         self,

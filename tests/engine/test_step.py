@@ -294,20 +294,26 @@ def test_edits_of_the_body_between_calls_are_where_the_next_step_starts(edit, ca
 
 
 def test_a_run_stores_its_state_in_the_body_at_frames_for_callbacks_and_at_the_end() -> None:
-    body = falling_body(3, 4)
-    sim = msd.Simulation(body, msd.Verlet(0.01), forces=[msd.Gravity(GRAVITY)])
+    bodies = [falling_body(3, 4), falling_body(3, 4)]
+    sims = [
+        msd.Simulation(body, msd.Verlet(0.01), forces=[msd.Gravity(GRAVITY)]) for body in bodies
+    ]
     seen = []
 
     def watch(sim: msd.Simulation) -> None:
         seen.append(sim.body.positions.copy())
-        sim.body.velocities[3] = 0.0  # an edit in a callback is kept
+        if sim.step_count == 2:
+            sim.body.positions[3, 1] += 1.0  # an edit in a callback is where the next step starts
 
-    run = sim.run(steps=7, record_every=3, callback=watch)
+    run = sims[0].run(steps=7, record_every=3, callback=watch)
+    sims[1].run(steps=7, record_every=3)
+    body = bodies[0]
     np.testing.assert_array_equal(body.positions, run.positions[-1])
     np.testing.assert_array_equal(body.positions, seen[-1])
     assert len(seen) == 7 and not np.array_equal(seen[0], seen[1])
-    assert not body.velocities[3].any()
-    state = sim.dynamics.springs.state()
+    lifted = body.positions[:, 1] - bodies[1].positions[:, 1]
+    assert lifted[3] == pytest.approx(1.0, abs=0.05)
+    state = sims[0].dynamics.springs.state()
     assert state[0] is body.positions and state[1] is body.velocities  # on the CPU: no copies
 
 
