@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab.compiled import reductions
+from msdlab.compiled import kernel as numba_kernel
 from msdlab.spring_kernel import make_kernel
 
 
@@ -33,26 +33,26 @@ def test_finite_sees_one_bad_coordinate(kernel: str, bad: float, where: str, ord
     assert not springs.finite(x, v)
 
 
-@pytest.mark.parametrize("count", [10, reductions.PARALLEL_MIN_PARTICLES + 1])
+@pytest.mark.parametrize("count", [10, numba_kernel.PARALLEL_MIN_PARTICLES + 1])
 @pytest.mark.parametrize("where", ["x", "v"])
 def test_finite_sees_a_bad_coordinate_anywhere(count: int, where: str) -> None:
     """The compiled check, on one thread and on the threads: every place is looked at."""
     rng = np.random.default_rng(count)
     x, v = rng.normal(size=(count, 3)), rng.normal(size=(count, 3))
-    assert reductions.finite(x, v)
+    assert numba_kernel.finite(x, v)
     for row in (0, count // 2, count - 1, *rng.integers(count, size=5)):
         bad = (x if where == "x" else v).copy()
         bad[row, rng.integers(3)] = np.nan
-        assert not reductions.finite(*((bad, v) if where == "x" else (x, bad)))
+        assert not numba_kernel.finite(*((bad, v) if where == "x" else (x, bad)))
 
 
 def test_finite_refuses_arrays_of_different_sizes() -> None:
     with pytest.raises(ValueError, match="same shape"):
-        reductions.finite(np.zeros((4, 3)), np.zeros((5, 3)))
+        numba_kernel.finite(np.zeros((4, 3)), np.zeros((5, 3)))
 
 
 @pytest.mark.parametrize(
-    "count", [3 * reductions.BLOCK + 17, reductions.PARALLEL_MIN_PARTICLES + 5]
+    "count", [3 * numba_kernel.BLOCK + 17, numba_kernel.PARALLEL_MIN_PARTICLES + 5]
 )
 def test_damping_work_sums_its_blocks_in_order(count: int) -> None:
     """One thread or several (past `PARALLEL_MIN_PARTICLES`): the blocks in the same order."""
@@ -63,8 +63,8 @@ def test_damping_work_sums_its_blocks_in_order(count: int) -> None:
         rng.normal(size=(count, 3)),
     )
     total = 0.0
-    for block in range(-(-count // reductions.BLOCK)):
-        total += reductions._kick_dots(masses, v, v_new, block)
-    got = reductions.damping_work(masses, v, v_new, 0.97)
+    for block in range(-(-count // numba_kernel.BLOCK)):
+        total += numba_kernel._kick_dots(masses, v, v_new, block)
+    got = numba_kernel.damping_work(masses, v, v_new, 0.97)
     assert got == (1.0 - 0.97) * (0.5 * total)
     assert got == pytest.approx(msd.energy.damping_work(masses, v, v_new, 0.97), rel=1e-12)
