@@ -91,19 +91,28 @@ def kinetic_energy(masses: np.ndarray, velocities: np.ndarray) -> float:
     return float(0.5 * np.sum(masses * np.einsum("ij,ij->i", velocities, velocities)))
 
 
+def kick_work(mass: float, kick: float, v_before: float, v_after: float) -> float:
+    """Work (J) of a velocity change ``kick`` Δv (m/s) given to a particle of ``mass`` (kg)
+    during a step, along one coordinate: ½ m Δv (v_before + v_after).
+
+    The force m·Δv/dt does work at the particle's velocity at the time it acts, the mean
+    of the step's start and end velocities: for position Verlet, (x(t+dt) - x(t-dt))/2dt.
+    Numbers or arrays of them; a contact's, the ground's and a velocity factor's work.
+    """
+    return 0.5 * mass * kick * (v_before + v_after)
+
+
 def contact_work(
     masses: np.ndarray, kick: np.ndarray, v_before: np.ndarray, v_after: np.ndarray
 ) -> float:
-    """Work (J) a contact did in one step: Σ m Δv·(v_before + v_after)/2.
+    """Work (J) a contact did in one step: Σ `kick_work`, Σ m Δv·(v_before + v_after)/2.
 
     ``kick`` (M, d) is the velocity change Δv the contact gave each particle in
     the step (its impulse per mass, m/s); ``v_before`` and ``v_after`` are the
-    velocities at the start and the end of the step. The contact force m·Δv/dt
-    does work at the particle's velocity at the time it acts, the mean of the
-    two: for position Verlet, (x(t+dt) - x(t-dt))/2dt. A contact that holds a
+    velocities at the start and the end of the step. A contact that holds a
     particle at rest does no work; one that stops a particle does negative work.
     """
-    return 0.5 * float(np.einsum("i,ij,ij->", masses, kick, v_before + v_after))
+    return float(np.sum(kick_work(masses[:, None], kick, v_before, v_after)))
 
 
 def ground_contact(
@@ -127,7 +136,7 @@ def ground_contact(
     (`contact_work` of the kick ṡ - v·n).
     """
     normal_speed = moved / dt
-    work = 0.5 * mass * (normal_speed - landing) * (before + normal_speed)
+    work = 0.5 * mass * (normal_speed - landing) * (before + normal_speed)  # `kick_work`'s
     return normal_speed, 0.5 * (1.0 - keep * keep) * mass * tangential_squared - work
 
 
@@ -142,5 +151,5 @@ def damping_work(
     end velocity v_after. Booking (1 - factor²)·½ Σ m v_before² instead misses
     the work against the forces' kick and leaves a first-order drift.
     """
-    kick_work = np.einsum("i,ij,ij->", masses, v_before, v_before + v_after)  # contact_work's
-    return (1.0 - factor) * 0.5 * float(kick_work)  # linear in Δv
+    kick = (factor - 1.0) * v_before
+    return -float(np.sum(kick_work(masses[:, None], kick, v_before, v_after)))

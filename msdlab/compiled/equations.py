@@ -16,6 +16,7 @@ dashpot_power = _inlined(equations.dashpot_power)
 transverse_stiffness = _inlined(equations.transverse_stiffness)
 acceleration = _inlined(equations.acceleration)
 ground_contact = _inlined(equations.ground_contact)
+kick_work = _inlined(equations.kick_work)
 
 
 @numba.njit(cache=True, inline="always")

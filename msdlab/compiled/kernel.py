@@ -34,6 +34,7 @@ from .equations import (
     acceleration,
     dashpot_power,
     ground_contact,
+    kick_work,
     separation,
     spring_energy,
     spring_state,
@@ -241,20 +242,20 @@ def finite(x, v):
 
 
 @numba.njit(cache=True)
-def _kick_dots(masses, v_before, v_after, block):
-    """Σ m v_before·(v_before + v_after) (kg·m²/s²) over the particles of ``block``."""
+def _kick_works(masses, v_before, v_after, factor, block):
+    """Σ `equations.kick_work` (J) of the kicks (factor - 1)·v_before over the particles of
+    ``block``."""
     total = 0.0
     for i in range(block * BLOCK, min(len(masses), (block + 1) * BLOCK)):
-        dot = 0.0
         for q in range(v_before.shape[1]):
-            dot += v_before[i, q] * (v_before[i, q] + v_after[i, q])
-        total += masses[i] * dot
+            kick = (factor - 1.0) * v_before[i, q]
+            total += kick_work(masses[i], kick, v_before[i, q], v_after[i, q])
     return total
 
 
 @numba.njit(cache=True, parallel=True)
 def damping_work(masses, v_before, v_after, factor):
-    """`equations.damping_work`: (1 - factor)·½ Σ m v_before·(v_before + v_after) (J).
+    """`equations.damping_work` (J): minus the work of the kicks (factor - 1)·v_before.
 
     Summed by blocks of `BLOCK` particles, on the threads for a big state
     (`PARALLEL_MIN_PARTICLES`), then over the blocks in order: the same sum either way.
@@ -262,14 +263,14 @@ def damping_work(masses, v_before, v_after, factor):
     sums = np.empty((len(masses) + BLOCK - 1) // BLOCK)
     if len(masses) < _REDUCTIONS_MIN_PARTICLES:
         for block in range(len(sums)):
-            sums[block] = _kick_dots(masses, v_before, v_after, block)
+            sums[block] = _kick_works(masses, v_before, v_after, factor, block)
     else:
         for block in numba.prange(len(sums)):
-            sums[block] = _kick_dots(masses, v_before, v_after, block)
+            sums[block] = _kick_works(masses, v_before, v_after, factor, block)
     total = 0.0
     for block in range(len(sums)):
         total += sums[block]
-    return (1.0 - factor) * (0.5 * total)
+    return -total
 
 
 # The ground's clamp in one loop over the particles, with its booking on the way. The
