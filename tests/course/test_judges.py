@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import os
 import signal
+import subprocess
+import sys
 import textwrap
 import time
 from multiprocessing import forkserver
@@ -14,7 +16,8 @@ from pathlib import Path
 import pytest
 
 from msdlab.course import runner
-from msdlab.instructor.judging.judges import ForkedJudges
+from msdlab.instructor.judging import grading
+from msdlab.instructor.judging.judges import SOCKET_PATH_BYTES, ForkedJudges
 
 CHECKS = """
 import os
@@ -78,3 +81,52 @@ def test_a_dead_server_is_started_again(server, tmp_path):
         time.sleep(0.05)
     (tmp_path / "second").mkdir()
     assert judge(server, tmp_path / "second")[0] == 0
+
+
+FORKED_UNDER_A_DEEP_TMPDIR = """
+import os, sys, tempfile
+from multiprocessing import forkserver
+from pathlib import Path
+from msdlab.course import runner
+from msdlab.instructor.judging.judges import ForkedJudges
+
+if __name__ == "__main__":
+    folder = Path(sys.argv[1])
+    assert len(tempfile.gettempdir()) > 80, tempfile.gettempdir()
+    arguments = ["-q", "-p", "no:cacheprovider", "--rootdir", str(folder), str(folder)]
+    status, printed = ForkedJudges().run(arguments, folder, runner.environment(), 120.0)
+    assert status == 0, printed
+    print(forkserver._forkserver._forkserver_pid)
+"""
+
+
+def test_a_temporary_folder_too_deep_for_a_socket_still_gets_a_judge_server(tmp_path):
+    deep = tmp_path / ("d" * (SOCKET_PATH_BYTES - len(str(tmp_path))))
+    deep.mkdir()
+    (tmp_path / "checks").mkdir()
+    (tmp_path / "checks" / "test_one.py").write_text("def test_one():\n    pass\n")
+    (tmp_path / "grade.py").write_text(FORKED_UNDER_A_DEEP_TMPDIR)
+    done = subprocess.run([sys.executable, str(tmp_path / "grade.py"), str(tmp_path / "checks")],
+                          env={**os.environ, "TMPDIR": str(deep)}, cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip().isdigit()  # the server ran the judge: no fresh start
+
+
+class NoServer(ForkedJudges):
+    def run(self, *args: object) -> tuple[int | None, str]:
+        raise OSError("AF_UNIX path too long")
+
+
+def test_without_a_server_each_judge_starts_afresh_and_the_grader_says_so_once(tmp_path, capsys):
+    (tmp_path / "test_one.py").write_text("def test_one():\n    pass\n")
+    arguments = ["-q", "-p", "no:cacheprovider", "--rootdir", str(tmp_path), str(tmp_path)]
+    server = NoServer()
+    for _ in range(2):
+        status, _ = grading._judge(arguments, tmp_path, runner.environment(), 120.0, server)
+        assert status == 0
+    said = capsys.readouterr().err.splitlines()
+    assert said == [
+        "msdlab grade: no judge server (OSError: AF_UNIX path too long); each judge starts "
+        "afresh, about a processor-second more a submission"
+    ]

@@ -401,8 +401,8 @@ def _judge(
     if server is not None:
         try:
             return server.run(arguments, workspace, environment, timeout)
-        except (EOFError, OSError):  # the server could not fork: a fresh judge grades
-            pass
+        except (EOFError, OSError) as error:  # no server could fork: a fresh judge grades
+            server.unavailable(error)
     return _run_judge(arguments, workspace, environment, timeout)
 
 

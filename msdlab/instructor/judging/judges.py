@@ -10,6 +10,11 @@ submission's judge to the next; the submission itself still runs only in its san
 the judge starts. As with any ``forkserver`` child, a script that grades must keep its work
 under ``if __name__ == "__main__":`` (each judge imports the script that started it).
 
+The server listens on a socket file in multiprocessing's temporary folder, under ``TMPDIR``;
+a socket's path holds at most 107 bytes, so where ``TMPDIR`` is too deep for it the folder
+is made in ``/tmp`` instead (`_short_socket_folder`). Where no server can start, each judge
+starts afresh (about a processor-second more a submission) and the grader says so once.
+
 The server is started with Python's safe-path setting (``PYTHONSAFEPATH``, Python 3.11 and
 later): its imports come from the installed packages, never from the folder grading runs
 in, where a clone of the course (a folder named ``msdlab``) would shadow the installed
@@ -22,14 +27,17 @@ import contextlib
 import multiprocessing
 import os
 import sys
+import tempfile
 import threading
-from multiprocessing import forkserver
+from multiprocessing import forkserver, util
 from pathlib import Path
 
 from . import processes
 
 PRELOAD = ["__main__", "hypothesis.strategies", "pytest", "scipy.linalg", "scipy.sparse", "msdlab"]
 SAFE_PATH = sys.version_info >= (3, 11)  # PYTHONSAFEPATH: no working folder on sys.path
+SOCKET_PATH_BYTES = 107  # a socket file's path, less its closing NUL (Linux's sun_path)
+SOCKET_NAME_BYTES = len("/pymp-12345678/listener-12345678")  # multiprocessing's names in it
 _STARTING = threading.Lock()
 
 
@@ -39,6 +47,15 @@ class ForkedJudges:
     def __init__(self) -> None:
         self.context = multiprocessing.get_context("forkserver")
         self.context.set_forkserver_preload(PRELOAD)
+        self._said_why = False
+
+    def unavailable(self, error: BaseException) -> None:
+        """Say once, on stderr, that judges start afresh because of ``error``."""
+        if not self._said_why:
+            self._said_why = True
+            print(f"msdlab grade: no judge server ({type(error).__name__}: {error}); each judge "
+                  "starts afresh, about a processor-second more a submission",
+                  file=sys.stderr)  # fmt: skip
 
     def run(
         self, arguments: list[str], cwd: Path, environment: dict[str, str], timeout: float
@@ -69,6 +86,7 @@ def _start_server() -> None:
     if not SAFE_PATH:
         raise OSError("a forkserver would import from the working folder before Python 3.11")
     with _STARTING:
+        _short_socket_folder()
         before = os.environ.get("PYTHONSAFEPATH")
         os.environ["PYTHONSAFEPATH"] = "1"  # inherited by the server, read at its start
         try:
@@ -78,6 +96,19 @@ def _start_server() -> None:
                 del os.environ["PYTHONSAFEPATH"]
             else:
                 os.environ["PYTHONSAFEPATH"] = before
+
+
+def _short_socket_folder() -> None:
+    """Make multiprocessing's temporary folder, where the server's socket file goes, in
+    ``/tmp`` when one under ``TMPDIR`` would make the socket's path too long."""
+    if len(tempfile.gettempdir()) + SOCKET_NAME_BYTES <= SOCKET_PATH_BYTES:
+        return
+    chosen = tempfile.tempdir
+    tempfile.tempdir = "/tmp"
+    try:
+        util.get_temp_dir()  # made now and kept for the process (removed at its exit)
+    finally:
+        tempfile.tempdir = chosen
 
 
 def _judge(arguments: list[str], cwd: str, environment: dict[str, str], output: str) -> None:
