@@ -25,6 +25,13 @@ from msdlab.instructor.points import gradebook_db
 SOLUTIONS = PROJECT_ROOT / "solutions"
 TEMPLATE = PROJECT_ROOT / "assignments"
 MSDLAB = Path(sys.executable).with_name("msdlab")
+# Started from a terminal, a command takes Ctrl-C; started in the background of a script
+# (as a test runner may be), it inherits SIGINT ignored. The run is started as from a terminal.
+AS_IN_A_TERMINAL = [
+    sys.executable, "-c",
+    "import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_DFL); "
+    "os.execv(sys.argv[1], sys.argv[1:])",
+]  # fmt: skip
 ENDLESS = """
 def particle_count(n: int = N) -> int:
     while True:
@@ -118,14 +125,18 @@ def test_ctrl_c_ends_the_run_at_once_and_resume_grades_exactly_the_rest(tmp_path
     (tmp_path / "tmp").mkdir()
     environment = dict(os.environ, TMPDIR=str(tmp_path / "tmp"))
     command = grade_command(out, checks, *folders, "--feedback", str(notes))
-    process = subprocess.Popen([*command, "--task-timeout", "600"], env=environment, text=True,
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               start_new_session=True)  # fmt: skip
-    deadline = time.monotonic() + 500
-    while graded_count(out) == 0 and process.poll() is None and time.monotonic() < deadline:
-        time.sleep(0.5)
-    os.killpg(process.pid, signal.SIGINT)  # as Ctrl-C in a terminal does
-    _, errors = process.communicate(timeout=120)  # far less than the endless loop's 600 s
+    process = subprocess.Popen([*AS_IN_A_TERMINAL, *command, "--task-timeout", "600"],
+                               env=environment, text=True, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, start_new_session=True)  # fmt: skip
+    try:
+        deadline = time.monotonic() + 500
+        while graded_count(out) == 0 and process.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.5)
+        os.killpg(process.pid, signal.SIGINT)  # as Ctrl-C in a terminal does
+        _, errors = process.communicate(timeout=120)  # far less than the endless loop's 600 s
+    finally:  # a run that outlives the test would be found by the next one
+        if process.poll() is None:
+            processes.kill_tree(process.pid)
     assert process.returncode == 130
     said = [line for line in errors.splitlines() if "interrupted" in line]
     assert len(said) == 1 and "Traceback" not in errors and "--resume" in said[0]
