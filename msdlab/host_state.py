@@ -1,8 +1,16 @@
-"""The state a backend on the CPU steps: the host's own arrays, loaded and handed back uncopied."""
+"""What both CPU backends keep between calls: the state they step (the host's own arrays,
+loaded and handed back uncopied) and a body's springs as an edge list."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
+
+from .springs import EdgeSprings
+
+if TYPE_CHECKING:
+    from .body import Body
 
 
 class HostState:
@@ -19,3 +27,16 @@ class HostState:
     def state(self) -> tuple[np.ndarray, np.ndarray]:
         """The positions (m) and velocities (m/s) being stepped: the arrays last loaded."""
         return self._state
+
+
+class KeptEdges:
+    """A backend's edge list of a body's springs: the body's own, or its lattice laid out
+    once per edit (``body.version``) and kept until the next."""
+
+    _edges: tuple[object, int, EdgeSprings] = (None, -1, EdgeSprings.empty())
+
+    def edges(self, body: Body) -> EdgeSprings:
+        """The springs of ``body`` as an edge list (a lattice's laid out once per edit)."""
+        if self._edges[0] is not body.spring_set or self._edges[1] != body.version:
+            self._edges = (body.spring_set, body.version, body.spring_set.edges())
+        return self._edges[2]

@@ -20,7 +20,7 @@ import numpy as np
 
 from . import equations
 from .body import Body
-from .host_state import HostState
+from .host_state import HostState, KeptEdges
 from .jacobian import JacobianPattern
 from .kernel_results import Advanced, Jacobians, SpringSums, Update
 from .springs import EdgeSprings
@@ -146,11 +146,11 @@ def ground_clamp(
     return float(np.sum(removed))
 
 
-class NumpyKernel(HostState):
+class NumpyKernel(HostState, KeptEdges):
     """The readable kernel (`spring_kernel.SpringKernel`): the equations on whole arrays.
 
     It reads a body's springs as an edge list: an edge list's own arrays, or a
-    lattice laid out once per edit (``body.version``) and kept here. The state it steps
+    lattice laid out once per edit (``body.version``, `KeptEdges`). The state it steps
     is the host's arrays (`HostState`).
     """
 
@@ -158,15 +158,6 @@ class NumpyKernel(HostState):
     finite = staticmethod(finite)
     damping_work = staticmethod(equations.damping_work)
     ground_clamp = staticmethod(ground_clamp)
-
-    def __init__(self) -> None:
-        self._edges: tuple[object, int, EdgeSprings] = (None, -1, EdgeSprings.empty())
-
-    def edges(self, body: Body) -> EdgeSprings:
-        """The springs of ``body`` as an edge list (a lattice's laid out once per edit)."""
-        if self._edges[0] is not body.spring_set or self._edges[1] != body.version:
-            self._edges = (body.spring_set, body.version, body.spring_set.edges())
-        return self._edges[2]
 
     def spring_forces(
         self,

@@ -134,12 +134,9 @@ class Simulation:
         read before may still hold the old state. Edits of the body's state made
         before the call are where the step starts.
         """
-        body = self.body
-        self.dynamics.springs.load(body.positions, body.velocities)  # `_load`, written out
+        self._load()
         self._step()
-        x, v = self.dynamics.springs.state()  # `_store`: a step enters fewer functions
-        if x is not body.positions or v is not body.velocities:
-            body.store_state(x, v)
+        self._store()
 
     def _load(self) -> None:
         """Hand the body's state to the backend: where a public call starts stepping."""

@@ -26,10 +26,9 @@ from numba.extending import register_jitable
 
 from .. import equations
 from ..body import Body
-from ..host_state import HostState
+from ..host_state import HostState, KeptEdges
 from ..kernel_results import Advanced, Jacobians, SpringSums
 from ..lattice import LatticeSprings
-from ..springs import EdgeSprings
 from .equations import (
     acceleration,
     dashpot_power,
@@ -436,7 +435,7 @@ def _not_compiled(update: Callable) -> str:
     )
 
 
-class NumbaKernel(HostState):
+class NumbaKernel(HostState, KeptEdges):
     """The numba backend (`spring_kernel.SpringKernel`), with what a body needs kept between
     calls, made again when its springs are edited (``body.version``).
 
@@ -453,18 +452,11 @@ class NumbaKernel(HostState):
     ground_clamp = staticmethod(ground_clamp)
 
     def __init__(self) -> None:
-        self._edges: tuple[object, int, EdgeSprings] = (None, -1, EdgeSprings.empty())
         self._sorted: tuple[object, int, tuple[np.ndarray, ...]] = (None, -1, ())
         self._gather = NO_PLAN  # see `lattice.plan`
         self._forces = np.zeros((0, 0))  # the spring forces of `advance`
         self._partial = np.zeros((0, 0, 0))  # the edge loop's extra threads' forces
         self._none = np.zeros((0, 0, 0))  # no threads' forces
-
-    def edges(self, body: Body) -> EdgeSprings:
-        """The springs of ``body`` as an edge list (a lattice's laid out once per edit)."""
-        if self._edges[0] is not body.spring_set or self._edges[1] != body.version:
-            self._edges = (body.spring_set, body.version, body.spring_set.edges())
-        return self._edges[2]
 
     def spring_forces(
         self,
