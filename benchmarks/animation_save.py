@@ -43,9 +43,8 @@ matplotlib.use("Agg")
 
 import numpy as np
 
-from msdlab import viz
+from msdlab import Trajectory, viz
 from msdlab.scenes import get_scene
-from msdlab.simulation import Trajectory
 
 FRAMES = 100
 FORMATS = (".gif", ".html")

@@ -51,7 +51,7 @@ def batches_us(run_once, repeats: int) -> list[float]:
 
 def ground_alone(sim):
     """`Ground.apply` on the state a step of ``sim`` reaches, run again and again."""
-    from msdlab.constraint import StepState
+    from msdlab import StepState
 
     body, ground = sim.body, sim.constraints[0]
     x, v = body.positions, body.velocities

@@ -9,11 +9,11 @@ trajectory = sim.run(duration=1.0, record_every=10)
 The public names are imported below for every tool that reads code (an IDE's completions,
 a type checker, a map of the imports), and at run time on first use (`__getattr__`), from
 the same lines: ``import msdlab`` alone imports no engine, so that ``msdlab check``
-starts at once; ``msd.Body`` imports `msdlab.body`, ``msd.max_stable_dt``
+starts at once; ``msd.Body`` imports `msdlab.engine.model.body`, ``msd.max_stable_dt``
 `msdlab.analysis` (which imports scipy).
 
 Debugging: under a debugger, or with ``MSDLAB_KERNEL=numpy`` set, the step runs on the
-readable numpy kernel, so a breakpoint in ``msdlab.equations`` (``spring_force``) or in an
+readable numpy kernel, so a breakpoint in ``msdlab.engine.equations`` (``spring_force``) or in an
 integrator's equation (``Verlet.update``) stops there.
 """
 
@@ -36,20 +36,8 @@ if TYPE_CHECKING:  # the public names; imported on first use at run time (`__get
         stability_limit,
         stiffest_mode,
     )
-    from .body import Body
-    from .constraint import Constraint, StepState
-    from .dynamics import Dynamics
-    from .energy import (
-        EnergyLedger,
-        angular_momentum,
-        elastic_energy,
-        gravitational_energy,
-        kinetic_energy,
-        momentum,
-    )
-    from .errors import SimulationDiverged
-    from .forces import Force, Gravity, ViscousDamping
-    from .integrators import (
+    from .engine.dynamics import Dynamics
+    from .engine.integrators import (
         RK4,
         ExplicitEuler,
         ImplicitEuler,
@@ -58,11 +46,23 @@ if TYPE_CHECKING:  # the public names; imported on first use at run time (`__get
         VelocityVerlet,
         Verlet,
     )
+    from .engine.model.body import Body
+    from .engine.model.constraint import Constraint, StepState
+    from .engine.model.errors import SimulationDiverged
+    from .engine.model.forces import Force, Gravity, ViscousDamping
+    from .engine.model.particle import Particle
+    from .engine.model.rotation import rotation_matrix
+    from .engine.model.spring import Spring
+    from .engine.simulation.energy import (
+        EnergyLedger,
+        angular_momentum,
+        elastic_energy,
+        gravitational_energy,
+        kinetic_energy,
+        momentum,
+    )
+    from .engine.simulation.simulation import Simulation, Trajectory
     from .interaction import Drag, Grab, Ground, Prescribed, SphereContact, Walls
-    from .particle import Particle
-    from .rotation import rotation_matrix
-    from .simulation import Simulation, Trajectory
-    from .spring import Spring
 
 
 @functools.cache

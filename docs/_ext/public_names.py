@@ -1,7 +1,7 @@
 """The ``public-names`` directive: a package's ``__all__`` as an autosummary table.
 
 Each name links to where it is documented, the module that defines it (``msdlab.Body``
-is `msdlab.body.Body`), and shows the first sentence of its docstring::
+is `msdlab.engine.model.body.Body`), and shows the first sentence of its docstring::
 
     .. public-names:: msdlab
 """

@@ -5,7 +5,7 @@ calls of sweeps and grading side by side, here or on a Dask cluster (`cluster`).
 The predictions and measurements are re-exported from `msdlab`.
 """
 
-from ..stability import Mode, max_stable_dt, stability_limit, stiffest_mode
+from ..engine.simulation.stability import Mode, max_stable_dt, stability_limit, stiffest_mode
 from .measure import Convergence, bisect_blowup, convergence_order, measure_blowup_dt
 
 __all__ = [

@@ -9,15 +9,15 @@ from functools import partial
 
 import numpy as np
 
-from .. import kernels
-from ..body import Body
-from ..constraint import Constraint
-from ..errors import SimulationDiverged
-from ..forces import Force
-from ..integrators import Integrator
-from ..simulation import Simulation
-from ..springs import EdgeSprings
-from ..stability import max_stable_dt
+from ..engine.backends import numpy as numpy_backend
+from ..engine.integrators import Integrator
+from ..engine.model.body import Body
+from ..engine.model.constraint import Constraint
+from ..engine.model.errors import SimulationDiverged
+from ..engine.model.forces import Force
+from ..engine.model.springs import EdgeSprings
+from ..engine.simulation.simulation import Simulation
+from ..engine.simulation.stability import max_stable_dt
 
 
 def bisect_blowup(
@@ -78,7 +78,7 @@ def measure_blowup_dt(
 
 def _strain(edges: EdgeSprings, positions: np.ndarray) -> float:
     """The largest strain |l/l₀ - 1| of the springs ``edges`` at ``positions`` (N, d) in m."""
-    _, length = kernels.vectors(edges, positions)
+    _, length = numpy_backend.vectors(edges, positions)
     return float(np.max(np.abs(length / edges.rest_lengths - 1.0)))
 
 

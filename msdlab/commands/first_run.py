@@ -1,7 +1,7 @@
 """A first run on a machine: the numpy kernel runs it while numba compiles in the background.
 
 On a machine where numba's disk cache does not hold the numba kernel's loops yet
-(`spring_kernel.compiling_first`), compiling them costs about 10 CPU seconds, more than
+(`choice.compiling_first`), compiling them costs about 10 CPU seconds, more than
 the whole of `msdlab demo` takes on the numpy kernel, which computes the same with
 nothing to compile. So `start_engine` runs this process on the numpy kernel
 (``MSDLAB_KERNEL=numpy``) and starts one background process, on one core at a low
@@ -22,7 +22,7 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
-from ..spring_kernel import compiling_first
+from ..engine.backends.choice import compiling_first
 
 NOTE = (
     "first run on this machine: running on the numpy kernel while the compiled engine "

@@ -10,7 +10,7 @@ from typing import TextIO
 
 from tqdm.auto import tqdm
 
-from ..spring_kernel import compiling_first
+from ..engine.backends.choice import compiling_first
 
 # The line before a first run on a machine compiles the engine (a cold `msdlab demo` less
 # a warm one, benchmarks/first_run.py, on a quiet machine; cached on disk after that).
@@ -36,7 +36,7 @@ def step_bar(
     """A bar drawn once ``delay`` s have passed, updated by calling it with the ``unit``s done.
 
     A run that starts by compiling the engine (``compiling``; by default
-    `spring_kernel.compiling_first`) says so first (`COMPILING`); otherwise, if no step
+    `choice.compiling_first`) says so first (`COMPILING`); otherwise, if no step
     is done ``note_after`` s after the start, a line says why (`STARTING`).
     """
     compiling = compiling_first() if compiling is None else compiling

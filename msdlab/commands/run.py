@@ -10,11 +10,10 @@ import argparse
 import ast
 from pathlib import Path
 
-from .. import integrators
-from ..errors import SimulationDiverged
+from .. import Simulation, SimulationDiverged, Trajectory
+from ..engine import integrators
 from ..scenes import SCENES, Scene, get_scene, sweep
 from ..scenes.trampoline import EXPERIMENTS, experiment_table, run_experiment
-from ..simulation import Simulation, Trajectory
 from .first_run import start_engine
 from .progress import count_bar, step_bar
 

@@ -4,7 +4,8 @@ for the student's code.
 Each task asks for physics the engine already has (task 5 is ``msd.Verlet`` with damping,
 task 2 the engine's spring kernel, ...). `ANSWERS` names, per task, the engine entry points
 that would be its answer. `install` wraps them once per process (before a submission is
-imported, so ``from msdlab.kernels import spring_forces`` gets the wrapper too); inside
+imported, so ``from msdlab.engine.backends.numpy import spring_forces`` gets the wrapper
+too); inside
 `refusing`, a wrapped entry point of the task being checked raises `DelegationRefused` when
 it is called directly from a file of the submission's folder, or (classes) when it acts on
 an object of a class the submission defined, such as ``class DampedVerlet(msd.Verlet)``.
@@ -26,20 +27,23 @@ from typing import Any
 
 from .feedback import CheckFailed
 
-SPRING_KERNELS = ("msdlab.kernels:spring_forces", "msdlab.kernels:spring_vectors")
-DYNAMICS = ("msdlab.dynamics:Dynamics.__init__",)
-VERLET = ("msdlab.integrators:Verlet.__init__", "msdlab.integrators:Verlet.step")
-ROTATIONS = ("msdlab.rotation:rotation_matrix", "msdlab.body:Body.rotate")
+SPRING_KERNELS = (
+    "msdlab.engine.backends.numpy:spring_forces",
+    "msdlab.engine.backends.numpy:spring_vectors",
+)
+DYNAMICS = ("msdlab.engine.dynamics:Dynamics.__init__",)
+VERLET = ("msdlab.engine.integrators:Verlet.__init__", "msdlab.engine.integrators:Verlet.step")
+ROTATIONS = ("msdlab.engine.model.rotation:rotation_matrix", "msdlab.engine.model.body:Body.rotate")
 LATTICE = (
-    "msdlab.body:Body.grid",
-    "msdlab.lattice:neighbour_offsets",
-    "msdlab.lattice:grid_pairs",
-    "msdlab.lattice:grid_pair_blocks",
+    "msdlab.engine.model.body:Body.grid",
+    "msdlab.engine.model.lattice:neighbour_offsets",
+    "msdlab.engine.model.lattice:grid_pairs",
+    "msdlab.engine.model.lattice:grid_pair_blocks",
 )
 
 ANSWERS: dict[int, tuple[str, ...]] = {
     1: VERLET,  # verlet_step and height_after are a Verlet step and a Verlet run
-    2: (*SPRING_KERNELS, *DYNAMICS, "msdlab.body:Body.grid"),
+    2: (*SPRING_KERNELS, *DYNAMICS, "msdlab.engine.model.body:Body.grid"),
     3: (*ROTATIONS, *SPRING_KERNELS, *DYNAMICS),  # its spring_acceleration is task 2's physics
     4: LATTICE,
     5: VERLET,  # a subclass of msd.Verlet delegates too: its instances are refused
@@ -48,7 +52,7 @@ ANSWERS: dict[int, tuple[str, ...]] = {
 
 _CONDITIONS: dict[str, Callable[[inspect.BoundArguments], bool]] = {
     # a grid of particles without springs is no answer: only the engine's springs are
-    "msdlab.body:Body.grid": lambda call: bool(tuple(call.arguments["neighbours"])),
+    "msdlab.engine.model.body:Body.grid": lambda call: bool(tuple(call.arguments["neighbours"])),
 }
 """Entry points that are the answer only for some arguments: refused when this is true."""
 
@@ -61,7 +65,8 @@ class DelegationRefused(CheckFailed):
 
 
 def describe(entry: str) -> str:
-    """``msdlab.integrators:Verlet.step`` -> ``msdlab.Verlet.step`` (the name students use)."""
+    """``msdlab.engine.integrators:Verlet.step`` -> ``msdlab.Verlet.step`` (the name students
+    use)."""
     module, name = entry.split(":")
     public = name.removesuffix(".__init__")
     if public.split(".")[0] in getattr(sys.modules.get("msdlab"), "__all__", ()):

@@ -16,6 +16,8 @@ import numpy as np
 
 import msdlab as msd
 
+from ..engine.backends.numpy import spring_forces
+
 TEMPLATE_DT = 0.1
 TEMPLATE_GRAVITY = (0.0, -0.001, 0.0)
 
@@ -65,7 +67,7 @@ def grid_body(
 
 def spring_acceleration(body: msd.Body, x: np.ndarray) -> np.ndarray:
     """Acceleration (N, d) from the springs alone, eq. (1.1)-(1.2), by the engine."""
-    force, _ = msd.kernels.spring_forces(body, x, np.zeros_like(x))
+    force, _ = spring_forces(body, x, np.zeros_like(x))
     return force / body.masses[:, None]
 
 
@@ -79,7 +81,7 @@ def energies(
     frames = np.asarray(frames, dtype=float)
     v = (frames[2:] - frames[:-2]) / (2 * dt)
     kinetic = 0.5 * np.einsum("n,fni,fni->f", body.masses, v, v)
-    elastic = np.array([msd.kernels.elastic_energy(body, x) for x in frames[1:-1]])
+    elastic = np.array([msd.elastic_energy(body, x) for x in frames[1:-1]])
     potential = 0.0
     if g is not None:
         potential = -np.einsum("n,fni,i->f", body.masses, frames[1:-1], np.asarray(g, float))

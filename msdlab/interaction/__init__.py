@@ -1,6 +1,7 @@
 """Scene-level interaction: the ground, drag, walls, driven and grabbed particles, ball contact.
 
-Built on the engine core (`msdlab.constraint`, `msdlab.forces`); re-exported from `msdlab`.
+Built on the engine (`msdlab.engine.model.constraint`, `msdlab.engine.model.forces`);
+re-exported from `msdlab`.
 """
 
 from .constraints import Drag, Grab, Ground, Prescribed, Walls

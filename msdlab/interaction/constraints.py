@@ -11,10 +11,11 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from .. import energy, equations
-from ..body import Body
-from ..constraint import Constraint, StepState
-from ..errors import check_non_negative
+from ..engine import equations
+from ..engine.model.body import Body
+from ..engine.model.constraint import Constraint, StepState
+from ..engine.model.errors import check_non_negative
+from ..engine.simulation import energy
 
 _UP = {2: np.array([0.0, 1.0]), 3: np.array([0.0, 1.0, 0.0])}  # the default ground normal, +y
 
@@ -54,7 +55,7 @@ class Ground(Constraint):
     which is what position Verlet implies: no bounce, no sticking.
 
     The ledger books the work of the contact force, not the energy difference
-    across the clamp (`msdlab.equations.ground_contact`): the clamp gives each
+    across the clamp (`msdlab.engine.equations.ground_contact`): the clamp gives each
     particle a kick Δv along the normal, and the force m·Δv/dt works at the
     particle's mean velocity over the step. A particle held at rest gets no
     work; one that lands loses energy, and with Verlet the ground never puts
@@ -62,7 +63,7 @@ class Ground(Constraint):
     x(t+dt) is on the plane and x(t-dt) was not below it). A body at rest on the
     ground books nothing. Friction books the kinetic energy it takes out of the tangential velocity.
 
-    The step's backend does it (`SpringKernel.ground_clamp`): `kernels.ground_clamp` on
+    The step's backend does it (`SpringKernel.ground_clamp`): `backends.numpy.ground_clamp` on
     numpy arrays, the readable reference, or one compiled pass over the particles.
     """
 
@@ -95,7 +96,7 @@ class Ground(Constraint):
             )
 
     def apply(self, state: StepState) -> float:
-        """The backend's `ground_clamp` (`kernels.ground_clamp` on numpy arrays) on the step."""
+        """The backend's `ground_clamp` (`backends.numpy.ground_clamp` on arrays) on the step."""
         body = state.body
         n = _UP[body.dim] if self.normal is None else self.normal
         arrays = (state.x, state.v, state.x_old, state.v_old, body.masses, body.fixed, n)
@@ -139,7 +140,7 @@ class Walls(Constraint):
     speed and the ledger books nothing. When the lift costs all the normal
     kinetic energy (a particle resting on the wall), it stays on the wall
     (w' = 0) and the ledger books the work of the wall's push at the particle's
-    mean normal velocity over the step (`msdlab.energy.contact_work`): zero for
+    mean normal velocity over the step (`msdlab.engine.simulation.energy.contact_work`): zero for
     a particle at rest, a loss for one that comes to rest. So walls never put
     energy in, and a body resting on them keeps every ledger entry still.
 

@@ -6,9 +6,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..body import Body
-from ..errors import check_positive
-from ..forces import Force
+from ..engine.model.body import Body
+from ..engine.model.errors import check_positive
+from ..engine.model.forces import Force
 
 
 class SphereContact(Force):

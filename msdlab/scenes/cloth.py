@@ -22,11 +22,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..body import Body
-from ..forces import Gravity, ViscousDamping
-from ..integrators import Integrator, SymplecticEuler
-from ..lattice import lattice_springs
-from ..simulation import Simulation
+from .. import Body, Gravity, Integrator, Simulation, SymplecticEuler, ViscousDamping
+from ..engine.model.lattice import lattice_springs
 
 PINS = ("corners", "row")
 

@@ -25,10 +25,11 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .. import equations, kernels
-from ..dynamics import Dynamics
-from ..integrators import Integrator, State
-from ..spring_kernel import SpringKernel
+from .. import Dynamics, Integrator
+from ..engine import equations
+from ..engine.backends import numpy as numpy_backend
+from ..engine.backends.contract import SpringKernel
+from ..engine.integrators import State
 
 WALL_RULES = ("hard", "periodic")
 
@@ -83,9 +84,9 @@ class FrameEuler(Integrator):
             start = np.where(start < self.lower, start + span, start)
             start = np.where(body.fixed[:, None], x, start)
         x_new = start + dt * u
-        _, length = kernels.spring_vectors(body, x_new)
+        _, length = numpy_backend.spring_vectors(body, x_new)
         pushing = np.flatnonzero(length > self.min_length)
-        springs, _ = kernels.spring_forces(body, x_new, u, springs=pushing)
+        springs, _ = numpy_backend.spring_forces(body, x_new, u, springs=pushing)
         return x_new, u + dt * equations.acceleration(springs, masses, free)
 
     def dissipated_energy(

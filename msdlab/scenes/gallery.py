@@ -34,14 +34,9 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from ..body import Body
-from ..constraint import Constraint
-from ..forces import Force, Gravity
-from ..integrators import VelocityVerlet
+from .. import Body, Constraint, Force, Gravity, Simulation, VelocityVerlet, rotation_matrix
+from ..engine.model.units import PAGE
 from ..interaction import Drag, Prescribed, Walls
-from ..rotation import rotation_matrix
-from ..simulation import Simulation
-from ..units import PAGE
 from .frame_model import FrameEuler
 
 WIDTH, HEIGHT = 600.0, 400.0  # the page's canvas (px)

@@ -14,12 +14,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from ..body import Body
-from ..forces import Gravity
-from ..integrators import Integrator, Verlet
+from .. import Body, Gravity, Integrator, Simulation, Verlet, rotation_matrix
 from ..interaction import Ground
-from ..rotation import rotation_matrix
-from ..simulation import Simulation
 
 
 def jelly_cube(

@@ -6,7 +6,7 @@ import inspect
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from ..simulation import Simulation
+from .. import Simulation
 from . import cloth, gallery, jelly, trampoline
 
 

@@ -19,10 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import Integrator, SimulationDiverged, Trajectory
 from ..analysis.cluster import run_all
-from ..errors import SimulationDiverged
-from ..integrators import Integrator
-from ..simulation import Trajectory
 from .registry import Scene, get_scene
 
 RUN_SETTINGS = ("dt", "integrator", "duration")  # swept like the scene's own settings

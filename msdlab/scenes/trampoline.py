@@ -33,12 +33,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..body import Body
-from ..forces import Gravity
-from ..integrators import Integrator, VelocityVerlet
+from .. import Body, Gravity, Integrator, Simulation, VelocityVerlet
+from ..engine.model.lattice import grid_pairs, neighbour_offsets
 from ..interaction import Drag, SphereContact
-from ..lattice import grid_pairs, neighbour_offsets
-from ..simulation import Simulation
 
 BALL = -1  # the ball is the last particle of the body
 

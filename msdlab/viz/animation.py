@@ -25,7 +25,7 @@ from matplotlib.artist import Artist
 from matplotlib.figure import Figure
 from PIL import Image
 
-from ..simulation import Trajectory
+from .. import Trajectory
 from .replay import replay_page
 from .upright import resolve_up
 from .view import BodyView, check_colour, new_axes, rim_height, sags, strains

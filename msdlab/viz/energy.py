@@ -8,7 +8,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from ..energy import EnergyLedger
+from .. import EnergyLedger
 from .view import save_figure
 
 

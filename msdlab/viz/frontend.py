@@ -17,9 +17,8 @@ import numpy as np
 from matplotlib import colormaps
 from matplotlib.colors import to_hex
 
-from ..body import Body
+from .. import Body, Simulation
 from ..interaction import Ground, Walls
-from ..simulation import Simulation
 from .lines import LEVELS
 from .upright import UPS
 

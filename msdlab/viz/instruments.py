@@ -12,9 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..body import Body
-from ..forces import Gravity
-from ..simulation import Simulation
+from .. import Body, Gravity, Simulation
 
 TOOLS = ("stopwatch", "ruler", "trace", "lines", "arrows")  # the page's toggles, in order
 GRAVITY = {"Earth": 9.81, "Moon": 1.62, "Jupiter": 24.79, "zero": 0.0}  # |g| in m/s²

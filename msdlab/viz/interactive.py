@@ -19,9 +19,8 @@ from matplotlib.axes import Axes
 from matplotlib.backend_bases import MouseEvent
 from matplotlib.patches import Rectangle
 
-from ..errors import SimulationDiverged
+from .. import Simulation, SimulationDiverged
 from ..interaction import Grab, Walls
-from ..simulation import Simulation
 from .upright import resolve_up
 from .view import LIVE_STRAIN_LIMIT, BodyView, new_axes, spheres_of
 

@@ -17,7 +17,7 @@ from html import escape
 
 import numpy as np
 
-from ..simulation import Simulation, Trajectory
+from .. import Simulation, Trajectory
 from . import frontend
 
 PAGE = """<!DOCTYPE html>

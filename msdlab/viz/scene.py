@@ -8,8 +8,8 @@ from typing import Any
 
 from matplotlib.figure import Figure
 
+from .. import Simulation, Trajectory
 from ..scenes.registry import Scene
-from ..simulation import Simulation, Trajectory
 from .animation import save_animation
 from .view import plot_body, spheres_of
 

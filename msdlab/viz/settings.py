@@ -12,10 +12,9 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ..forces import Gravity, ViscousDamping
+from .. import Gravity, Simulation, ViscousDamping
 from ..interaction import Drag
 from ..scenes.registry import Scene
-from ..simulation import Simulation
 
 
 @dataclass

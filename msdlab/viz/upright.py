@@ -13,9 +13,8 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from ..forces import Gravity
+from .. import Gravity, Simulation, Trajectory
 from ..interaction import Ground
-from ..simulation import Simulation, Trajectory
 
 UPS = ("x", "y", "z")
 

@@ -21,10 +21,9 @@ from matplotlib.patches import Circle
 from matplotlib.ticker import MaxNLocator, NullLocator
 from mpl_toolkits.mplot3d import proj3d
 
-from ..body import Body
+from .. import Body, Simulation
+from ..engine.model.springs import EdgeSprings
 from ..interaction import SphereContact
-from ..simulation import Simulation
-from ..springs import EdgeSprings
 from .lines import SpringLines, SpringLines3D
 from .upright import UPS, resolve_up
 

@@ -30,13 +30,10 @@ import anywidget
 import numpy as np
 import traitlets
 
-from ..energy import kinetic_energy
-from ..errors import SimulationDiverged
-from ..forces import Gravity
+from .. import Gravity, Simulation, SimulationDiverged, kinetic_energy
+from ..engine.model.units import SI
 from ..interaction import Grab, Ground, Walls
 from ..scenes.registry import Scene
-from ..simulation import Simulation
-from ..units import SI
 from . import frontend, instruments, settings
 from .export import Recording
 from .hand import HandPath

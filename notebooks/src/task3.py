@@ -23,8 +23,9 @@ import numpy as np
 from IPython.display import HTML, display
 
 import msdlab as msd
-from msdlab import kernels, viz
+from msdlab import viz
 from msdlab.course.notebook import Course
+from msdlab.engine.backends import numpy as kernels
 from msdlab.scenes import jelly
 
 course = Course()  # your assignments/ (MSDLAB_IMPL=solutions: the reference answers)

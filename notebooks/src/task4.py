@@ -20,8 +20,9 @@ import numpy as np
 from IPython.display import HTML, display
 
 import msdlab as msd
-from msdlab import kernels, viz
+from msdlab import viz
 from msdlab.course.notebook import Course
+from msdlab.engine.backends import numpy as kernels
 
 course = Course()  # your assignments/ (MSDLAB_IMPL=solutions: the reference answers)
 task4 = course.task(4)

@@ -1,19 +1,16 @@
-"""The imports of msdlab flow one way: no cycles, no upward imports, no hidden imports in the core.
+"""The imports of msdlab flow one way: no cycles, no upward imports, no hidden imports in the
+engine. The layers are msdlab's folders; a module may import its own layer and those below.
 
-The layers, lowest first; a module may import its own layer and the layers below:
+msdlab's layers, lowest first, are ``FOLDERS``: ``engine``; ``analysis`` and ``interaction``,
+built on it; the package ``msdlab`` itself (its ``__init__`` names the public names of the
+layers below); ``scenes`` and ``course``; ``viz``; ``instructor``; ``commands``; and last the
+modules directly in ``msdlab/``, the ways in (``cli`` and its ``process`` settings,
+``__main__``, the Jupyter server's ``jupyter_extension``).
 
-0. the engine core: the modules directly in ``msdlab/`` (body, equations, the kernel
-   interface ``spring_kernel``, the numpy kernel ``kernels``, the Jacobian pattern
-   ``jacobian``, dynamics, stability, ...) and its numba backend ``msdlab.compiled``,
-   which only ``spring_kernel`` loads, when asked to
-1. ``msdlab.analysis`` and ``msdlab.interaction``, built on the core
-2. the package ``msdlab`` itself (its ``__init__`` re-exports 0 and 1)
-3. ``msdlab.scenes`` and ``msdlab.course``
-4. ``msdlab.viz`` and ``msdlab.jupyter_extension`` (the Jupyter server's side of the live
-   view and of the course's notebooks)
-5. ``msdlab.instructor``
-6. ``msdlab.commands``
-7. ``msdlab.cli``, the process settings it makes (``msdlab.process``) and ``msdlab.__main__``
+The engine's layers, lowest first, are what ``msdlab/engine/`` holds, a folder or a module
+each (``ENGINE``, as its ``__init__`` describes them): ``equations``, ``model``,
+``backends``, ``dynamics``, ``integrators``, ``simulation``. Every folder and module is
+in one layer: the test fails for one it does not know.
 
 Imports under ``if TYPE_CHECKING:`` are for type hints only and are not counted.
 """
@@ -26,22 +23,19 @@ from pathlib import Path
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[2] / "msdlab"
-LAYERS = {
-    "compiled": 0,
-    "analysis": 1,
-    "interaction": 1,
-    "scenes": 3,
-    "course": 3,
-    "viz": 4,
-    "jupyter_extension": 4,
-    "instructor": 5,
-    "commands": 6,
-    "cli": 7,
-    "process": 7,
-    "__main__": 7,
-}
-# The one import made inside a function in the core: the optional compiled backend.
-ALLOWED_LOCAL_IMPORTS = {("msdlab.spring_kernel", "msdlab.compiled")}
+FOLDERS = [
+    ("engine",),
+    ("analysis", "interaction"),
+    ("",),  # the package msdlab: its __init__
+    ("scenes", "course"),
+    ("viz",),
+    ("instructor",),
+    ("commands",),
+]
+ENGINE = ["equations", "model", "backends", "dynamics", "integrators", "simulation"]
+# The one import made inside a function in the engine: a compiled backend, when chosen.
+LOADS_BACKENDS = "msdlab.engine.backends.choice"
+COMPILED = ("msdlab.engine.backends.numba",)
 
 
 def module_name(path: Path) -> str:
@@ -52,12 +46,16 @@ def module_name(path: Path) -> str:
 MODULES = {module_name(path): path for path in sorted(PACKAGE.rglob("*.py"))}
 
 
-def layer(module: str) -> int:
-    """The layer of a module (see the module docstring)."""
-    parts = module.split(".")
-    if len(parts) == 1:
-        return 2
-    return LAYERS.get(parts[1], 0)
+def layer(module: str) -> tuple[int, int]:
+    """The layer of a module: its folder's place in `FOLDERS` (the modules directly in
+    msdlab/ last), and within the engine its folder's or module's place in `ENGINE`."""
+    parts = module.split(".")[1:]
+    if not parts:
+        return FOLDERS.index(("",)), 0
+    if MODULES[module].parent == PACKAGE and MODULES[module].name != "__init__.py":
+        return len(FOLDERS), 0
+    outer = next(i for i, names in enumerate(FOLDERS) if parts[0] in names)
+    return outer, ENGINE.index(parts[1]) if parts[0] == "engine" and len(parts) > 1 else -1
 
 
 def is_type_checking(node: ast.If) -> bool:
@@ -107,12 +105,23 @@ def imports(module: str) -> list[tuple[str, bool]]:
 GRAPH = {module: imports(module) for module in MODULES}
 
 
+def test_every_folder_and_engine_layer_is_known() -> None:
+    """A folder or engine module added is placed in a layer before it can be imported."""
+    folders = {path.name for path in PACKAGE.iterdir() if (path / "__init__.py").exists()}
+    assert folders == {name for names in FOLDERS for name in names if name}
+    inside = {path.stem for path in (PACKAGE / "engine").iterdir() if path.suffix == ".py"}
+    inside |= {path.name for path in (PACKAGE / "engine").iterdir() if path.is_dir()}
+    assert inside - {"__init__", "__pycache__"} == set(ENGINE)
+
+
 def test_the_parser_sees_the_imports() -> None:
     """A check that finds nothing proves nothing: known imports are found."""
-    assert ("msdlab.equations", False) in GRAPH["msdlab.kernels"]
-    assert ("msdlab.compiled", True) in GRAPH["msdlab.spring_kernel"]
-    assert ("msdlab.body", False) in GRAPH["msdlab.interaction.constraints"]
-    assert layer("msdlab.dynamics") == 0 < layer("msdlab.analysis.measure") < layer("msdlab")
+    assert ("msdlab.engine.equations", False) in GRAPH["msdlab.engine.backends.numpy"]
+    assert ("msdlab.engine.backends.numba", True) in GRAPH[LOADS_BACKENDS]
+    assert ("msdlab.engine.model.body", False) in GRAPH["msdlab.interaction.constraints"]
+    assert layer("msdlab.engine.model.body") < layer("msdlab.engine.dynamics")
+    assert layer("msdlab.engine.dynamics") < layer("msdlab.analysis.measure") < layer("msdlab")
+    assert layer("msdlab.commands") < layer("msdlab.cli")
 
 
 def test_no_import_cycles() -> None:
@@ -138,27 +147,29 @@ def test_imports_only_go_down_the_layers() -> None:
         f"{module} (layer {layer(module)}) imports {target} (layer {layer(target)})"
         for module, targets in GRAPH.items()
         for target, _ in targets
-        if layer(target) > layer(module)
+        if target in MODULES and layer(target) > layer(module)
     ]
     assert not upward, "\n".join(upward)
 
 
-def test_the_core_imports_at_the_top_of_its_modules() -> None:
+def test_the_engine_imports_at_the_top_of_its_modules() -> None:
     hidden = [
         f"{module} imports {target} inside a function"
         for module, targets in GRAPH.items()
         for target, in_function in targets
-        if layer(module) == 0 and in_function and (module, target) not in ALLOWED_LOCAL_IMPORTS
+        if module.startswith("msdlab.engine.")
+        and in_function
+        and not (module == LOADS_BACKENDS and target.startswith(COMPILED))
     ]
     assert not hidden, "\n".join(hidden)
 
 
-def test_only_the_kernel_choice_loads_the_numba_backend() -> None:
-    """Importing msdlab needs no numba: the backend is loaded by `make_kernel` alone."""
+def test_only_the_kernel_choice_loads_a_compiled_backend() -> None:
+    """Importing msdlab needs no numba: a compiled backend is loaded by `make_kernel` alone."""
     loaders = {
         (module, in_function)
         for module, targets in GRAPH.items()
         for target, in_function in targets
-        if target.startswith("msdlab.compiled") and not module.startswith("msdlab.compiled")
+        if target.startswith(COMPILED) and not module.startswith(COMPILED)
     }
-    assert loaders == {("msdlab.spring_kernel", True)}
+    assert loaders == {(LOADS_BACKENDS, True)}

@@ -44,7 +44,8 @@ def run(code: str) -> str:
 
 
 def test_importing_msdlab_sets_nothing() -> None:
-    code = f"import os, msdlab, msdlab.compiled; print([os.environ.get(k) for k in {SETTINGS!r}])"
+    code = "import os, msdlab, msdlab.engine.backends.numba\n"
+    code += f"print([os.environ.get(k) for k in {SETTINGS!r}])"
     assert run(code) == str([None] * len(SETTINGS))
 
 

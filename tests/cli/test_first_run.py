@@ -12,7 +12,7 @@ import time
 from msdlab.commands.first_run import NOTE, compiling_lock
 from msdlab.commands.progress import COMPILING, STARTING, step_bar
 
-ASK = "from msdlab.spring_kernel import compiling_first; print(compiling_first())"
+ASK = "from msdlab.engine.backends.choice import compiling_first; print(compiling_first())"
 
 
 def test_a_run_that_compiles_says_so_before_the_first_step() -> None:

@@ -19,7 +19,7 @@ from msdlab.course.report import CheckReport
 SUBMISSION = """
 import numpy as np
 import msdlab as msd
-from msdlab.kernels import spring_forces
+from msdlab.engine.backends.numpy import spring_forces
 
 class Subclassed(msd.Verlet):
     pass

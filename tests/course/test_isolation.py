@@ -237,6 +237,10 @@ def test_the_engine_is_loaded_before_the_submission_runs(tmp_path):
     finally:
         remote.close()
     engine = set(sandbox_child.engine_modules())
-    assert {"msdlab.simulation", "msdlab.analysis", "msdlab.interaction.contact"} <= engine
+    assert {
+        "msdlab.engine.simulation.simulation",
+        "msdlab.analysis",
+        "msdlab.interaction.contact",
+    } <= engine
     assert not {name for name in engine if name.startswith("msdlab.instructor")}
     assert engine - loaded == set()

@@ -50,7 +50,7 @@ def test_shipped_files_are_the_engine_templates_notebooks_and_public_checks():
 
 def test_the_rules_by_path():
     for path in (
-        "msdlab/integrators.py",
+        "msdlab/engine/integrators.py",
         "msdlab/course/release_rules.py",
         "assignments/task3.py",
         "notebooks/task1.ipynb",

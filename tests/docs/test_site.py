@@ -34,7 +34,7 @@ PAGES = {
     "gallery": "gallery/scene_jelly_cube.html",
     "notebook": "notebooks/task2.html",
     "api": "api/index.html",
-    "module": "api/generated/msdlab.simulation.html",
+    "module": "api/generated/msdlab.engine.simulation.simulation.html",
     "equations": "engine/equations.html",
 }
 

@@ -44,7 +44,7 @@ def test_gallery_pages_show_a_picture_and_an_animation(site):
 
 def test_the_api_reference_has_a_page_per_listed_module(site):
     listed = re.findall(r"^   (msdlab[\w.]*)$", (DOCS / "api" / "index.md").read_text(), re.M)
-    assert "msdlab.simulation" in listed
+    assert "msdlab.engine.simulation.simulation" in listed
     for module in listed:
         assert (site / "api" / "generated" / f"{module}.html").exists(), module
 

@@ -1,7 +1,7 @@
 """Every spring kernel computes what the readable numpy kernel computes, method by method.
 
-The numpy kernel (`kernels.NumpyKernel`) is the reference. Each kernel named in
-`spring_kernel.KERNELS` runs each method of `spring_kernel.SpringKernel` on the same
+The numpy kernel (`backends.numpy.NumpyKernel`) is the reference. Each kernel named in
+`choice.KERNELS` runs each method of `contract.SpringKernel` on the same
 bodies (a cloth built from arrays, grids in 2-D and 3-D, a pinned body, a damped
 body) and must give the numpy kernel's results to rounding (`RTOL`; a compiled loop
 sums in its own order); its `advance` must give what the numpy kernel's forces,
@@ -18,9 +18,10 @@ import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab import equations, spring_kernel
-from msdlab.jacobian import JacobianPattern
-from msdlab.kernels import NumpyKernel
+from msdlab.engine import equations
+from msdlab.engine.backends import choice, contract
+from msdlab.engine.backends.jacobian import JacobianPattern
+from msdlab.engine.backends.numpy import NumpyKernel
 
 RTOL = 1e-12
 REFERENCE = NumpyKernel()
@@ -96,15 +97,15 @@ BODIES: dict[str, Callable[[], msd.Body]] = {
 # How a kernel is made to use its threads on these small bodies (its own thresholds).
 THREADED: dict[str, tuple[str, ...]] = {
     "numba": tuple(
-        f"msdlab.compiled.kernel.PARALLEL_MIN_{least}"
+        f"msdlab.engine.backends.numba.kernel.PARALLEL_MIN_{least}"
         for least in ("SPRINGS", "GATHERED", "PARTICLES")
     ),
 }
 
 
-@pytest.fixture(params=[name for name in spring_kernel.KERNELS if name != "numpy"])
+@pytest.fixture(params=[name for name in choice.KERNELS if name != "numpy"])
 def kernel(request: pytest.FixtureRequest) -> str:
-    """Each kernel of `spring_kernel.KERNELS` but the reference itself (this overrides the
+    """Each kernel of `choice.KERNELS` but the reference itself (this overrides the
     engine's two-kernel run)."""
     return request.param
 
@@ -112,14 +113,14 @@ def kernel(request: pytest.FixtureRequest) -> str:
 @pytest.fixture(params=["one thread", "threads"])
 def backend(
     request: pytest.FixtureRequest, kernel: str, monkeypatch: pytest.MonkeyPatch
-) -> spring_kernel.SpringKernel:
+) -> contract.SpringKernel:
     """The kernel under test, on one thread or made to share even small bodies out."""
     if request.param == "threads":
         if kernel not in THREADED:
             pytest.skip(f"the {kernel} kernel has no threads")
         for setting in THREADED[kernel]:
             monkeypatch.setattr(setting, 0)
-    return spring_kernel.make_kernel(kernel)
+    return choice.make_kernel(kernel)
 
 
 @pytest.fixture(params=list(BODIES))
@@ -132,7 +133,7 @@ def assert_close(actual: np.ndarray, expected: np.ndarray) -> None:
     np.testing.assert_allclose(actual, expected, rtol=RTOL, atol=RTOL * scale)
 
 
-def test_spring_forces(backend: spring_kernel.SpringKernel, body: msd.Body) -> None:
+def test_spring_forces(backend: contract.SpringKernel, body: msd.Body) -> None:
     """The forces are added to what ``out`` holds; the largest stretch and the dashpot
     power come by name; a subset of the springs gives its own forces."""
     x, v = body.positions, body.velocities
@@ -151,7 +152,7 @@ def test_spring_forces(backend: spring_kernel.SpringKernel, body: msd.Body) -> N
     assert subset == pytest.approx(reference, rel=RTOL, abs=1e-300)
 
 
-def test_elastic_energy(backend: spring_kernel.SpringKernel, body: msd.Body) -> None:
+def test_elastic_energy(backend: contract.SpringKernel, body: msd.Body) -> None:
     x = body.positions
     assert backend.elastic_energy(body, x) == pytest.approx(REFERENCE.elastic_energy(body, x))
     some = body.springs_touching(np.array([2, 7]))
@@ -159,7 +160,7 @@ def test_elastic_energy(backend: spring_kernel.SpringKernel, body: msd.Body) -> 
     assert backend.elastic_energy(body, x, some) == pytest.approx(expected, rel=RTOL)
 
 
-def test_jacobians(backend: spring_kernel.SpringKernel, body: msd.Body) -> None:
+def test_jacobians(backend: contract.SpringKernel, body: msd.Body) -> None:
     pattern = JacobianPattern(body)
     got = backend.jacobians(body, body.positions, pattern)
     expected = REFERENCE.jacobians(body, body.positions, pattern)
@@ -168,7 +169,7 @@ def test_jacobians(backend: spring_kernel.SpringKernel, body: msd.Body) -> None:
 
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf])
-def test_finite(backend: spring_kernel.SpringKernel, body: msd.Body, bad: float) -> None:
+def test_finite(backend: contract.SpringKernel, body: msd.Body, bad: float) -> None:
     x, v = body.positions.copy(), body.velocities.copy()
     assert backend.finite(x, v) and REFERENCE.finite(x, v)
     v[len(v) // 2, -1] = bad
@@ -193,7 +194,7 @@ UPDATES = {
 @pytest.mark.parametrize("update", list(UPDATES))
 @pytest.mark.parametrize("others", [False, True])
 def test_fused_advance(
-    backend: spring_kernel.SpringKernel, body: msd.Body, update: str, others: bool
+    backend: contract.SpringKernel, body: msd.Body, update: str, others: bool
 ) -> None:
     """The fused `advance` is the forces, a = (F + m·g)/m and the update on arrays, with the
     stretch and power of the pass; ``others`` adds forces beside the springs'."""
@@ -217,7 +218,7 @@ def test_fused_advance(
 
 
 def test_the_fused_advance_is_its_own_forces_then_the_update_bit_for_bit(
-    backend: spring_kernel.SpringKernel, body: msd.Body
+    backend: contract.SpringKernel, body: msd.Body
 ) -> None:
     """Fusing changes no bit: the kernel's own `spring_forces`, then a = (F + m·g)/m and
     `Verlet.update` on whole arrays give the same new state."""
@@ -234,14 +235,14 @@ def test_the_fused_advance_is_its_own_forces_then_the_update_bit_for_bit(
     assert (step.stretch, step.power) == sums
 
 
-def test_damping_work(backend: spring_kernel.SpringKernel, body: msd.Body) -> None:
+def test_damping_work(backend: contract.SpringKernel, body: msd.Body) -> None:
     v_new = np.random.default_rng(6).normal(size=body.velocities.shape)
     arrays = (body.masses, body.velocities, v_new, 0.97)
     assert backend.damping_work(*arrays) == pytest.approx(REFERENCE.damping_work(*arrays), rel=RTOL)
 
 
 @pytest.mark.parametrize("friction", [0.0, 0.3])
-def test_ground_clamp(backend: spring_kernel.SpringKernel, body: msd.Body, friction: float) -> None:
+def test_ground_clamp(backend: contract.SpringKernel, body: msd.Body, friction: float) -> None:
     """The same particles are put on the plane (a tilted one, above the middle of the body)
     with the same velocities, and the same energy is booked; fixed ones stay below."""
     normal = np.array([0.2, 1.0, -0.1][: body.dim])
@@ -290,11 +291,11 @@ def test_an_update_that_is_a_method_says_how_to_compile_it(body: msd.Body) -> No
     assert_close(sim.body.positions, reference.body.positions)
 
 
-@pytest.mark.parametrize("name", spring_kernel.KERNELS)
+@pytest.mark.parametrize("name", choice.KERNELS)
 def test_a_cpu_backend_steps_the_arrays_it_is_given(name: str) -> None:
     """`load` and `state`: the backend holds the state it steps; on the CPU backends the
     arrays themselves, loaded and handed back without a copy."""
-    backend = spring_kernel.make_kernel(name)
+    backend = choice.make_kernel(name)
     x, v = np.zeros((4, 3)), np.ones((4, 3))
     backend.load(x, v)
     state = backend.state()

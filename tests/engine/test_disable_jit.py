@@ -19,7 +19,7 @@ import json, sys
 import numba
 import numpy as np
 import msdlab as msd
-from msdlab.compiled import kernel
+from msdlab.engine.backends.numba import kernel
 
 if sys.argv[1] == "threads":  # every loop on its threaded variant
     for limit in ("PARALLEL_MIN_SPRINGS", "PARALLEL_MIN_GATHERED", "PARALLEL_MIN_PARTICLES"):

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab import kernels, spring_kernel
-from msdlab.compiled import NumbaKernel
+from msdlab.engine.backends import contract
+from msdlab.engine.backends import numpy as numpy_backend
+from msdlab.engine.backends.numba import NumbaKernel
 
 RTOL = 1e-12
 
@@ -35,7 +36,7 @@ def shuffled_body(seed: int = 0) -> msd.Body:
     return body
 
 
-def forces_by(kernel: spring_kernel.SpringKernel, body: msd.Body, springs=None) -> tuple:
+def forces_by(kernel: contract.SpringKernel, body: msd.Body, springs=None) -> tuple:
     out = np.zeros_like(body.positions)
     stretch, power = kernel.spring_forces(body, body.positions, body.velocities, out, springs)
     return out, stretch, power
@@ -48,7 +49,7 @@ def assert_same(actual: tuple, expected: tuple) -> None:
 
 
 def assert_close_to_numpy(body: msd.Body, kernel: NumbaKernel, springs=None) -> None:
-    expected = forces_by(kernels.NumpyKernel(), body, springs)
+    expected = forces_by(numpy_backend.NumpyKernel(), body, springs)
     actual = forces_by(kernel, body, springs)
     scale = np.abs(expected[0]).max()
     np.testing.assert_allclose(actual[0], expected[0], rtol=RTOL, atol=RTOL * scale)
@@ -128,7 +129,7 @@ def test_springs_edited_between_steps(threaded: bool, monkeypatch: pytest.Monkey
     """Springs edited between steps count at the next step, as if the body had been built
     with the new values."""
     if threaded:
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.engine.backends.numba.kernel.PARALLEL_MIN_SPRINGS", 0)
     body = shuffled_body(2)
     sim = msd.Simulation(body, msd.Verlet(0.01), dt=1e-3, kernel="numba")
     for step in range(3):

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab.constraint import StepState
+from msdlab.engine.model.constraint import StepState
 from msdlab.scenes import gallery
 
 

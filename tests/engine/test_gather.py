@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 import msdlab as msd
-import msdlab.compiled.kernel as compiled_kernel
-from msdlab import kernels
-from msdlab.compiled import NumbaKernel
-from msdlab.spring_kernel import SpringKernel
+import msdlab.engine.backends.numba.kernel as compiled_kernel
+from msdlab.engine.backends import numpy as numpy_backend
+from msdlab.engine.backends.contract import SpringKernel
+from msdlab.engine.backends.numba import NumbaKernel
 
 RTOL = 1e-12
 
@@ -44,7 +44,7 @@ def gathers(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     for name in ("gather_serial", "gather_parallel"):
         loop = getattr(compiled_kernel, name)
         monkeypatch.setattr(
-            f"msdlab.compiled.kernel.{name}",
+            f"msdlab.engine.backends.numba.kernel.{name}",
             lambda *args, name=name, loop=loop: ran.append(name) or loop(*args),
         )
     return ran
@@ -57,7 +57,7 @@ def forces_by(kernel: SpringKernel, body: msd.Body) -> tuple[np.ndarray, float, 
 
 
 def assert_agree(body: msd.Body, numba_kernel: NumbaKernel) -> None:
-    expected, stretch, power = forces_by(kernels.NumpyKernel(), body)
+    expected, stretch, power = forces_by(numpy_backend.NumpyKernel(), body)
     forces_by(numba_kernel, body)  # a second call must not see the first one's forces
     actual, actual_stretch, actual_power = forces_by(numba_kernel, body)
     scale = np.abs(expected).max()
@@ -87,8 +87,8 @@ def test_gather_matches_edge_loop_and_numpy(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     if threaded:
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
+        monkeypatch.setattr("msdlab.engine.backends.numba.kernel.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.engine.backends.numba.kernel.PARALLEL_MIN_GATHERED", 0)
     body = shaken_grid(shape, neighbours, damping)
     ran = gathers(monkeypatch)
     assert_agree(body, NumbaKernel())
@@ -108,8 +108,8 @@ def test_threads_give_the_same_sums_as_one_thread(
 ) -> None:
     body = shaken_grid(shape, neighbours, damping)
     one_thread = forces_by(NumbaKernel(), body)
-    monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
-    monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
+    monkeypatch.setattr("msdlab.engine.backends.numba.kernel.PARALLEL_MIN_SPRINGS", 0)
+    monkeypatch.setattr("msdlab.engine.backends.numba.kernel.PARALLEL_MIN_GATHERED", 0)
     threads = forces_by(NumbaKernel(), body)
     np.testing.assert_array_equal(threads[0], one_thread[0])
     assert threads[1:] == one_thread[1:]
@@ -165,9 +165,9 @@ def test_simulation_on_the_gather_follows_the_edge_loop(
     """200 steps of a grid falling onto the ground, SymplecticEuler and damped Verlet
     (threaded: the spring forces and the update, on the gather and on the edge loop)."""
     if threaded:
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_PARTICLES", 0)
+        monkeypatch.setattr("msdlab.engine.backends.numba.kernel.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.engine.backends.numba.kernel.PARALLEL_MIN_GATHERED", 0)
+        monkeypatch.setattr("msdlab.engine.backends.numba.kernel.PARALLEL_MIN_PARTICLES", 0)
     runs = []
     for gathered in (True, False):
         for integrator in (msd.SymplecticEuler(), msd.Verlet(0.01)):
@@ -190,8 +190,8 @@ def test_shuffled_springs_sorted_for_the_edge_loop(
 ) -> None:
     """Springs in a random order with random values: the sorted edge loop sees every edit."""
     if threaded:
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
+        monkeypatch.setattr("msdlab.engine.backends.numba.kernel.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.engine.backends.numba.kernel.PARALLEL_MIN_GATHERED", 0)
     grid = shaken_grid((4, 3, 5), (1, 2, 3), 0.0)
     order = np.random.default_rng(2).permutation(grid.n_springs)
     pairs = np.stack([grid.edges().a[order], grid.edges().b[order]], axis=1)
@@ -207,5 +207,5 @@ def test_shuffled_springs_sorted_for_the_edge_loop(
     assert_agree(body, kernel)
     touching = body.springs_touching(np.array([3, 8]))
     assert kernel.elastic_energy(body, body.positions, touching) == pytest.approx(
-        kernels.elastic_energy(body, body.positions, touching), rel=RTOL
+        numpy_backend.elastic_energy(body, body.positions, touching), rel=RTOL
     )

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab.lattice import grid_pairs, neighbour_offsets
+from msdlab.engine.model.lattice import grid_pairs, neighbour_offsets
 
 
 @pytest.mark.parametrize("n", [1, 2, 3, 5, 8])

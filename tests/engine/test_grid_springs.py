@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab.kernels import NumpyKernel
-from msdlab.lattice import LatticeSprings, grid_pairs, neighbour_offsets
-from msdlab.spring_kernel import make_kernel
-from msdlab.springs import EdgeSprings
+from msdlab.engine.backends.choice import make_kernel
+from msdlab.engine.backends.numpy import NumpyKernel
+from msdlab.engine.model.lattice import LatticeSprings, grid_pairs, neighbour_offsets
+from msdlab.engine.model.springs import EdgeSprings
 
 
 def jelly(shape: tuple[int, ...], damping: float = 0.0, seed: int = 0) -> msd.Body:
@@ -102,9 +102,9 @@ def test_a_run_matches_the_laid_out_body(
     if threads and kernel == "numpy":
         pytest.skip("threads are the numba kernel's")
     if threads:
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_PARTICLES", 0)
+        monkeypatch.setattr("msdlab.engine.backends.numba.kernel.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.engine.backends.numba.kernel.PARALLEL_MIN_GATHERED", 0)
+        monkeypatch.setattr("msdlab.engine.backends.numba.kernel.PARALLEL_MIN_PARTICLES", 0)
     trajectories = []
     for body in (jelly((6, 5, 7), 0.3), laid_out(jelly((6, 5, 7), 0.3))):
         body.positions[:, 1] += 0.05

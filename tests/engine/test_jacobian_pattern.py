@@ -8,8 +8,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 import msdlab as msd
-from msdlab import jacobian, kernels, spring_kernel
-from msdlab.dynamics import Dynamics
+from msdlab.engine.backends import choice, jacobian
+from msdlab.engine.backends import numpy as numpy_backend
+from msdlab.engine.dynamics import Dynamics
 
 
 def shaken_grid(seed: int = 0) -> msd.Body:
@@ -25,7 +26,7 @@ def shaken_grid(seed: int = 0) -> msd.Body:
 
 
 def fresh_jacobians(body: msd.Body, x: np.ndarray) -> tuple[sp.csr_matrix, sp.csr_matrix]:
-    """The blocks of `kernels.spring_jacobians` assembled from scratch (COO to CSR)."""
+    """The blocks of `numpy_backend.spring_jacobians` assembled from scratch (COO to CSR)."""
     dim = body.dim
     d = x[body.edges().a] - x[body.edges().b]
     length = np.linalg.norm(d, axis=1)
@@ -52,7 +53,7 @@ def fresh_implicit_step(body: msd.Body, dt: float) -> tuple[np.ndarray, np.ndarr
     x, v, dim = body.positions, body.velocities, body.dim
     jx, jv = fresh_jacobians(body, x)
     matrix = sp.diags(np.repeat(body.masses, dim)) - dt * jv - dt * dt * jx
-    force, _ = kernels.spring_forces(body, x, v)
+    force, _ = numpy_backend.spring_forces(body, x, v)
     rhs = dt * (force.ravel() + dt * (jx @ v.ravel()))
     free = np.repeat(~body.fixed, dim)
     dv = np.zeros_like(rhs)
@@ -63,7 +64,7 @@ def fresh_implicit_step(body: msd.Body, dt: float) -> tuple[np.ndarray, np.ndarr
 
 def test_pattern_jacobians_equal_fresh_assembly() -> None:
     body = shaken_grid()
-    jx, jv = kernels.spring_jacobians(body, body.positions)
+    jx, jv = numpy_backend.spring_jacobians(body, body.positions)
     fresh_x, fresh_v = fresh_jacobians(body, body.positions)
     np.testing.assert_allclose(jx.toarray(), fresh_x.toarray(), rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(jv.toarray(), fresh_v.toarray(), rtol=1e-12, atol=1e-12)
@@ -110,7 +111,7 @@ def test_each_kernel_sums_the_blocks_a_fresh_assembly_sums(kernel: str, shape: t
         body.springs_as_edges()  # values of their own per spring
         body.set_springs(slice(None, None, 2), damping=0.3)
     pattern = jacobian.JacobianPattern(body)
-    jx, jv = spring_kernel.make_kernel(kernel).jacobians(body, body.positions, pattern)
+    jx, jv = choice.make_kernel(kernel).jacobians(body, body.positions, pattern)
     fresh_x, fresh_v = fresh_jacobians(body, body.positions)
     np.testing.assert_allclose(jx.toarray(), fresh_x.toarray(), rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(jv.toarray(), fresh_v.toarray(), rtol=1e-12, atol=1e-12)
@@ -122,7 +123,7 @@ def test_coincident_ends_give_an_isotropic_block(kernel: str) -> None:
     body.set_springs(damping=0.5)
     body.positions[1] = body.positions[0]
     pattern = jacobian.JacobianPattern(body)
-    jx, jv = spring_kernel.make_kernel(kernel).jacobians(body, body.positions, pattern)
+    jx, jv = choice.make_kernel(kernel).jacobians(body, body.positions, pattern)
     block = 7.0 * np.eye(3)
     np.testing.assert_array_equal(jx.toarray(), np.block([[-block, block], [block, -block]]))
     np.testing.assert_array_equal(jv.toarray(), np.zeros((6, 6)))

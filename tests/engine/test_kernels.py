@@ -8,8 +8,10 @@ import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab import kernels, spring_kernel
-from msdlab.dynamics import Dynamics
+from msdlab.engine import equations
+from msdlab.engine.backends import choice
+from msdlab.engine.backends import numpy as numpy_backend
+from msdlab.engine.dynamics import Dynamics
 
 RTOL = 1e-12
 
@@ -58,11 +60,11 @@ def test_kernel_matches_spring_objects(
     if threaded:
         if kernel != "numba":
             pytest.skip("only the numba kernel has threads")
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_SPRINGS", 0)
-        monkeypatch.setattr("msdlab.compiled.kernel.PARALLEL_MIN_GATHERED", 0)
+        monkeypatch.setattr("msdlab.engine.backends.numba.kernel.PARALLEL_MIN_SPRINGS", 0)
+        monkeypatch.setattr("msdlab.engine.backends.numba.kernel.PARALLEL_MIN_GATHERED", 0)
     body = deformed_body(dim)
     x, v = body.positions, body.velocities
-    springs = spring_kernel.make_kernel(kernel)
+    springs = choice.make_kernel(kernel)
     assert springs.name == kernel
     forces, energy, power = per_spring(body)
     out = np.ones_like(x)  # the kernel adds to what is there
@@ -80,9 +82,9 @@ def test_public_numpy_functions_match_spring_objects() -> None:
     body = deformed_body(3, seed=1)
     x, v = body.positions, body.velocities
     forces, energy, power = per_spring(body)
-    assert_close(kernels.spring_forces(body, x, v)[0], forces, np.abs(forces).max())
-    assert kernels.elastic_energy(body, x) == pytest.approx(energy, rel=RTOL)
-    dashpots = kernels.NumpyKernel().spring_forces(body, x, v, np.zeros_like(x)).power
+    assert_close(numpy_backend.spring_forces(body, x, v)[0], forces, np.abs(forces).max())
+    assert numpy_backend.elastic_energy(body, x) == pytest.approx(energy, rel=RTOL)
+    dashpots = numpy_backend.NumpyKernel().spring_forces(body, x, v, np.zeros_like(x)).power
     assert dashpots == pytest.approx(power, rel=RTOL)
 
 
@@ -107,16 +109,16 @@ def test_accelerations_include_forces_and_subsets(dim: int) -> None:
 def test_kernel_choice(monkeypatch: pytest.MonkeyPatch) -> None:
     body = deformed_body(2)
     monkeypatch.setenv("MSDLAB_KERNEL", "numpy")
-    assert spring_kernel.default_kernel() == "numpy"
+    assert choice.default_kernel() == "numpy"
     assert msd.Simulation(body).dynamics.kernel == "numpy"
     monkeypatch.setenv("MSDLAB_KERNEL", "numba")
     assert msd.Simulation(body).dynamics.kernel == "numba"
     assert msd.Simulation(body, kernel="numpy").dynamics.kernel == "numpy"
     monkeypatch.delenv("MSDLAB_KERNEL")
-    assert spring_kernel.default_kernel() == "numba"
+    assert choice.default_kernel() == "numba"
     monkeypatch.setenv("MSDLAB_KERNEL", "fortran")
     with pytest.raises(ValueError, match="MSDLAB_KERNEL must be one of numba, numpy"):
-        spring_kernel.default_kernel()
+        choice.default_kernel()
     with pytest.raises(ValueError, match="kernel must be one of"):
         msd.Simulation(body, kernel="cuda")
 
@@ -130,7 +132,7 @@ def test_under_a_debugger_the_step_runs_the_readable_equations(
     monkeypatch.delenv("MSDLAB_KERNEL")
     stopped = []
 
-    watched = (msd.equations.spring_force.__code__, msd.Verlet.update.__code__)
+    watched = (equations.spring_force.__code__, msd.Verlet.update.__code__)
 
     def tracer(frame, event: str, argument: object):
         if event == "call" and frame.f_code in watched:

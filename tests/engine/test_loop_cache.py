@@ -10,14 +10,14 @@ import sys
 import pytest
 
 import msdlab as msd
-from msdlab.compiled import kernel as numba_kernel
+from msdlab.engine.backends.numba import kernel as numba_kernel
 
 # A process steps a small cube once and reports, for its Verlet update loop, how many
 # signatures numba compiled and how many it loaded from its disk cache.
 STEP_ONCE = """
 import json
 import msdlab as msd
-from msdlab.compiled import kernel
+from msdlab.engine.backends.numba import kernel
 cube = msd.Body.grid((3, 3, 3), spacing=0.1, stiffness=500.0)
 msd.Simulation(cube, msd.Verlet(0.01), dt=1e-3, forces=[msd.Gravity((0, -9.81, 0))]).step()
 (loop,) = [f for (update, _), f in kernel._LOOPS.items() if update is msd.Verlet.update]
@@ -60,7 +60,7 @@ COMPILE_ONE = """
 import json, sys
 import numpy as np
 import msdlab as msd
-from msdlab.compiled.kernel import compile_advance
+from msdlab.engine.backends.numba.kernel import compile_advance
 loop = compile_advance(msd.Verlet.update, threads=sys.argv[1] == "threads")
 x = np.zeros((4, 3))
 loop(x, x, x, np.zeros((0, 4, 3)), np.zeros(3), np.ones(4), np.zeros(4, bool), 1e-3, (0.01,),

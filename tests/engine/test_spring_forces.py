@@ -6,7 +6,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 import msdlab as msd
-from msdlab import kernels
+from msdlab.engine.backends import numpy as numpy_backend
 
 coordinates = st.floats(-3.0, 3.0, allow_nan=False, allow_infinity=False)
 
@@ -43,13 +43,15 @@ def rotations(draw: st.DrawFn, dim: int) -> np.ndarray:
 def forces(body: msd.Body, x: np.ndarray | None = None, v: np.ndarray | None = None) -> np.ndarray:
     x = body.positions if x is None else x
     v = body.velocities if v is None else v
-    return kernels.spring_forces(body, x, v)[0]
+    return numpy_backend.spring_forces(body, x, v)[0]
 
 
 def dashpot_power(body: msd.Body) -> float:
     """The power (W) the dashpots take, from the numpy kernel's pass over the springs."""
     x = body.positions
-    return kernels.NumpyKernel().spring_forces(body, x, body.velocities, np.zeros_like(x)).power
+    return (
+        numpy_backend.NumpyKernel().spring_forces(body, x, body.velocities, np.zeros_like(x)).power
+    )
 
 
 @given(random_bodies())

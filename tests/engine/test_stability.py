@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import msdlab as msd
+from msdlab.engine.simulation import stability
 
 
 def chain(n: int = 8, dim: int = 2) -> msd.Body:
@@ -80,7 +81,7 @@ def fine_scan_limit(integrator: msd.Integrator, mode: msd.Mode) -> float:
     unstable one, bisected to a relative 10⁻¹⁰ (0 below 10⁻⁵/ω, inf above 1000/ω)."""
     stable = 0.0
     for dt in np.logspace(-6, 3, 361) / mode.omega:
-        if msd.stability.spectral_radius(integrator, mode, dt) > 1.0 + 1e-12:
+        if stability.spectral_radius(integrator, mode, dt) > 1.0 + 1e-12:
             break
         stable = dt
     else:
@@ -90,7 +91,7 @@ def fine_scan_limit(integrator: msd.Integrator, mode: msd.Mode) -> float:
     low, high = stable, dt
     while high - low > 1e-10 * low:
         middle = 0.5 * (low + high)
-        unstable = msd.stability.spectral_radius(integrator, mode, middle) > 1.0 + 1e-12
+        unstable = stability.spectral_radius(integrator, mode, middle) > 1.0 + 1e-12
         low, high = (low, middle) if unstable else (middle, high)
     return low
 

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab.compiled import kernel as numba_kernel
+from msdlab.engine.backends.numba import kernel as numba_kernel
+from msdlab.engine.equations import damping_work
 
 GRAVITY = (0.0, -9.81, 0.0)
 
@@ -249,7 +250,7 @@ def test_the_integrators_damping_is_summed_by_the_simulations_backend(kernel: st
     assert sim.dissipated["integrator"] == pytest.approx(sum(sums), rel=1e-15) != 0.0
     v, v_new = np.ones((4, 3)), np.full((4, 3), 0.5)
     masses = np.arange(1.0, 5.0)
-    expected = msd.energy.damping_work(masses, v, v_new, 0.9)
+    expected = damping_work(masses, v, v_new, 0.9)
     for backend in (None, sim.dynamics.springs):
         lost = msd.Verlet(0.1).dissipated_energy(v, masses, v_new, kernel=backend)
         assert lost == pytest.approx(expected, rel=1e-14)

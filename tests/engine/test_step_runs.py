@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import msdlab as msd
-from msdlab.dynamics import Dynamics
+from msdlab.engine.dynamics import Dynamics
 
 
 def grid() -> msd.Body:

@@ -57,7 +57,7 @@ def test_a_step_of_the_jelly_cube_enters_few_functions(kernel: str) -> None:
     sim.run(steps=3)  # warm: compiled, and resting on the ground
     entered = functions_entered(sim)
     print(f"{len(entered)} functions entered by one step ({kernel} kernel):", *entered, sep="\n  ")
-    assert "simulation.Simulation.step" in entered
+    assert "engine.simulation.simulation.Simulation.step" in entered
     assert len(entered) <= MOST, f"{len(entered)} functions: {entered}"
 
 
@@ -89,7 +89,7 @@ def test_the_ledger_books_the_dashpots_from_the_pass_over_the_springs(kernel: st
     before = sim.dissipated["dashpot"]
     entered = functions_entered(sim)
     print(f"one step of a damped cloth ({kernel} kernel):", *entered, sep="\n  ")
-    assert "dynamics.Dynamics.powers_now" not in entered  # the ledger's own pass: none
+    assert "engine.dynamics.Dynamics.powers_now" not in entered  # the ledger's own pass: none
     expected = sim.dynamics.springs.spring_forces(body, x, v, np.zeros_like(x)).power * sim.dt
     assert sim.dissipated["dashpot"] - before == pytest.approx(expected, rel=1e-12)
     assert expected > 0.0
@@ -136,9 +136,8 @@ def test_a_breakpoint_set_after_building_stops_in_spring_force(tmp_path: Path) -
     kernel: a breakpoint set there in `equations.spring_force` stops at the next step."""
     script = tmp_path / "debug_me.py"
     script.write_text(PDB_SCRIPT)
-    commands = (
-        "import msdlab.equations\nbreak msdlab.equations.spring_force\ncontinue\nwhere\nquit\n"
-    )
+    commands = "import msdlab.engine.equations\nbreak msdlab.engine.equations.spring_force\n"
+    commands += "continue\nwhere\nquit\n"
     env = {key: value for key, value in os.environ.items() if key != "MSDLAB_KERNEL"}
     env["PYTHONBREAKPOINT"] = "pdb.set_trace"
     done = subprocess.run(

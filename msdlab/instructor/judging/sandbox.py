@@ -39,10 +39,10 @@ from typing import Any
 
 import numpy as np
 
+from ... import Integrator
 from ...course.delegation import DelegationRefused
 from ...course.report import WHERE
-from ...integrators import Integrator
-from ...spring_kernel import SpringKernel
+from ...engine.backends.contract import SpringKernel
 from . import processes, wire
 
 CHILD = Path(__file__).with_name("sandbox_child.py")

@@ -59,11 +59,12 @@ def _die_with_parent() -> None:
 
 
 NOT_ENGINE = frozenset({
-    "instructor", "course", "viz", "scenes", "commands", "compiled", "cli", "__main__",
-    "jupyter_extension",
+    "instructor", "course", "viz", "scenes", "commands", "cli", "__main__",
+    "jupyter_extension", "engine.backends.numba",
 })  # fmt: skip
-"""The parts of msdlab a submission's calls do not need: the grader's and the course's
-tools, the pictures, and the numba kernel (the sandbox runs the numpy kernel)."""
+"""The parts of msdlab a submission's calls do not need (dotted names below ``msdlab``): the
+grader's and the course's tools, the pictures, and the numba backend (the sandbox runs the
+numpy backend)."""
 
 
 def _load_engine() -> None:
@@ -87,7 +88,8 @@ def engine_modules() -> list[str]:
     while folders:
         path, prefix = folders.pop()
         for module in pkgutil.iter_modules(path, prefix):
-            if module.name.removeprefix("msdlab.").split(".")[0] in NOT_ENGINE:
+            parts = module.name.removeprefix("msdlab.").split(".")
+            if any(".".join(parts[:end]) in NOT_ENGINE for end in range(1, len(parts) + 1)):
                 continue
             names.append(module.name)
             if module.ispkg:

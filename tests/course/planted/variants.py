@@ -413,7 +413,7 @@ BUGS += [
         "delegated to the spring kernel",
         2,
         "    a = np.zeros_like(x)\n",
-        "    import msdlab as msd\n    from msdlab.kernels import spring_forces\n\n"
+        "    import msdlab as msd\n    from msdlab.engine.backends.numpy import spring_forces\n\n"
         "    body = msd.Body.from_arrays(x.reshape(-1, 3))\n"
         "    for axis in range(3):\n"
         "        index = np.arange(x[..., 0].size).reshape(x.shape[:3])\n"
@@ -831,7 +831,7 @@ BUGS += [
         "offsets delegated to the engine's lattice",
         4,
         "    steps = (-1, 0, 1)\n",
-        "    from msdlab.lattice import neighbour_offsets as engine_offsets\n\n"
+        "    from msdlab.engine.model.lattice import neighbour_offsets as engine_offsets\n\n"
         "    return engine_offsets(3, wanted)\n    steps = (-1, 0, 1)\n",
         "neighbour_offsets_26",
         "asks for your own implementation",

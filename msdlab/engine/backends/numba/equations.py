@@ -1,12 +1,13 @@
-"""The equations of `msdlab.equations`, compiled by numba for numbers and inlined in the loops.
+"""The equations of `msdlab.engine.equations`, compiled by numba for numbers and inlined in
+the loops.
 
-The same functions, not copies: each is `msdlab.equations`'s own code, handed to
+The same functions, not copies: each is `msdlab.engine.equations`'s own code, handed to
 ``numba.njit``, so the compiled loops compute exactly what the numpy kernel does.
 """
 
 import numba
 
-from .. import equations
+from ... import equations
 
 _inlined = numba.njit(cache=True, inline="always")
 

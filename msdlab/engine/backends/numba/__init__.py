@@ -1,16 +1,16 @@
-"""The numba backend: the same `msdlab.equations`, compiled into loops.
+"""The numba backend: the same `msdlab.engine.equations`, compiled into loops.
 
-Two files of compiled loops, which call the equations (`equations`: `msdlab.equations`'s
+Two files of compiled loops, which call the equations (`equations`: `msdlab.engine.equations`'s
 own functions, compiled) one spring or particle at a time:
 
-- `kernel`: `NumbaKernel`, with the methods of `kernels.NumpyKernel` in the same order,
+- `kernel`: `NumbaKernel`, with the methods of `backends.numpy.NumpyKernel` in the same order,
   and its loops: the edge loop over an edge list's springs sorted by their ends (forces,
   energy, Jacobian blocks), the finiteness check, the damping work, the ground's clamp,
   and an integrator's update function (for example `integrators.Verlet.update`) compiled
   into one loop over the particles with a = F/m, which also adds the spring forces the
   spring loop left to it;
 - `lattice`: the backend's second loop, chosen when the springs are a lattice
-  (`msdlab.lattice.LatticeSprings`, the springs of `Body.grid`): forces and energy by
+  (`msdlab.engine.model.lattice.LatticeSprings`, the springs of `Body.grid`): forces and energy by
   neighbour offset with no list of springs, and its layout.
 
 The loops are compiled on first use and cached on disk (``cache=True``), so compiling

@@ -7,10 +7,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .springs import EdgeSprings
+from ..model.springs import EdgeSprings
 
 if TYPE_CHECKING:
-    from .body import Body
+    from ..model.body import Body
 
 
 class HostState:

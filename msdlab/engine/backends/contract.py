@@ -7,28 +7,52 @@ velocity factor and clamps particles to the ground, booking the energy that take
 It holds the state it steps: the simulation loads the body's positions and velocities
 into it (`load`) and asks for them (`state`) where it needs arrays. `SpringKernel` is the
 whole contract, nine methods, none optional; nothing else asks a backend for more, and
-nothing asks which one runs: `kernels.NumpyKernel` (readable, whole arrays, the reference
-every backend is tested against) or `msdlab.compiled.NumbaKernel` (compiled loops, the
-default). Both apply the same `msdlab.equations`, and both keep the host's arrays as the
-state (`host_state.HostState`: loading and asking copy nothing). What the methods return
-is named in `msdlab.kernel_results`.
+nothing asks which one runs: `numpy.NumpyKernel` (readable, whole arrays, the reference
+every backend is tested against) or `numba.NumbaKernel` (compiled loops, the default).
+Both apply the same `msdlab.engine.equations`, and both keep the host's arrays as the
+state (`host.HostState`: loading and asking copy nothing). What the methods return is
+named here too (`SpringSums`, `Jacobians`, `Advanced`); `choice` picks the backend.
 """
 
 from __future__ import annotations
 
-import os
-import sys
-import warnings
-from typing import Protocol
+from collections.abc import Callable
+from typing import TYPE_CHECKING, NamedTuple, Protocol
 
 import numpy as np
+import scipy.sparse as sp
 
-from .body import Body
-from .jacobian import JacobianPattern
-from .kernel_results import Advanced, Jacobians, SpringSums, Update
-from .kernels import NumpyKernel
+if TYPE_CHECKING:
+    from ..model.body import Body
+    from .jacobian import JacobianPattern
 
-KERNELS = ("numba", "numpy")
+
+class SpringSums(NamedTuple):
+    """What a pass over the springs finds besides their forces."""
+
+    stretch: float  # the largest |x_a - x_b| / l, to detect blow-ups (dimensionless)
+    power: float  # Σ c ((v_a - v_b)·n)², the power the dashpots take out (W), >= 0
+
+
+class Jacobians(NamedTuple):
+    """The springs' ∂F/∂x (N/m) and ∂F/∂v (N·s/m), sparse (N·d × N·d)."""
+
+    position: sp.csr_matrix
+    velocity: sp.csr_matrix
+
+
+class Advanced(NamedTuple):
+    """One step of an integrator's update, and the `SpringSums` of the pass it took."""
+
+    x: np.ndarray  # positions (N, d) in m
+    v: np.ndarray  # velocities (N, d) in m/s
+    stretch: float
+    power: float
+
+
+# An integrator's update ``update(x, v, a, dt, *coefficients) -> (x_new, v_new)``, a function
+# of numbers or whole arrays (like `integrators.Verlet.update`).
+Update = Callable[..., tuple[np.ndarray, np.ndarray]]
 
 
 class SpringKernel(Protocol):
@@ -70,7 +94,7 @@ class SpringKernel(Protocol):
         """Energy (J) stored in the springs, Σ ½ k (|x_a - x_b| - l)²."""
 
     def jacobians(self, body: Body, x: np.ndarray, pattern: JacobianPattern) -> Jacobians:
-        """∂F/∂x and ∂F/∂v of the springs on ``pattern`` (see `kernels.spring_jacobians`)."""
+        """∂F/∂x and ∂F/∂v of the springs on ``pattern`` (see `backends.numpy.spring_jacobians`)."""
 
     def finite(self, x: np.ndarray, v: np.ndarray) -> bool:
         """Whether every position and velocity (N, d) is a finite number."""
@@ -114,65 +138,4 @@ class SpringKernel(Protocol):
         friction: float,
     ) -> float:
         """`interaction.Ground`: the free particles below the plane put back on it, in place
-        (`kernels.ground_clamp`); the energy (J) the ground removed."""
-
-
-def default_kernel() -> str:
-    """The spring kernel to use: ``MSDLAB_KERNEL`` if set; else "numpy" while a debugger
-    traces the program (`sys.gettrace`), so its breakpoints in `msdlab.equations` and in
-    an integrator's update stop; else "numba".
-
-    "numba" is the compiled loop of `msdlab.compiled`; "numpy" is the readable
-    array version of `msdlab.kernels`. Both apply the same `msdlab.equations`.
-    """
-    name = os.environ.get("MSDLAB_KERNEL", "").strip().lower()
-    if name:
-        return checked_kernel_name(name, "MSDLAB_KERNEL")
-    return "numpy" if sys.gettrace() is not None else "numba"
-
-
-def kernel_left_to_msdlab(name: str | None) -> bool:
-    """Whether a simulation asked for no kernel (``kernel=None`` and no ``MSDLAB_KERNEL``):
-    then each step runs on the numpy kernel while a debugger traces the program."""
-    return name is None and not os.environ.get("MSDLAB_KERNEL", "").strip()
-
-
-def checked_kernel_name(name: str, what: str) -> str:
-    """``name`` if it is a kernel's name, else a ValueError naming ``what`` and the choices."""
-    if name not in KERNELS:
-        raise ValueError(f"{what} must be one of {', '.join(KERNELS)}, got {name!r}")
-    return name
-
-
-def compiling_first() -> bool:
-    """Whether a run on the default kernel starts by compiling the numba kernel's loops
-    (a first run on a machine: `msdlab.compiled.loops_cached` is False)."""
-    if default_kernel() != "numba":
-        return False
-    try:
-        from .compiled import loops_cached
-    except ImportError:  # `make_kernel` warns and runs on numpy
-        return False
-    return loops_cached() is False
-
-
-def make_kernel(name: str | None = None) -> SpringKernel:
-    """The kernel called ``name`` ("numba" or "numpy"; default `default_kernel()`).
-
-    numba is a dependency of msdlab; if it cannot be imported (a broken
-    install), this warns and returns the numpy kernel, which computes the same.
-    """
-    name = default_kernel() if name is None else checked_kernel_name(name, "kernel")
-    if name == "numpy":
-        return NumpyKernel()
-    try:
-        from .compiled import NumbaKernel  # the one optional, compiled backend
-    except ImportError as error:
-        warnings.warn(
-            f"the numba kernel is unavailable ({error}); using the numpy kernel, which "
-            "computes the same more slowly. Reinstall msdlab (pip install -e .) to fix it.",
-            RuntimeWarning,
-            stacklevel=3,
-        )
-        return NumpyKernel()
-    return NumbaKernel()
+        (`backends.numpy.ground_clamp`); the energy (J) the ground removed."""

@@ -2,10 +2,10 @@
 springs, a step's update, and the ground's clamp, on whole arrays.
 
 `NumpyKernel` is the readable reference of the backend contract
-(`spring_kernel.SpringKernel`): the functions of this module, which apply
-`msdlab.equations` to the (E, d) arrays of all springs at once. Every other
+(`contract.SpringKernel`): the functions of this module, which apply
+`msdlab.engine.equations` to the (E, d) arrays of all springs at once. Every other
 backend is tested against it, method by method. The numba backend
-(`msdlab.compiled.NumbaKernel`, the default) applies the same equations one
+(`msdlab.engine.backends.numba.NumbaKernel`, the default) applies the same equations one
 spring or particle at a time in compiled loops.
 
 Every function reads a body's springs as an edge list (`springs.EdgeSprings`: ``a``,
@@ -18,12 +18,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import equations
-from .body import Body
-from .host_state import HostState, KeptEdges
+from .. import equations
+from ..model.body import Body
+from ..model.springs import EdgeSprings
+from .contract import Advanced, Jacobians, SpringSums, Update
+from .host import HostState, KeptEdges
 from .jacobian import JacobianPattern
-from .kernel_results import Advanced, Jacobians, SpringSums, Update
-from .springs import EdgeSprings
 
 
 def spring_vectors(body: Body, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -147,7 +147,7 @@ def ground_clamp(
 
 
 class NumpyKernel(HostState, KeptEdges):
-    """The readable kernel (`spring_kernel.SpringKernel`): the equations on whole arrays.
+    """The readable kernel (`contract.SpringKernel`): the equations on whole arrays.
 
     It reads a body's springs as an edge list: an edge list's own arrays, or a
     lattice laid out once per edit (``body.version``, `KeptEdges`). The state it steps

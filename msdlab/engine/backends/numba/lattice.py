@@ -28,7 +28,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-from ..lattice import LatticeSprings
+from ...model.lattice import LatticeSprings
 from .equations import dashpot_power, separation, spring_energy, spring_state
 
 # Particles a gather block holds (whole grid rows): long inner loops, enough blocks for threads.
@@ -184,19 +184,15 @@ def _pull_damped(y0, y1, y2, u0, u1, u2, xs, vs, q, there, k, rest, c):
 @numba.njit(cache=True, error_model="numpy")
 def _push_three(xs, vs, fs, squared, columns, masks, first, stop, shifts, springs, scales, pad):
     """Add to particles ``first`` to ``stop - 1`` the forces of their springs to three
-    neighbours, at p + ``shifts[j]``, the same grid row offset apart, and keep each
-    spring's f/|d| in ``scales[j, pad + p - first]`` for `_react`.
-
-    ``xs``, ``vs``, ``fs`` are positions, velocities and forces by coordinate,
-    contiguous, so the loop runs on vector registers; a particle's position
-    is read and its force written once for three springs. ``columns[masks[j], p - first]``
-    is 1 where p has neighbour j, 0 where it would leave p's grid row.
-    ``springs`` holds the springs' stiffness, rest length, dashpot and 1/rest²
-    (three numbers each); ``squared[p]`` keeps the largest |d|²/l² seen (a running maximum
-    would keep the loop scalar). Returns the dashpot power (W) of these
-    springs; with dashpots the loop stays scalar. Indices are unsigned: numba
-    then needs no negative-index test, which would also keep the loop scalar.
-    """
+    neighbours, at p + ``shifts[j]``, the same grid row offset apart, and keep each spring's
+    f/|d| in ``scales[j, pad + p - first]`` for `_react`. ``xs``, ``vs``, ``fs`` are
+    positions, velocities and forces by coordinate, contiguous (vector registers); a
+    particle's position is read and its force written once for three springs.
+    ``columns[masks[j], p - first]`` is 1 where p has neighbour j, 0 where it would leave
+    p's grid row. ``springs`` holds stiffness, rest length, dashpot and 1/rest² (three
+    each); ``squared[p]`` keeps the largest |d|²/l² (a running maximum would keep the loop
+    scalar). Returns the dashpot power (W); with dashpots the loop stays scalar. Unsigned
+    indices spare numba the negative-index test."""
     x0, x1, x2 = xs
     f0, f1, f2 = fs
     ma, mb, mc = masks  # rows of `columns`
@@ -409,23 +405,18 @@ def _totals(squares, powers):
 
 
 def _compile(parallel: bool) -> tuple[Callable, Callable]:
-    """`gather` and `grid_sum` compiled for threads (``parallel``) or for one thread, which
-    does the same work in the same order, so the same sums."""
+    """`gather` and `grid_sum` for threads (``parallel``) or one thread: the same sums."""
     loop = numba.prange if parallel else range
 
     @numba.njit(cache=True, parallel=parallel, error_model="numpy")
     def gather(x, v, out, add, *lattice):
         """Add to ``out`` (N, d) the forces of a lattice's springs, each computed once, from
-        the particle behind (`_push_unit`); return the largest stretch |d|/l and the
-        dashpot power (W), summed over the units in order. ``lattice`` is the fields of
-        its `Layout`, `Triples` and `Scratch`, in that order
-        (plain arrays and numbers: a call then costs no typing of named tuples); without
-        ``add`` the forces stay in the scratch's forces for the caller to add in a loop of
-        its own (see `kernel.compile_advance`).
-
-        The threads push every third unit at once, in three rounds, so no two write the
-        same particle.
-        """
+        the particle behind (`_push_unit`); return the largest stretch |d|/l and the dashpot
+        power (W), summed over the units in order. ``lattice`` is the fields of its
+        `Layout`, `Triples` and `Scratch` (plain arrays and numbers: a call types no named
+        tuples); without ``add`` the forces stay in the scratch for the caller's loop
+        (`kernel.compile_advance`). The threads push every third unit at once, in three
+        rounds, so no two write the same particle."""
         layout, triples, memory = (
             Layout(*lattice[:3]),
             Triples(*lattice[3:10]),

@@ -18,7 +18,7 @@ import numpy as np
 from .body import Body
 
 if TYPE_CHECKING:
-    from .spring_kernel import SpringKernel
+    from ..backends.contract import SpringKernel
 
 
 @dataclass

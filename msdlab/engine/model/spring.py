@@ -7,7 +7,7 @@ import operator
 
 import numpy as np
 
-from . import equations
+from .. import equations
 from .bound import Bound, Field
 from .errors import check_non_negative, check_positive, shown
 
@@ -34,8 +34,8 @@ class Spring(Bound):
         f_a = k (l - |x_a - x_b|) n  -  c ((v_a - v_b) · n) n,     f_b = -f_a
 
     ``rest_length=None`` takes the distance between the particles when the spring
-    is added to a body. `Spring.force` and the numpy kernel (`msdlab.kernels`) apply
-    `equations.spring_force`; the compiled loops (`msdlab.compiled`) its terms,
+    is added to a body. `Spring.force` and the numpy kernel (`msdlab.engine.backends.numpy`) apply
+    `equations.spring_force`; the compiled loops (`msdlab.engine.backends.numba`) its terms,
     `equations.spring_state`, one spring at a time. In a body, the object reads and writes
     spring ``index`` of the body's spring set (`Body.set_springs`).
     """

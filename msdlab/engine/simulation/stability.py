@@ -18,10 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from . import kernels
-from .body import Body
-from .forces import Force
-from .integrators import Integrator
+from ..backends import numpy as numpy_backend
+from ..integrators import Integrator
+from ..model.body import Body
+from ..model.forces import Force
 
 SCAN_PER_DECADE = 4  # trial dts a decade of `stability_limit`'s scan (a factor 1.78 apart)
 LIMIT_RTOL = 1e-8  # relative precision of `stability_limit` (the checks compare at 1e-6)
@@ -50,7 +50,7 @@ def stiffest_mode(body: Body, forces: Sequence[Force] = (), x: np.ndarray | None
     import scipy.sparse.linalg as spla
 
     x = body.positions if x is None else x
-    jx, jv = kernels.spring_jacobians(body, x)
+    jx, jv = numpy_backend.spring_jacobians(body, x)
     for force in forces:
         fx, fv = force.jacobians(body, x, body.velocities)
         jx = jx if fx is None else jx + fx
@@ -178,7 +178,7 @@ def describe_blowup(
         lines.append(f"particle {fastest} moves at {speed[fastest]:.3g} m/s")
     if body.n_springs:
         edges = body.edges()
-        stretch = kernels.vectors(edges, x)[1] / edges.rest_lengths
+        stretch = numpy_backend.vectors(edges, x)[1] / edges.rest_lengths
         worst = int(np.argmax(stretch))
         lines.append(
             f"spring {worst} (particles {edges.a[worst]}-{edges.b[worst]}) is at "

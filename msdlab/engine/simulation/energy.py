@@ -7,9 +7,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import equations, kernels
-from .body import Body
-from .equations import contact_work, damping_work
+from .. import equations
+from ..backends import numpy as numpy_backend
+from ..equations import contact_work, damping_work
+from ..model.body import Body
 
 __all__ = [
     "EnergyLedger",
@@ -31,7 +32,7 @@ def kinetic_energy(body: Body, v: np.ndarray | None = None) -> float:
 
 def elastic_energy(body: Body, x: np.ndarray | None = None) -> float:
     """Σ ½ k (|x_a - x_b| - l)² over all springs (J)."""
-    return kernels.elastic_energy(body, body.positions if x is None else x)
+    return numpy_backend.elastic_energy(body, body.positions if x is None else x)
 
 
 def gravitational_energy(body: Body, g: Sequence[float], x: np.ndarray | None = None) -> float:

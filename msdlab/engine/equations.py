@@ -1,8 +1,8 @@
 """The equations of the engine, each written once.
 
 Every function here is plain arithmetic, so it works on numbers and, by numpy
-broadcasting, on whole arrays. The numpy kernel (`msdlab.kernels`) calls them
-on arrays of all springs or particles; the numba kernel (`msdlab.compiled`)
+broadcasting, on whole arrays. The numpy kernel (`msdlab.engine.backends.numpy`) calls them
+on arrays of all springs or particles; the numba kernel (`msdlab.engine.backends.numba`)
 compiles the same functions and calls them on one spring or one coordinate
 at a time. `Spring`, the kernels and the integrators all use these, so there
 is no second copy of a formula to keep in step.

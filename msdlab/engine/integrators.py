@@ -30,7 +30,7 @@ from .dynamics import Dynamics
 from .equations import damping_work, kinetic_energy
 
 if TYPE_CHECKING:
-    from .spring_kernel import SpringKernel
+    from .backends.contract import SpringKernel
 
 State = tuple[np.ndarray, np.ndarray]
 

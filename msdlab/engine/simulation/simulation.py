@@ -11,16 +11,16 @@ from functools import partial
 
 import numpy as np
 
-from . import equations
-from .body import Body
-from .constraint import Constraint, StepState
-from .dynamics import Dynamics
+from .. import equations
+from ..dynamics import Dynamics
+from ..integrators import Integrator, Verlet
+from ..model.body import Body
+from ..model.constraint import Constraint, StepState
+from ..model.errors import SimulationDiverged, check_finite_array, check_positive, shown
+from ..model.forces import Force
+from ..model.units import SI, Units
 from .energy import EnergyLedger, kinetic_energy
-from .errors import SimulationDiverged, check_finite_array, check_positive, shown
-from .forces import Force
-from .integrators import Integrator, Verlet
 from .stability import describe_blowup
-from .units import SI, Units
 
 
 @dataclass

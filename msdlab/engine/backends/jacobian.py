@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .body import Body
+from ..model.body import Body
 
 
 class JacobianPattern:

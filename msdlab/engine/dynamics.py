@@ -8,12 +8,12 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import equations
-from .body import Body
-from .forces import Force
-from .jacobian import JacobianPattern
-from .kernel_results import Update
-from .kernels import NumpyKernel
-from .spring_kernel import SpringKernel, kernel_left_to_msdlab, make_kernel
+from .backends.choice import kernel_left_to_msdlab, make_kernel
+from .backends.contract import SpringKernel, Update
+from .backends.jacobian import JacobianPattern
+from .backends.numpy import NumpyKernel
+from .model.body import Body
+from .model.forces import Force
 
 
 def keep_acceleration(
@@ -32,9 +32,9 @@ class Dynamics:
     acceleration. Integrators call `acceleration` or `advance` (and `force`,
     `jacobians` or `implicit_matrix`, `masses`, `free` for implicit methods).
 
-    ``kernel`` picks the backend (`msdlab.spring_kernel`): "numba" (compiled,
+    ``kernel`` picks the backend (`msdlab.engine.backends.contract`): "numba" (compiled,
     threaded) or "numpy" (readable); the default is ``MSDLAB_KERNEL`` or "numba".
-    Both apply the same `msdlab.equations`; nothing here depends on which runs:
+    Both apply the same `msdlab.engine.equations`; nothing here depends on which runs:
     the springs' forces, energy and Jacobians and a step's a = F/m and update come
     from the backend; the uniform fields and the other forces are gathered here.
     """

@@ -1,11 +1,11 @@
-"""The numba backend: `NumbaKernel`, the methods of `kernels.NumpyKernel` on compiled loops.
+"""The numba backend: `NumbaKernel`, the methods of `backends.numpy.NumpyKernel` on compiled loops.
 
-The same `msdlab.equations`, compiled (`compiled.equations`: the equations' own functions
+The same `msdlab.engine.equations`, compiled (`numba.equations`: the equations' own functions
 handed to numba), applied one spring or particle at a time, in this file's loops: the edge
 loop over an edge list's springs sorted by their ends (forces, energy, Jacobian blocks),
 the finiteness check and the damping work, the ground's clamp, and an integrator's update
 compiled into one loop over the particles. A lattice (the springs of `Body.grid`) goes to
-the backend's second loop, by neighbour offset (`compiled.lattice`).
+the backend's second loop, by neighbour offset (`numba.lattice`).
 
 To step through these loops in a debugger, or print inside them, run them as plain Python
 with ``NUMBA_DISABLE_JIT=1`` (same results, slowly); to step through the readable
@@ -24,11 +24,11 @@ import numba
 import numpy as np
 from numba.extending import register_jitable
 
-from .. import equations
-from ..body import Body
-from ..host_state import HostState, KeptEdges
-from ..kernel_results import Advanced, Jacobians, SpringSums
-from ..lattice import LatticeSprings
+from ... import equations
+from ...model.body import Body
+from ...model.lattice import LatticeSprings
+from ..contract import Advanced, Jacobians, SpringSums
+from ..host import HostState, KeptEdges
 from .equations import (
     acceleration,
     dashpot_power,
@@ -199,7 +199,8 @@ elastic_energy_serial, elastic_energy_parallel = _compile_energy(False), _compil
 
 @numba.njit(cache=True)
 def jacobian_blocks(x, a, b, k, rest, c, stiff, damp):
-    """Each spring's blocks (E, d, d) of `kernels.spring_jacobians`: B = (k - k_t) n nᵀ + k_t I
+    """Each spring's blocks (E, d, d) of `backends.numpy.spring_jacobians`:
+    B = (k - k_t) n nᵀ + k_t I
     into ``stiff`` and, if it is not empty, C = c n nᵀ into ``damp``."""
     dim = x.shape[1]
     for s in range(len(a)):
@@ -215,7 +216,7 @@ def jacobian_blocks(x, a, b, k, rest, c, stiff, damp):
 
 
 # Sums over the state at the end of a step: one pass each, no temporary arrays, the same
-# quantities as the numpy kernel's (`kernels.finite`, `equations.damping_work`). The work
+# quantities as the numpy kernel's (`backends.numpy.finite`, `equations.damping_work`). The work
 # is summed over blocks of `BLOCK` particles, then over the blocks in order, so one thread
 # and several give the same sum; it may differ from numpy's in the last bits.
 
@@ -273,7 +274,7 @@ def damping_work(masses, v_before, v_after, factor):
 
 
 # The ground's clamp in one loop over the particles, with its booking on the way. The
-# numpy backend's `kernels.ground_clamp` takes some thirty numpy calls on the few particles
+# numpy backend's `backends.numpy.ground_clamp` takes some thirty numpy calls on the few particles
 # below the plane, which for a small body cost more than its springs; this loop does the
 # same per particle: put it back on the plane and apply `equations.ground_contact` (its new
 # normal speed and the energy removed).
@@ -282,7 +283,7 @@ def damping_work(masses, v_before, v_after, factor):
 @numba.njit(cache=True)
 def ground_clamp(x, v, x_old, v_old, masses, fixed, normal, height, dt, friction):
     """Clamp the free particles with x·n < ``height`` onto the plane, in place; return the
-    energy (J) the ground removed (`kernels.ground_clamp`, one particle at a time)."""
+    energy (J) the ground removed (`backends.numpy.ground_clamp`, one particle at a time)."""
     keep = 1.0 - friction
     removed = 0.0
     dim = x.shape[1]
@@ -436,7 +437,7 @@ def _not_compiled(update: Callable) -> str:
 
 
 class NumbaKernel(HostState, KeptEdges):
-    """The numba backend (`spring_kernel.SpringKernel`), with what a body needs kept between
+    """The numba backend (`contract.SpringKernel`), with what a body needs kept between
     calls, made again when its springs are edited (``body.version``).
 
     A lattice (`lattice.LatticeSprings`, the springs of `Body.grid`) is gathered by
@@ -490,7 +491,7 @@ class NumbaKernel(HostState, KeptEdges):
         return energy(x, *arrays, blocks)
 
     def jacobians(self, body: Body, x: np.ndarray, pattern: JacobianPattern) -> Jacobians:
-        """∂F/∂x and ∂F/∂v of the springs on ``pattern``, as `kernels.jacobians`, with the
+        """∂F/∂x and ∂F/∂v of the springs on ``pattern``, as `backends.numpy.jacobians`, with the
         blocks computed spring by spring."""
         edges = self.edges(body)
         dim = x.shape[1]

@@ -1,0 +1,10 @@
+"""The backends: what a step asks of the springs and the particles, and who computes it.
+
+- `contract`: the methods every backend has (`SpringKernel`) and what they return;
+- `choice`: which backend a simulation steps on (``kernel=``, ``MSDLAB_KERNEL``, and the
+  readable numpy one while a debugger traces the program);
+- `numpy`: the readable reference, the equations on whole arrays;
+- `numba`: the same equations compiled into loops (the default), loaded only when chosen;
+- `host`: the state and edge list both CPU backends keep; `jacobian`: the sparsity of the
+  springs' Jacobians, shared by every backend.
+"""

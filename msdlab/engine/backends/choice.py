@@ -1,0 +1,73 @@
+"""The choice of backend: by name, by ``MSDLAB_KERNEL``, or the readable one under a debugger."""
+
+from __future__ import annotations
+
+import os
+import sys
+import warnings
+
+from .contract import SpringKernel
+from .numpy import NumpyKernel
+
+KERNELS = ("numba", "numpy")
+
+
+def default_kernel() -> str:
+    """The spring kernel to use: ``MSDLAB_KERNEL`` if set; else "numpy" while a debugger
+    traces the program (`sys.gettrace`), so its breakpoints in `msdlab.engine.equations` and in
+    an integrator's update stop; else "numba".
+
+    "numba" is the compiled loop of `msdlab.engine.backends.numba`; "numpy" is the readable
+    array version of `msdlab.engine.backends.numpy`. Both apply the same `msdlab.engine.equations`.
+    """
+    name = os.environ.get("MSDLAB_KERNEL", "").strip().lower()
+    if name:
+        return checked_kernel_name(name, "MSDLAB_KERNEL")
+    return "numpy" if sys.gettrace() is not None else "numba"
+
+
+def kernel_left_to_msdlab(name: str | None) -> bool:
+    """Whether a simulation asked for no kernel (``kernel=None`` and no ``MSDLAB_KERNEL``):
+    then each step runs on the numpy kernel while a debugger traces the program."""
+    return name is None and not os.environ.get("MSDLAB_KERNEL", "").strip()
+
+
+def checked_kernel_name(name: str, what: str) -> str:
+    """``name`` if it is a kernel's name, else a ValueError naming ``what`` and the choices."""
+    if name not in KERNELS:
+        raise ValueError(f"{what} must be one of {', '.join(KERNELS)}, got {name!r}")
+    return name
+
+
+def compiling_first() -> bool:
+    """Whether a run on the default kernel starts by compiling the numba kernel's loops
+    (a first run on a machine: `msdlab.engine.backends.numba.loops_cached` is False)."""
+    if default_kernel() != "numba":
+        return False
+    try:
+        from .numba import loops_cached
+    except ImportError:  # `make_kernel` warns and runs on numpy
+        return False
+    return loops_cached() is False
+
+
+def make_kernel(name: str | None = None) -> SpringKernel:
+    """The kernel called ``name`` ("numba" or "numpy"; default `default_kernel()`).
+
+    numba is a dependency of msdlab; if it cannot be imported (a broken
+    install), this warns and returns the numpy kernel, which computes the same.
+    """
+    name = default_kernel() if name is None else checked_kernel_name(name, "kernel")
+    if name == "numpy":
+        return NumpyKernel()
+    try:
+        from .numba import NumbaKernel  # the one optional, compiled backend
+    except ImportError as error:
+        warnings.warn(
+            f"the numba kernel is unavailable ({error}); using the numpy kernel, which "
+            "computes the same more slowly. Reinstall msdlab (pip install -e .) to fix it.",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+        return NumpyKernel()
+    return NumbaKernel()
