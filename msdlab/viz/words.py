@@ -188,13 +188,19 @@ def energy_table(summary: BodySummary) -> list[tuple[str, float]]:
     return [*rows, ("total", total)]
 
 
+def counted(count: int, noun: str) -> str:
+    """The noun counted: "1 spring", "2 springs"."""
+    return f"{count} {noun}{'' if count == 1 else 's'}"
+
+
 def full(summary: BodySummary) -> str:
     """The whole state in words: the body, its size, its lowest point, what it does, the
     particle in hand and the energy table."""
     s, unit = summary, summary.length_unit
     scale = max(s.size) or 1.0
     pinned = f", {s.pinned} of them pinned" if s.pinned else ""
-    words = [f"A {len(s.size)}-D body of {s.particles} particles and {s.springs} springs{pinned}."]
+    parts = f"{counted(s.particles, 'particle')} and {counted(s.springs, 'spring')}"
+    words = [f"A {len(s.size)}-D body of {parts}{pinned}."]
     extent = ", ".join(f"{number(v, scale)} {unit} along {AXES[k]}" for k, v in enumerate(s.size))
     words.append(f"Its size: {extent}.")
     above = "the floor" if s.has_floor else "where gravity's energy is counted from"
