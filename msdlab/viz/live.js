@@ -83,6 +83,7 @@ const STYLE = `.msdlab-hidden { position: absolute; width: 1px; height: 1px; ove
   clip: rect(0 0 0 0); clip-path: inset(50%); white-space: nowrap; }
 .msdlab-live :focus-visible, .msdlab-live:focus-visible { outline: 3px solid #1a5fb4;
   outline-offset: 2px; }
+.msdlab-live .msdlab-canvas:focus-visible { outline-offset: -3px; }
 .msdlab-full { margin: 4px 0; padding: 4px 6px; border-left: 3px solid #1a5fb4;
   max-width: 640px; }`;
 

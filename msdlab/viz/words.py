@@ -18,6 +18,7 @@ from ..simulation import Simulation
 STILL = 0.01  # of the body's size a second watched: slower than this, it is resting
 TOUCHING = 0.02  # of the body's height: a lowest point this near the floor touches it
 SHARE_STEP = 10  # per cent: the shares said are rounded to this (a new line only on change)
+NOTHING = 1e-9  # of the largest energy: a mechanism's share this small is not said
 PUT_IN = ("hand", "driven")  # ledger entries of work put in, not energy lost
 AXES = "xyz"
 
@@ -178,10 +179,13 @@ def energy_table(summary: BodySummary) -> list[tuple[str, float]]:
     rows = [("kinetic", e["kinetic"]), ("spring", e["elastic"]), ("gravity", e["gravitational"])]
     if e.get("other"):
         rows.append(("other potential", e["other"]))
+    largest = max(abs(v) for _, v in rows) + max(map(abs, e["dissipated"].values()), default=0)
     for name, value in e["dissipated"].items():
-        if name in PUT_IN and value:
+        if abs(value) <= NOTHING * largest:  # nothing booked yet, or rounding's crumbs
+            continue
+        if name in PUT_IN:
             rows.append((f"{'your hand' if name == 'hand' else 'driven particles'} put in", -value))
-        elif value:
+        else:
             rows.append((f"taken out by {name}", value))
     total = sum(v for name, v in rows if not name.endswith("put in"))
     total -= sum(v for name, v in rows if name.endswith("put in"))
@@ -210,5 +214,5 @@ def full(summary: BodySummary) -> str:
         words.append(f"Particle {s.held} is in hand at {place(s.held_at, scale, unit)}.")
     table = "; ".join(f"{name} {value + 0.0:.3g}" for name, value in energy_table(s))
     words.append(f"Energy in {s.energy_unit}: {table}.")
-    words.append(f"Time {s.energy['time']:.4g} {s.time_unit}.")
+    words.append(f"Simulated time t = {s.energy['time']:.4g} {s.time_unit}.")
     return " ".join(words)

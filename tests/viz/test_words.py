@@ -77,15 +77,16 @@ def test_the_shares_are_coarse_and_sum_to_a_hundred():
 
 
 def test_the_whole_state_has_the_body_its_size_its_lowest_point_and_the_energy_table():
-    energy = {**ENERGY, "dissipated": {"drag": 0.5, "hand": -2.0}}
+    energy = {**ENERGY, "dissipated": {"drag": 0.5, "hand": -2.0, "walls": -4.4e-16}}
     text = words.full(summary(lowest=0.25, pinned=2, energy=energy))
     assert text.startswith("A 2-D body of 25 particles and 72 springs, 2 of them pinned.")
     assert "Its size: 1.20 m along x, 0.80 m along y." in text
     assert "Its lowest point is 0.25 m above the floor." in text
     assert (
         "Energy in J: kinetic 6; spring 2.9; gravity 1.1; taken out by drag 0.5; "
-        "your hand put in 2; total 8.5." in text  # 6 + 2.9 + 1.1 + 0.5 - 2
+        "your hand put in 2; total 8.5." in text  # 6 + 2.9 + 1.1 + 0.5 - 2; walls: crumbs
     )
+    assert text.endswith("Simulated time t = 1.5 s.")
 
 
 def test_a_running_view_sends_the_line_and_the_whole_state_when_asked():
