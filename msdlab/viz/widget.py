@@ -251,6 +251,7 @@ class LiveView(anywidget.AnyWidget):
             self.sim,
             velocities,
             self.energy,
+            springs=len(self.rest) // 4,  # float32 rest lengths, one a spring
             up=self._up,
             level=self._level,
             has_floor=self._floor,

@@ -59,6 +59,7 @@ def summarise(
     velocities: np.ndarray,
     energy: dict,
     *,
+    springs: int,
     up: int,
     level: float,
     has_floor: bool,
@@ -68,15 +69,16 @@ def summarise(
     stopped: str = "",
 ) -> BodySummary:
     """The summary of ``sim`` now, with its ``velocities`` at the positions' time and its
-    ``energy``; ``level``: the floor's height along axis ``up``; ``watched``: simulated
-    time per second of watching (the view's pace)."""
+    ``energy``; ``springs``: how many it has (counted once: a lattice lays its springs
+    out to count them); ``level``: the floor's height along axis ``up``; ``watched``:
+    simulated time per second of watching (the view's pace)."""
     x, masses = sim.body.positions, sim.body.masses
     size = tuple(float(s) for s in np.ptp(x, axis=0))
     mass = float(np.sum(masses))
     rise = float(masses @ velocities[:, up]) / mass if mass > 0 else 0.0
     return BodySummary(
         particles=len(sim.body),
-        springs=len(sim.body.edges().a),
+        springs=springs,
         pinned=int(np.count_nonzero(sim.body.fixed)) - (held is not None),
         size=size,
         lowest=float(x[:, up].min()) - level,
