@@ -8,6 +8,10 @@
 // 3-D ones through an orbit camera (orthographic: left-drag on empty space or
 // right-drag turns, the wheel zooms). Springs are coloured by strain on the
 // colour table the scene brings (matplotlib's coolwarm in 64 levels).
+// Everything works by keyboard too (the body's canvas: the focus among particles, the hand,
+// pins; the view: run, step, reset, the instruments), and the view speaks: two polite live
+// regions say what the keys did and, every 2 s at most, what the body does (words from
+// Python, msdlab/viz/words.py); a tone can follow the kinetic energy's share.
 
 const LEVELS = 64;
 const PICK_RADIUS = 25; // px: how near the mouse a particle must be to be taken
@@ -121,6 +125,43 @@ class Announcer {
 
   stop() {
     clearTimeout(this.waiting);
+  }
+}
+
+/** A tone whose pitch follows the share of the energy in the body that is kinetic: 220 Hz
+ * at rest, 880 Hz all in motion (two octaves). Off until `toggle()` (a key press or a click
+ * starts the browser's audio). */
+class Tone {
+  constructor() {
+    this.on = false;
+    this.frequency = 220;
+  }
+
+  toggle() {
+    this.on = !this.on;
+    if (!this.audio && this.on) this.start();
+    this.gain?.gain.setTargetAtTime(this.on ? 0.05 : 0, this.audio.currentTime, 0.05);
+    return this.on;
+  }
+
+  start() {
+    this.audio = new AudioContext();
+    this.oscillator = this.audio.createOscillator();
+    this.gain = this.audio.createGain();
+    this.gain.gain.value = 0;
+    this.oscillator.connect(this.gain).connect(this.audio.destination);
+    this.oscillator.start();
+  }
+
+  follow(energy) {
+    const inBody = Math.abs(energy.kinetic) + Math.abs(energy.elastic)
+      + Math.abs(energy.gravitational);
+    this.frequency = 220 * 4 ** (inBody > 0 ? Math.abs(energy.kinetic) / inBody : 0);
+    if (this.on) this.oscillator.frequency.setTargetAtTime(this.frequency, this.audio.currentTime, 0.1);
+  }
+
+  stop() {
+    this.audio?.close();
   }
 }
 
@@ -951,6 +992,7 @@ function render({ model, el }) {
   const show = (state) => { // a state's positions, and its energies and status line if any
     positions = state.positions;
     if (state.energy && view.energy) view.energy.update(state.energy);
+    if (state.energy) bar.tone.follow(state.energy);
     if (state.pace !== undefined) view.status.dataset.pace = String(state.pace);
     if (state.status !== undefined) view.status.dataset.line = state.status;
     if (state.status !== undefined && !model.get("error")) view.status.textContent = state.status;
@@ -1006,6 +1048,7 @@ function render({ model, el }) {
   model.on("msg:custom", onMessage);
   model.on("change:error", onError);
   const bar = controls(view.root, model, send);
+  view.tone = bar.tone;
   const tools = instrumentPanel(view.root, model, send);
   view.root.insertBefore(full, view.status.nextSibling);
   keyboard(view.root, bar);
@@ -1018,6 +1061,7 @@ function render({ model, el }) {
     tools.stop();
     view.said.stop();
     view.told.stop();
+    bar.tone.stop();
     model.off("change:positions", onPositions);
     model.off("change:fixed", onFixed);
     model.off("msg:custom", onMessage);
@@ -1052,6 +1096,10 @@ function controls(parent, model, send) {
   const reset = button(bar, "↺ reset", "back to the start (r)", () => send({ type: "reset" }));
   const describe = button(bar, "describe", "describe the state in words (d)",
     () => send({ type: "describe" }));
+  const tone = new Tone();
+  const sound = button(bar, "♪ tone", "a tone rising with the kinetic energy's share (a)",
+    () => sound.setAttribute("aria-pressed", String(tone.toggle())));
+  sound.setAttribute("aria-pressed", "false");
   const speed = { name: "speed", label: "speed ×", min: 0.1, max: 4, step: 0.1,
     value: model.get("speed") };
   const sliders = [slider(bar, speed, (value) => {
@@ -1062,7 +1110,7 @@ function controls(parent, model, send) {
   for (const setting of model.get("settings")) {
     sliders.push(slider(row, setting, (value) => send({ type: "set", name: setting.name, value })));
   }
-  return { play, step, reset, describe, sliders };
+  return { play, step, reset, describe, sound, tone, sliders };
 }
 
 // ------------------------------------------------------------------ the instruments
@@ -1318,7 +1366,8 @@ const TOOL_KEYS = { w: "stopwatch", m: "ruler", t: "trace", l: "lines", v: "arro
 
 /** Keys while the view has the focus: space pauses or runs, s steps, r resets, [ and ]
  * move the speed down or up, d describes the state in words, w, m, t, l and v turn the
- * instruments on and off, g goes to the next gravity; Tab reaches every control and the
+ * instruments on and off, g goes to the next gravity, a turns the tone on and off (`Tone`);
+ * Tab reaches every control and the
  * arrow keys move a slider. JupyterLab leaves the keys inside the view to it. */
 function keyboard(root, bar) {
   root.tabIndex = 0;
@@ -1326,7 +1375,8 @@ function keyboard(root, bar) {
   root.setAttribute("role", "region");
   root.setAttribute("aria-label", "msdlab live view. Keys: space pauses or runs, s steps, "
     + "r resets, [ and ] change the speed, d describes the state in words, w, m, t, l and v "
-    + "turn the stopwatch, ruler, trace, lines and arrows on and off, g changes gravity; "
+    + "turn the stopwatch, ruler, trace, lines and arrows on and off, g changes gravity, "
+    + "a turns a tone following the kinetic energy on and off; "
     + "on the body, the arrow keys move the focus among particles and Enter picks one up");
   const nudge = (input, steps) => {
     input.value = Number(input.value) + steps * Number(input.step);
@@ -1341,7 +1391,8 @@ function keyboard(root, bar) {
   };
   const keys = { " ": () => bar.play.click(), s: () => bar.step.click(),
     r: () => bar.reset.click(), "[": () => nudge(bar.sliders[0], -1),
-    "]": () => nudge(bar.sliders[0], 1), d: () => bar.describe.click(), g: nextGravity };
+    "]": () => nudge(bar.sliders[0], 1), d: () => bar.describe.click(), g: nextGravity,
+    a: () => bar.sound.click() };
   for (const [key, tool] of Object.entries(TOOL_KEYS)) {
     keys[key] = () => click(`button[data-tool="${tool}"]`);
   }

@@ -381,6 +381,13 @@ def test_the_keyboard_alone_takes_a_particle_moves_it_and_hears_the_body(widget_
     assert full.text_content().startswith(
         "A 2-D body of 2 particles and 1 spring, 1 of them pinned."
     )
+    page.keyboard.press("a")  # a tone: two octaves above 220 Hz when all is kinetic
+    kernel.frames(2)
+    assert page.get_by_role("button", name="a tone").get_attribute("aria-pressed") == "true"
+    e = view.energy
+    share = e["kinetic"] / (e["kinetic"] + e["elastic"] + abs(e["gravitational"]))
+    tone = page.evaluate("() => window.msdlabViews[0].tone.frequency")
+    assert tone == pytest.approx(220 * 4**share, rel=1e-6) and tone > 221  # it swings
     page.keyboard.press("p")  # pins the hung mass where it is
     kernel.frames()
     assert view.sim.body.fixed[1]
