@@ -383,6 +383,7 @@ def test_the_keyboard_alone_takes_a_particle_moves_it_and_hears_the_body(widget_
     )
     page.keyboard.press("a")  # a tone: two octaves above 220 Hz when all is kinetic
     kernel.frames(2)
+    page.evaluate("() => new Promise((done) => requestAnimationFrame(done))")  # the last shown
     assert page.get_by_role("button", name="a tone").get_attribute("aria-pressed") == "true"
     e = view.energy
     share = e["kinetic"] / (e["kinetic"] + e["elastic"] + abs(e["gravitational"]))
