@@ -683,7 +683,8 @@ export function mountView(el, scene, arrays, source) {
       const hand = source.stepping?.() ? view.hand : null;
       const readings = source.readings?.() ?? null;
       // drawn again only if something changed: the same picture would cost a canvas upload
-      const focus = document.activeElement === canvas ? view.focus : null;
+      // the keyboard's focus ring, not a mouse's click's (the browser's :focus-visible)
+      const focus = canvas.matches(":focus-visible") ? view.focus : null;
       const now = [positions, hand, view.held, camera.azimuth, camera.elevation, camera.zoom,
         readings, focus, painter.fixed];
       if (now.some((value, i) => value !== shown[i])) {
@@ -773,7 +774,7 @@ function pointer(view, painter, source) {
     }
     take(event);
     // in 3-D the hand moves on the plane facing the camera through the particle
-    view.held = nearest;
+    view.held = view.focus = nearest; // the keys go on from the particle taken
     depth = painter.depth[nearest];
     hold(nearest, camera.unproject(px, py, depth), event);
     source.grab(nearest, view.hand.target, view.hand.time);
@@ -897,10 +898,12 @@ function canvasKeys(view, scene, source) {
   });
 }
 
+/** Where a target (world coordinates) is, in words. */
 function placeAt(target, scene) {
   return placeOf(Float32Array.from(target), 0, scene);
 }
 
+/** When an event was made (ms, the page's clock). */
 function eventTime(event) {
   return Math.min(event.timeStamp, performance.now());
 }

@@ -10,12 +10,15 @@ inside the same message. The page queues the states and shows one a frame, so tw
 that arrive together are both shown. A thread rather than an asyncio task: the kernel's event loop
 stops while a cell runs, and a thread also runs outside Jupyter (tests,
 scripts); the kernel sends comm messages from any thread. What the page asks
-(grab, move, release, step, reset, a slider, the stopwatch's buttons, an export)
+(grab, move, release, step, reset, a slider, the stopwatch's buttons, an export, a pin,
+a description)
 arrives on the kernel's main thread and is queued, to be done by the stepping thread
 between two steps; the hand's moves are played back to `Grab` one step at a time at the
 pace the hand made them (`hand.HandPath`). The instruments turned on (`instruments`)
 are read here and their readings ride in the states; every state sent is kept for
-export (`export.Recording`).
+export (`export.Recording`). Every energy update carries the state in a line of words
+(`words.brief`), which the page's live region reads out; asked, the next state carries
+the whole state in words (`words.full`).
 """
 
 from __future__ import annotations
