@@ -118,6 +118,7 @@ def describe(
         "energy": energy,
         "energy_unit": energy_unit or sim.units.energy,
         "time_unit": sim.units.time,
+        "length_unit": sim.units.length,
         "width": SIZE[0],
         "height": SIZE[1],
     }

@@ -34,10 +34,16 @@ class HandPath:
         self.clock = time
 
     def add(self, time: float, target: Sequence[float]) -> None:
-        """The hand at ``target`` at ``time`` (ms); a move out of order replaces the newest."""
+        """The hand at ``target`` at ``time`` (ms); a move out of order replaces the newest.
+        A move to where the hand is, once the playback has caught up, says the hand stood
+        still until ``time``: the playback goes on from there (the keyboard sends one
+        before each of its moves), not from the last move, up to `JUMP_LIMIT` behind."""
         point = (time, np.array(target, dtype=float))
         if time <= self.points[-1][0]:
             self.points[-1] = (self.points[-1][0], point[1])
+        elif self.caught_up and np.array_equal(point[1], self.points[-1][1]):
+            self.points[-1] = point
+            self.clock = time
         else:
             self.points.append(point)
 

@@ -8,6 +8,10 @@
 // 3-D ones through an orbit camera (orthographic: left-drag on empty space or
 // right-drag turns, the wheel zooms). Springs are coloured by strain on the
 // colour table the scene brings (matplotlib's coolwarm in 64 levels).
+// Everything works by keyboard too (the body's canvas: the focus among particles, the hand,
+// pins; the view: run, step, reset, the instruments), and the view speaks: two polite live
+// regions say what the keys did and, every 2 s at most, what the body does (words from
+// Python, msdlab/viz/words.py); a tone can follow the kinetic energy's share.
 
 const LEVELS = 64;
 const PICK_RADIUS = 25; // px: how near the mouse a particle must be to be taken
@@ -35,6 +39,13 @@ const REPORT_EVERY = 1000; // ms between two reports of the page's frame rate to
 // the moves back at their pace whenever they come; the page draws the held particle at
 // the hand at once.
 const MOVES_EVERY = 100;
+// The keyboard's hand (WCAG 2.1.1): a key press moves the hand by a step, over `GLIDE` ms at
+// most (a move in one engine step would fling the particle); the moves of an arrow key held
+// down join into one path, as a pointer's do.
+const GLIDE = 50;
+const SAY_EVERY = 2000; // ms: the body's line is said at most this often, and only when new
+const TABLE_EVERY = 500; // ms between two updates of the energy bars' table
+let views = 0; // views on the page: each names its own help text's id
 
 /** A typed array of `Type` over a DataView, ArrayBuffer or typed array. */
 function typed(data, Type) {
@@ -69,6 +80,103 @@ function element(tag, attributes = {}, parent = null) {
   const node = Object.assign(document.createElement(tag), attributes);
   if (parent) parent.appendChild(node);
   return node;
+}
+
+/** Text a screen reader reads but the eye does not see, and a ring round the focus. */
+const STYLE = `.msdlab-hidden { position: absolute; width: 1px; height: 1px; overflow: hidden;
+  clip: rect(0 0 0 0); clip-path: inset(50%); white-space: nowrap; }
+.msdlab-live :focus-visible, .msdlab-live:focus-visible { outline: 3px solid #1a5fb4;
+  outline-offset: 2px; }
+.msdlab-live .msdlab-canvas:focus-visible { outline-offset: -3px; }
+.msdlab-full { margin: 4px 0; padding: 4px 6px; border-left: 3px solid #1a5fb4;
+  max-width: 640px; }`;
+
+function addStyle() {
+  if (document.getElementById("msdlab-style")) return;
+  element("style", { id: "msdlab-style", textContent: STYLE }, document.head);
+}
+
+/** A polite live region: `say(text)` is read out at most every `every` ms, the newest
+ * text then, and only if it differs from the last said (at once with `every` = 0). */
+class Announcer {
+  constructor(parent, every, name) {
+    this.node = element("div", { className: `${name} msdlab-hidden` }, parent);
+    this.node.setAttribute("aria-live", "polite");
+    this.every = every;
+    this.said = "";
+    this.at = -Infinity;
+    this.waiting = null;
+  }
+
+  say(text) {
+    this.next = text;
+    if (this.waiting !== null) return;
+    const wait = this.at + this.every - performance.now();
+    if (wait <= 0) this.flush();
+    else this.waiting = setTimeout(() => this.flush(), wait);
+  }
+
+  flush() {
+    this.waiting = null;
+    if (this.next === this.said) return;
+    this.node.textContent = this.said = this.next;
+    this.at = performance.now();
+  }
+
+  stop() {
+    clearTimeout(this.waiting);
+  }
+}
+
+/** A tone whose pitch follows the share of the energy in the body that is kinetic: 220 Hz
+ * at rest, 880 Hz all in motion (two octaves). Off until `toggle()` (a key press or a click
+ * starts the browser's audio). */
+class Tone {
+  constructor() {
+    this.on = false;
+    this.frequency = 220;
+  }
+
+  toggle() {
+    this.on = !this.on;
+    if (!this.audio && this.on) this.start();
+    this.gain?.gain.setTargetAtTime(this.on ? 0.05 : 0, this.audio.currentTime, 0.05);
+    return this.on;
+  }
+
+  start() {
+    this.audio = new AudioContext();
+    this.oscillator = this.audio.createOscillator();
+    this.gain = this.audio.createGain();
+    this.gain.gain.value = 0;
+    this.oscillator.connect(this.gain).connect(this.audio.destination);
+    this.oscillator.start();
+  }
+
+  follow(energy) {
+    const inBody = Math.abs(energy.kinetic) + Math.abs(energy.elastic)
+      + Math.abs(energy.gravitational);
+    this.frequency = 220 * 4 ** (inBody > 0 ? Math.abs(energy.kinetic) / inBody : 0);
+    if (this.on) this.oscillator.frequency.setTargetAtTime(this.frequency, this.audio.currentTime, 0.1);
+  }
+
+  stop() {
+    this.audio?.close();
+  }
+}
+
+/** `value` to a hundredth of `scale` (a view's span), as msdlab/viz/words.py says it. */
+function number(value, scale) {
+  const places = Math.max(0, -Math.floor(Math.log10(scale / 100)));
+  const text = value.toFixed(places);
+  return Number(text) === 0 ? "0" : text;
+}
+
+/** Where particle `p` of `x` is, in words: "x 0.12, y -0.40 m". */
+function placeOf(x, p, scene) {
+  const d = scene.dim, axes = "xyz";
+  const parts = Array.from({ length: d }, (_, k) => `${axes[k]} ${number(x[d * p + k], scene.span)}`);
+  return `${parts.join(", ")} ${scene.length_unit ?? ""}`.trim();
 }
 
 /** Where the camera looks from: azimuth about the up axis, elevation, zoom. */
@@ -244,7 +352,7 @@ class Painter {
     return this.placed;
   }
 
-  draw(camera, positions, held) {
+  draw(camera, positions, held, focus = null) {
     const g = this.context, { width, height } = this.canvas;
     camera.project(positions, this.n, this.screen, this.depth);
     if (this.dense) {
@@ -259,6 +367,20 @@ class Painter {
     }
     this.drawHeld(g, held);
     this.drawBalls(g, camera);
+    this.drawFocus(g, focus);
+  }
+
+  /** The keyboard's focus: a dark blue ring (white inside, to show on dark springs). */
+  drawFocus(g, focus) {
+    if (focus === null) return;
+    const [x, y] = [this.screen[2 * focus], this.screen[2 * focus + 1]];
+    for (const [colour, width, radius] of [["#fff", 5, 12], ["#1a5fb4", 2.5, 12]]) {
+      g.strokeStyle = colour;
+      g.lineWidth = width;
+      g.beginPath();
+      g.arc(x, y, radius, 0, 2 * Math.PI);
+      g.stroke();
+    }
   }
 
   /** Thousands of springs: 1-px lines written into the pixels, one pass, no paths. */
@@ -374,11 +496,30 @@ class EnergyPanel {
     this.canvas = element("canvas", { width: 260, height: 480 }, parent);
     this.canvas.className = "msdlab-energy";
     this.canvas.setAttribute("role", "img");
-    this.canvas.setAttribute("aria-label", "energy bars, and the total against time");
+    this.canvas.setAttribute("aria-label", "energy bars, and the total against time "
+      + "(the table after them gives the numbers)");
     this.canvas.style.maxWidth = "100%";
+    this.table = element("table", { className: "msdlab-energy-table msdlab-hidden" }, parent);
+    element("caption", { textContent: `energy now (${unit})` }, this.table);
+    this.rows = element("tbody", {}, this.table);
+    this.tabled = -Infinity;
     this.unit = unit;
     this.history = [];
     this.bars = {};
+  }
+
+  /** The bars' numbers in the table, every `TABLE_EVERY` ms at most. */
+  tabulate() {
+    const now = performance.now();
+    if (now - this.tabled < TABLE_EVERY) return;
+    this.tabled = now;
+    this.rows.replaceChildren(...[...Object.entries(this.bars), ["total", this.total ?? 0]]
+      .map(([name, value]) => {
+        const row = element("tr");
+        element("th", { textContent: name, scope: "row" }, row);
+        element("td", { textContent: value.toPrecision(3) }, row);
+        return row;
+      }));
   }
 
   /** The bars: the energies in the body, what each mechanism took out, and the work put
@@ -438,6 +579,7 @@ class EnergyPanel {
       g.fillText(`${name} ${value.toPrecision(3)} ${this.unit}`, 10, y + 10);
     });
     this.drawHistory(g, width, height);
+    this.tabulate();
   }
 
   drawHistory(g, width, height) {
@@ -503,31 +645,32 @@ function isAt(x, p, target, d) {
  * positions (`latest()`) and takes the user's grabs (`grab/move/release`, each grab and
  * move with the time of the event, ms). */
 export function mountView(el, scene, arrays, source) {
+  addStyle();
   const root = element("div", { className: "msdlab-live" }, el);
   root.style.cssText = "font: 12px sans-serif; max-width: 100%";
   const row = element("div", {}, root);  // the energy panel wraps below a narrow view
   row.style.cssText = "display: flex; flex-wrap: wrap; align-items: flex-start; gap: 6px";
-  const canvas = element("canvas", { width: scene.width, height: scene.height }, row);
-  canvas.className = "msdlab-canvas";
-  canvas.setAttribute("role", "img");
-  canvas.setAttribute("aria-label", "the body: drag a particle to move it"
-    + (scene.dim === 3 ? ", drag empty space to turn the view, the wheel zooms" : ""));
-  canvas.style.cssText = "cursor: crosshair; border: 1px solid #ccc; max-width: 100%; height: auto";
+  const canvas = bodyCanvas(row, scene, !!source.grab);
   const energy = scene.energy ? new EnergyPanel(row, scene.energy_unit) : null;
   const status = element("div", { className: "msdlab-status" }, root);
   const camera = new Camera(scene, canvas.width, canvas.height);
   const painter = new Painter(canvas, scene, arrays.springs, arrays.rest, arrays.fixed);
   const stats = newStats();
-  // `hand`: the held particle and where the hand put it (world coordinates)
+  // `hand`: the held particle and where the hand put it (world coordinates); `focus`: the
+  // particle the keyboard is on; `said`: what the keys did, said at once; `told`: what the
+  // body does, said every `SAY_EVERY` ms at most
   const view = { root, canvas, status, energy, camera, painter, stats, held: null, hand: null,
-    alive: true };
+    focus: null, positions: null, alive: true, said: new Announcer(root, 0, "msdlab-said"),
+    told: new Announcer(root, SAY_EVERY, "msdlab-told") };
   window.msdlabViews = window.msdlabViews || [];
   window.msdlabViews.push(view);
   pointer(view, painter, source);
+  canvasKeys(view, scene, source);
   let last = null, shown = [];
   const frame = () => {
     if (!view.alive) return;
     const positions = source.latest();
+    view.positions = positions;
     if (positions) {
       if (positions !== last) {
         stats.updates++;
@@ -540,10 +683,12 @@ export function mountView(el, scene, arrays, source) {
       const hand = source.stepping?.() ? view.hand : null;
       const readings = source.readings?.() ?? null;
       // drawn again only if something changed: the same picture would cost a canvas upload
+      // the keyboard's focus ring, not a mouse's click's (the browser's :focus-visible)
+      const focus = canvas.matches(":focus-visible") ? view.focus : null;
       const now = [positions, hand, view.held, camera.azimuth, camera.elevation, camera.zoom,
-        readings];
+        readings, focus, painter.fixed];
       if (now.some((value, i) => value !== shown[i])) {
-        painter.draw(camera, hand ? painter.place(positions, hand) : positions, view.held);
+        painter.draw(camera, hand ? painter.place(positions, hand) : positions, view.held, focus);
         if (readings) drawInstruments(painter, camera, readings);
         stats.drawn++;
         if (hand && stats.moved !== null) stats.drawDelays.push(performance.now() - stats.moved);
@@ -558,6 +703,27 @@ export function mountView(el, scene, arrays, source) {
   };
   requestAnimationFrame(frame);
   return view;
+}
+
+/** The body's canvas: focusable, named, its keys in a description (`live`: a live view's,
+ * whose particles the hand takes). */
+function bodyCanvas(parent, scene, live) {
+  const canvas = element("canvas", { width: scene.width, height: scene.height }, parent);
+  canvas.className = "msdlab-canvas";
+  canvas.tabIndex = 0;
+  canvas.setAttribute("role", "application");
+  canvas.setAttribute("aria-roledescription", "simulation");
+  canvas.setAttribute("aria-label", "the body");
+  const help = element("p", { className: "msdlab-hidden", id: `msdlab-keys-${++views}`,
+    textContent: (live ? "A pointer drags a particle. Keys: the arrow keys move the focus to "
+      + "the nearest particle that way, n and shift n to the next and previous by number, "
+      + "or type its number; Enter picks it up and lets it go, the arrow keys then move it, "
+      + "plus and minus change their step, Escape lets go; p pins or frees it. " : "")
+      + (scene.dim === 3 ? "Shift and the arrow keys turn the view, Page Up and Page Down "
+        + "zoom; a pointer drags empty space to turn it, the wheel zooms." : "") }, parent);
+  canvas.setAttribute("aria-describedby", help.id);
+  canvas.style.cssText = "cursor: crosshair; border: 1px solid #ccc; max-width: 100%; height: auto";
+  return canvas;
 }
 
 /** Time from a mouse move to the first engine positions with the held particle where it
@@ -608,7 +774,7 @@ function pointer(view, painter, source) {
     }
     take(event);
     // in 3-D the hand moves on the plane facing the camera through the particle
-    view.held = nearest;
+    view.held = view.focus = nearest; // the keys go on from the particle taken
     depth = painter.depth[nearest];
     hold(nearest, camera.unproject(px, py, depth), event);
     source.grab(nearest, view.hand.target, view.hand.time);
@@ -644,6 +810,139 @@ function pointer(view, painter, source) {
     event.preventDefault();
     camera.zoom *= Math.exp(-event.deltaY * 0.001);
   }, { passive: false });
+}
+
+const DIRECTIONS = { ArrowRight: [1, 0], ArrowLeft: [-1, 0], ArrowUp: [0, -1], ArrowDown: [0, 1] };
+
+/** The particle nearest `from` on the screen in direction `[dx, dy]` (px, y down): the
+ * least distance along it plus twice the distance across; null if none is that way. */
+function nearestToward(painter, from, [dx, dy]) {
+  const s = painter.screen, x0 = s[2 * from], y0 = s[2 * from + 1];
+  let best = null, least = Infinity;
+  for (let i = 0; i < painter.n; i++) {
+    const along = (s[2 * i] - x0) * dx + (s[2 * i + 1] - y0) * dy;
+    const across = Math.abs((s[2 * i] - x0) * dy - (s[2 * i + 1] - y0) * dx);
+    if (i !== from && along > 0.5 && along + 2 * across < least) [best, least] = [i, along + 2 * across];
+  }
+  return best;
+}
+
+/** The particle nearest the middle of the body on the screen: the keyboard starts there. */
+function middleParticle(painter) {
+  const s = painter.screen, n = painter.n;
+  let mx = 0, my = 0;
+  for (let i = 0; i < n; i++) [mx, my] = [mx + s[2 * i] / n, my + s[2 * i + 1] / n];
+  let best = 0, least = Infinity;
+  for (let i = 0; i < n; i++) {
+    const d = (s[2 * i] - mx) ** 2 + (s[2 * i + 1] - my) ** 2;
+    if (d < least) [best, least] = [i, d];
+  }
+  return best;
+}
+
+/** A round step for the keyboard's hand: a fiftieth of the view's span, to 1, 2 or 5. */
+function roundStep(span) {
+  const raw = span / 50, ten = 10 ** Math.floor(Math.log10(raw));
+  return Number([1, 2, 5, 10].map((m) => m * ten).find((v) => v >= raw * 0.7).toPrecision(2));
+}
+
+/** The canvas's keys (WCAG 2.1.1): the focus among particles (arrows, n, shift n, a number),
+ * the hand (Enter takes and lets go, the arrows move it by `step`, + and - change the step,
+ * Escape lets go), p pins; in 3-D shift and the arrows turn, Page Up and Down zoom. */
+function canvasKeys(view, scene, source) {
+  const { canvas, painter, camera } = view;
+  const keys = { step: roundStep(scene.span), typed: "", typedAt: 0, moved: 0 };
+  const unit = scene.length_unit ?? "";
+  const where = (p) => `particle ${p} of ${painter.n}${painter.fixed[p] ? ", pinned" : ""}`
+    + (view.positions ? `, at ${placeOf(view.positions, p, scene)}` : "");
+  const focusOn = (p) => {
+    if (p === null || p < 0 || p >= painter.n) return;
+    view.focus = p;
+    view.said.say(where(p));
+  };
+  canvas.addEventListener("focus", () => focusOn(view.focus ?? middleParticle(painter)));
+  const hand = {
+    take(event) {
+      const p = view.focus, d = scene.dim;
+      const target = Array.from(view.positions.subarray(d * p, d * p + d));
+      view.held = p;
+      view.hand = { particle: p, target, time: eventTime(event), released: null };
+      keys.moved = view.hand.time;
+      source.grab(p, target, view.hand.time);
+      view.said.say(`picked up particle ${p}: the arrow keys move it by ${keys.step} ${unit}, `
+        + "Enter lets go");
+    },
+    move(event, [dx, dy]) {
+      const [right, top] = scene.dim === 3 ? camera.axes() : [[1, 0], [0, 1]];
+      const from = view.hand.target, time = eventTime(event);
+      const target = from.map((c, k) => c + keys.step * (dx * right[k] - dy * top[k]));
+      source.move(from, Math.max(time - GLIDE, keys.moved)); // where the hand stood till then
+      source.move(target, time);
+      view.hand = { ...view.hand, target, time };
+      keys.moved = time;
+      view.said.say(`particle ${view.held} at ${placeAt(target, scene)}`);
+    },
+    letGo() {
+      source.release();
+      view.hand.released = performance.now();
+      view.said.say(`let go of particle ${view.held} at ${placeAt(view.hand.target, scene)}`);
+      view.held = null;
+    },
+  };
+  canvas.addEventListener("keydown", (event) => {
+    if (event.ctrlKey || event.metaKey || event.altKey) return;
+    const done = keyOnCanvas(event, view, scene, source, keys, hand, focusOn);
+    if (!done) return;
+    event.preventDefault();
+    event.stopPropagation();
+  });
+}
+
+/** Where a target (world coordinates) is, in words. */
+function placeAt(target, scene) {
+  return placeOf(Float32Array.from(target), 0, scene);
+}
+
+/** When an event was made (ms, the page's clock). */
+function eventTime(event) {
+  return Math.min(event.timeStamp, performance.now());
+}
+
+/** One key on the canvas; whether it was the canvas's. */
+function keyOnCanvas(event, view, scene, source, keys, hand, focusOn) {
+  const { camera, painter } = view, key = event.key, direction = DIRECTIONS[key];
+  if (direction && event.shiftKey && scene.dim === 3) {
+    camera.azimuth -= 0.1 * direction[0];
+    camera.elevation = Math.max(-1.55, Math.min(1.55, camera.elevation - 0.1 * direction[1]));
+  } else if (key === "PageUp" || key === "PageDown") {
+    camera.zoom *= key === "PageUp" ? 1.1 : 1 / 1.1;
+  } else if (!source.grab || view.focus === null) {
+    return false;
+  } else if (direction && view.held !== null) {
+    hand.move(event, direction);
+  } else if (direction) {
+    focusOn(nearestToward(painter, view.focus, direction));
+  } else if (key === "Enter") {
+    if (view.held === null) hand.take(event);
+    else hand.letGo();
+  } else if (key === "Escape" && view.held !== null) {
+    hand.letGo();
+  } else if (key === "n" || key === "N") {
+    focusOn((view.focus + (key === "n" ? 1 : painter.n - 1)) % painter.n);
+  } else if (/^[0-9]$/.test(key)) {
+    const now = performance.now();
+    keys.typed = (now - keys.typedAt < 1000 ? keys.typed : "") + key;
+    keys.typedAt = now;
+    focusOn(Number(keys.typed) < painter.n ? Number(keys.typed) : null);
+  } else if (key === "p") {
+    source.pin?.(view.focus);
+  } else if (key === "+" || key === "=" || key === "-") {
+    keys.step = roundStep(keys.step * (key === "-" ? 25 : 100));
+    view.said.say(`step ${keys.step} ${scene.length_unit ?? ""}`);
+  } else {
+    return false;
+  }
+  return true;
 }
 
 /** The free particle nearest to screen (px, py), within PICK_RADIUS, or null. */
@@ -696,6 +995,7 @@ function render({ model, el }) {
   const show = (state) => { // a state's positions, and its energies and status line if any
     positions = state.positions;
     if (state.energy && view.energy) view.energy.update(state.energy);
+    if (state.energy) bar.tone.follow(state.energy);
     if (state.pace !== undefined) view.status.dataset.pace = String(state.pace);
     if (state.status !== undefined) view.status.dataset.line = state.status;
     if (state.status !== undefined && !model.get("error")) view.status.textContent = state.status;
@@ -725,12 +1025,18 @@ function render({ model, el }) {
     },
     stepping: () => model.get("running") && !model.get("error"),
     readings: () => tools.shown(),
+    pin: (particle) => send({ type: "pin", particle }),
   };
   const view = mountView(el, scene, arrays, source);
+  const full = element("div", { className: "msdlab-full", hidden: true }, view.root);
+  full.setAttribute("aria-live", "polite");
   const onPositions = () => (positions = typed(model.get("positions"), Float32Array));
+  const onFixed = () => (view.painter.fixed = typed(model.get("fixed"), Uint8Array));
   const onMessage = (message, buffers) => {
     if (message.type === "export") download(message, buffers);
     if (message.type !== "state") return;
+    if (message.words) view.told.say(message.words);
+    if (message.full) [full.hidden, full.textContent] = [false, message.full];
     view.stats.received++;
     states.push({ ...message, positions: typed(buffers[0], Float32Array) });
     if (states.length > QUEUED) states.shift();
@@ -741,10 +1047,13 @@ function render({ model, el }) {
     view.status.style.color = error ? "#b00" : "#333";
   };
   model.on("change:positions", onPositions);
+  model.on("change:fixed", onFixed);
   model.on("msg:custom", onMessage);
   model.on("change:error", onError);
   const bar = controls(view.root, model, send);
+  view.tone = bar.tone;
   const tools = instrumentPanel(view.root, model, send);
+  view.root.insertBefore(full, view.status.nextSibling);
   keyboard(view.root, bar);
   onError();
   const report = reportFrames(view.stats, send);
@@ -753,7 +1062,11 @@ function render({ model, el }) {
     clearInterval(report);
     clearTimeout(sending);
     tools.stop();
+    view.said.stop();
+    view.told.stop();
+    bar.tone.stop();
     model.off("change:positions", onPositions);
+    model.off("change:fixed", onFixed);
     model.off("msg:custom", onMessage);
     model.off("change:error", onError);
   };
@@ -784,6 +1097,12 @@ function controls(parent, model, send) {
   label();
   const step = button(bar, "▶❚ step", "one step (s)", () => send({ type: "step" }));
   const reset = button(bar, "↺ reset", "back to the start (r)", () => send({ type: "reset" }));
+  const describe = button(bar, "describe", "describe the state in words (d)",
+    () => send({ type: "describe" }));
+  const tone = new Tone();
+  const sound = button(bar, "♪ tone", "a tone rising with the kinetic energy's share (a)",
+    () => sound.setAttribute("aria-pressed", String(tone.toggle())));
+  sound.setAttribute("aria-pressed", "false");
   const speed = { name: "speed", label: "speed ×", min: 0.1, max: 4, step: 0.1,
     value: model.get("speed") };
   const sliders = [slider(bar, speed, (value) => {
@@ -794,18 +1113,18 @@ function controls(parent, model, send) {
   for (const setting of model.get("settings")) {
     sliders.push(slider(row, setting, (value) => send({ type: "set", name: setting.name, value })));
   }
-  return { play, step, reset, sliders };
+  return { play, step, reset, describe, sound, tone, sliders };
 }
 
 // ------------------------------------------------------------------ the instruments
 // Python measures (msdlab/viz/instruments.py); the page draws what it reads.
 
 const TOOLS = ["stopwatch", "ruler", "trace", "lines", "arrows"];
-const TOOL_NAMES = { stopwatch: "stopwatch (simulated time)",
-  ruler: "ruler between the last two particles taken in hand",
-  trace: "trace of the particle last taken in hand, with its period",
-  lines: "natural-length and equilibrium lines of a hung mass",
-  arrows: "velocity and force arrows on the particle last taken in hand" };
+const TOOL_NAMES = { stopwatch: "stopwatch (simulated time) (w)",
+  ruler: "ruler between the last two particles taken in hand (m)",
+  trace: "trace of the particle last taken in hand, with its period (t)",
+  lines: "natural-length and equilibrium lines of a hung mass (l)",
+  arrows: "velocity and force arrows on the particle last taken in hand (v)" };
 const ARROW = 60; // px: the longest arrow (PhET's vectors: scaled to show, not to units)
 
 /** The ruler, the lines and the arrows over the body just drawn. */
@@ -1046,22 +1365,40 @@ function download(content, buffers) {
   setTimeout(() => URL.revokeObjectURL(url), 10_000);
 }
 
+const TOOL_KEYS = { w: "stopwatch", m: "ruler", t: "trace", l: "lines", v: "arrows" };
+
 /** Keys while the view has the focus: space pauses or runs, s steps, r resets, [ and ]
- * move the speed down or up. JupyterLab leaves the keys inside the view to it. */
+ * move the speed down or up, d describes the state in words, w, m, t, l and v turn the
+ * instruments on and off, g goes to the next gravity, a turns the tone on and off (`Tone`);
+ * Tab reaches every control and the
+ * arrow keys move a slider. JupyterLab leaves the keys inside the view to it. */
 function keyboard(root, bar) {
   root.tabIndex = 0;
   root.setAttribute("data-lm-suppress-shortcuts", "true");
   root.setAttribute("role", "region");
   root.setAttribute("aria-label", "msdlab live view. Keys: space pauses or runs, s steps, "
-    + "r resets, [ and ] change the speed");
+    + "r resets, [ and ] change the speed, d describes the state in words, w, m, t, l and v "
+    + "turn the stopwatch, ruler, trace, lines and arrows on and off, g changes gravity, "
+    + "a turns a tone following the kinetic energy on and off; "
+    + "on the body, the arrow keys move the focus among particles and Enter picks one up");
   const nudge = (input, steps) => {
     input.value = Number(input.value) + steps * Number(input.step);
     input.dispatchEvent(new Event("input"));
     input.dispatchEvent(new Event("change"));
   };
+  const click = (selector) => root.querySelector(selector)?.click();
+  let gravity = -1;
+  const nextGravity = () => {
+    const presets = root.querySelectorAll("button[data-gravity]");
+    if (presets.length) presets[(gravity = (gravity + 1) % presets.length)].click();
+  };
   const keys = { " ": () => bar.play.click(), s: () => bar.step.click(),
     r: () => bar.reset.click(), "[": () => nudge(bar.sliders[0], -1),
-    "]": () => nudge(bar.sliders[0], 1) };
+    "]": () => nudge(bar.sliders[0], 1), d: () => bar.describe.click(), g: nextGravity,
+    a: () => bar.sound.click() };
+  for (const [key, tool] of Object.entries(TOOL_KEYS)) {
+    keys[key] = () => click(`button[data-tool="${tool}"]`);
+  }
   root.addEventListener("keydown", (event) => {
     const act = keys[event.key];
     const typing = event.target.tagName === "BUTTON" && event.key === " ";
@@ -1071,7 +1408,10 @@ function keyboard(root, bar) {
   });
 }
 
-/** The replay page's player: recorded frames, play / pause, a scrubber, orbiting. */
+/** The replay page's player: recorded frames, play / pause, a scrubber, orbiting. It
+ * starts playing, paused instead where the reader asked for reduced motion (WCAG 2.2.2:
+ * the pause button stops it); keys: space plays or pauses, the arrow keys step a frame
+ * back or on, Home and End go to the first and last. */
 export async function replay(el, data) {
   const scene = data.scene;
   const arrays = {
@@ -1081,33 +1421,61 @@ export async function replay(el, data) {
   };
   const size = arrays.fixed.length * scene.dim, count = data.times.length;
   const frames = positionsOf(await inflate(data.frames, Uint16Array), size, data.low, data.step);
-  let index = 0, playing = true, start = performance.now();
+  const still = window.matchMedia?.("(prefers-reduced-motion: reduce)").matches ?? false;
+  let index = 0, playing = !still, start = performance.now();
   const frameAt = (i) => frames.subarray(i * size, (i + 1) * size);
   const view = mountView(el, scene, arrays, { latest: () => frameAt(index) });
   const bar = element("div", { className: "msdlab-controls" }, view.root);
-  const play = button(bar, "❚❚ pause", "play / pause", () => {
-    playing = !playing;
+  const play = button(bar, "", "", () => setPlaying(!playing));
+  const setPlaying = (on) => {
+    playing = on;
     start = performance.now() - (index * 1000) / data.fps;
     play.textContent = playing ? "❚❚ pause" : "▶ play";
-  });
+    play.setAttribute("aria-label", playing ? "pause the replay (space)" : "play the replay (space)");
+    play.title = play.getAttribute("aria-label");
+  };
+  setPlaying(playing);
   const scrub = element("input", { type: "range", min: 0, max: count - 1, value: 0 }, bar);
   scrub.style.cssText = "width: 50%; vertical-align: middle";
   scrub.className = "msdlab-scrub";
-  scrub.addEventListener("input", () => {
-    playing = false;
-    play.textContent = "▶ play";
-    index = Number(scrub.value);
-  });
+  scrub.setAttribute("aria-label", "frame of the replay");
+  const goTo = (i) => {
+    index = Math.max(0, Math.min(count - 1, i));
+    if (playing) setPlaying(false);
+  };
+  scrub.addEventListener("input", () => goTo(Number(scrub.value)));
+  replayKeys(view.root, play, goTo, () => index, count);
+  let said = -1;
   const tick = () => {
     if (playing) index = Math.floor(((performance.now() - start) * data.fps) / 1000) % count;
     scrub.value = index;
-    view.status.textContent = `t = ${data.times[index].toPrecision(4)} ${data.unit}`
-      + `   frame ${index + 1} / ${count}`;
+    const where = `t = ${data.times[index].toPrecision(4)} ${data.unit}`;
+    view.status.textContent = `${where}   frame ${index + 1} / ${count}`;
     view.status.dataset.frame = String(index);
+    if (said !== index) scrub.setAttribute("aria-valuetext", `${where}, frame ${index + 1} of ${count}`);
+    said = index;
     requestAnimationFrame(tick);
   };
   requestAnimationFrame(tick);
   return view;
+}
+
+/** The replay's keys on its region (the scrubber keeps its own arrow keys). */
+function replayKeys(root, play, goTo, index, count) {
+  root.tabIndex = 0;
+  root.setAttribute("role", "region");
+  root.setAttribute("aria-label", "replay. Keys: space plays or pauses, the left and right "
+    + "arrow keys step a frame, Home and End go to the first and last frame");
+  root.addEventListener("keydown", (event) => {
+    const target = event.target;
+    if (target.tagName === "INPUT" || (target.tagName === "BUTTON" && event.key === " ")) return;
+    const moves = { ArrowLeft: () => goTo(index() - 1), ArrowRight: () => goTo(index() + 1),
+      Home: () => goTo(0), End: () => goTo(count - 1), " ": () => play.click() };
+    const shifted = event.shiftKey && target.tagName === "CANVAS"; // the canvas turns the view
+    if (!moves[event.key] || shifted || event.ctrlKey || event.metaKey || event.altKey) return;
+    event.preventDefault();
+    moves[event.key]();
+  });
 }
 
 export default { render };

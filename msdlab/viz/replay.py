@@ -24,8 +24,10 @@ PAGE = """<!DOCTYPE html>
 <html lang="en">
 <head><meta charset="utf-8"><title>{title}</title></head>
 <body style="margin: 12px; font-family: sans-serif">
-<h3 style="margin: 4px 0">{title}</h3>
+<main>
+<h1 style="margin: 4px 0; font-size: 1.25em">{title}</h1>
 <div id="msdlab-replay"></div>
+</main>
 <script type="text/plain" id="msdlab-module">{module}</script>
 <script type="application/json" id="msdlab-data">{data}</script>
 <script type="module">

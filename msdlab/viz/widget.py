@@ -10,12 +10,15 @@ inside the same message. The page queues the states and shows one a frame, so tw
 that arrive together are both shown. A thread rather than an asyncio task: the kernel's event loop
 stops while a cell runs, and a thread also runs outside Jupyter (tests,
 scripts); the kernel sends comm messages from any thread. What the page asks
-(grab, move, release, step, reset, a slider, the stopwatch's buttons, an export)
+(grab, move, release, step, reset, a slider, the stopwatch's buttons, an export, a pin,
+a description)
 arrives on the kernel's main thread and is queued, to be done by the stepping thread
 between two steps; the hand's moves are played back to `Grab` one step at a time at the
 pace the hand made them (`hand.HandPath`). The instruments turned on (`instruments`)
 are read here and their readings ride in the states; every state sent is kept for
-export (`export.Recording`).
+export (`export.Recording`). Every energy update carries the state in a line of words
+(`words.brief`), which the page's live region reads out; asked, the next state carries
+the whole state in words (`words.full`).
 """
 
 from __future__ import annotations
@@ -34,7 +37,7 @@ from .. import Gravity, Simulation, SimulationDiverged, kinetic_energy
 from ..engine.model.units import SI
 from ..interaction import Grab, Ground, Walls
 from ..scenes.registry import Scene
-from . import frontend, instruments, settings
+from . import frontend, instruments, settings, words
 from .export import Recording
 from .hand import HandPath
 from .upright import UPS, resolve_up
@@ -54,15 +57,22 @@ PACED = ("move", "frames")
 _running: list[LiveView] = []  # views started by `show`, stopped when a new one starts
 
 
-def ground_level(sim: Simulation, up: int) -> float:
-    """The height (along axis ``up``) gravitational energy is counted from, as PhET does:
-    the floor's, or the walls' bottom, else the lowest particle's now."""
+def floor_level(sim: Simulation, up: int) -> float | None:
+    """The floor's height along axis ``up``: the ground's, or the walls' bottom; None
+    without either."""
     for item in sim.constraints:
         if isinstance(item, Ground):
             return item.height / item.normal_of(sim.body)[up]
         if isinstance(item, Walls) and np.isfinite(item.lower[up]):
             return float(item.lower[up])
-    return float(sim.body.positions[:, up].min())
+    return None
+
+
+def ground_level(sim: Simulation, up: int) -> float:
+    """The height (along axis ``up``) gravitational energy is counted from, as PhET does:
+    the floor's (`floor_level`), else the lowest particle's now."""
+    floor = floor_level(sim, up)
+    return float(sim.body.positions[:, up].min()) if floor is None else floor
 
 
 def velocities_now(sim: Simulation) -> np.ndarray:
@@ -157,6 +167,8 @@ class LiveView(anywidget.AnyWidget):
         self.achieved = 1.0  # steps done over steps asked since the last energy update
         self.stopwatch = instruments.Stopwatch(lambda: self.sim.time)
         self.readings: dict = {}  # what the instruments turned on read, as last sent
+        self.in_words = ""  # the state in a line of words, as last sent (`words.brief`)
+        self._describe = False  # the page asked for the whole state in words
         self.tools = {name: False for name in instruments.TOOLS}
         self.attach(sim)
         self.on_msg(self._on_message)
@@ -174,6 +186,7 @@ class LiveView(anywidget.AnyWidget):
         up = resolve_up(self._look[1], sim, sim.body.dim)
         self._up = UPS.index(up)
         self._level = ground_level(sim, self._up)
+        self._floor = floor_level(sim, self._up) is not None
         self._owed, self._clock = PHASE, time.perf_counter()
         self._asked = self._done = 0.0
         view, _, energy_unit = self._look
@@ -219,6 +232,11 @@ class LiveView(anywidget.AnyWidget):
         velocities = velocities_now(self.sim)
         self.energy = energies(self.sim, self._taken, self._level, velocities)
         self.recording.add(self.sim.time, self.sim.body.positions, velocities, self.energy)
+        if energy or self._describe:
+            summary = self.summary(velocities)
+            self.in_words = content["words"] = words.brief(summary)
+            if self._describe:
+                content["full"], self._describe = words.full(summary), False
         if energy:
             content["energy"] = self.energy
             self.status = content["status"] = self.status_line()
@@ -226,6 +244,22 @@ class LiveView(anywidget.AnyWidget):
         if any(self.tools.values()) or self.readings:  # once more, empty, when all go off
             self.readings = content["readings"] = self.measure() if any(self.tools.values()) else {}
         self.send(content, buffers=[self._positions()])
+
+    def summary(self, velocities: np.ndarray) -> words.BodySummary:
+        """The body now, for the words the page reads out (`words.summarise`)."""
+        return words.summarise(
+            self.sim,
+            velocities,
+            self.energy,
+            springs=len(self.rest) // 4,  # float32 rest lengths, one a spring
+            up=self._up,
+            level=self._level,
+            has_floor=self._floor,
+            held=self.grab.particle,
+            watched=self.steps_per_second * self.speed * self.sim.dt,
+            energy_unit=self.scene["energy_unit"],
+            stopped=self.error,
+        )
 
     def status_line(self) -> str:
         """The time, the steps and, when the engine falls behind, the pace it keeps."""
@@ -321,6 +355,8 @@ class LiveView(anywidget.AnyWidget):
             "frames": lambda: self.match_frames(content["rate"]),
             "stopwatch": lambda: self.press_stopwatch(content["action"]),
             "export": lambda: self.send_export(content["format"]),
+            "describe": self.describe,
+            "pin": lambda: self.pin(content["particle"]),
         }
         command = handlers.get(content.get("type"))
         if command is not None:
@@ -352,6 +388,25 @@ class LiveView(anywidget.AnyWidget):
             self.let_go()
         else:
             self._letting_go = True
+
+    def describe(self) -> None:
+        """Send the whole state in words with the next state (`words.full`)."""
+        self._describe = True
+
+    def pin(self, particle: int) -> None:
+        """Pin ``particle`` where it is, or free it if it is pinned. Pinned, it stops: the
+        hand took its kinetic energy out (booked under "hand", as `Grab` books its work)."""
+        body = self.sim.body
+        if not 0 <= particle < len(body):
+            raise ValueError(f"particle {particle} does not exist: the body has {len(body)}")
+        if self.grab.particle == particle:
+            self.let_go()
+        if not body.fixed[particle]:
+            speed = velocities_now(self.sim)[particle]
+            self.sim.dissipated["hand"] += 0.5 * float(body.masses[particle] * speed @ speed)
+            body.velocities[particle] = 0.0
+        body.fixed[particle] = not body.fixed[particle]
+        self.fixed = body.fixed.astype(np.uint8).tobytes()
 
     def match_frames(self, rate: float) -> None:
         """Send as many states a second as the page draws frames (``rate``, 1/s)."""

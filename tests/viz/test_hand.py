@@ -2,6 +2,7 @@
 smoothly."""
 
 import numpy as np
+import pytest
 
 from msdlab.viz.hand import CATCH_UP, HandPath
 
@@ -24,3 +25,15 @@ def test_a_hand_half_a_second_ahead_is_caught_up_without_a_jump():
     moves = np.diff([0.0, *played])
     assert moves.max() <= CATCH_UP + 1e-9  # before: one step jumped 24 px
     assert played[-1] == 30.0
+
+
+def test_a_hand_that_stood_still_moves_at_once_when_it_moves_again():
+    """The keyboard's move: the hand where it stood at the key's time, then the move
+    100 ms later. Played back from the key's time, not from the grab two seconds before
+    (before: the playback jumped to a second before the move, then caught up for 375 ms)."""
+    path = HandPath(0.0, [0.0, 0.0])
+    path.advance(FRAME)
+    path.add(2000.0, [0.0, 0.0])
+    path.add(2100.0, [6.0, 0.0])
+    played = [path.advance(FRAME)[0] for _ in range(7)]
+    assert played == pytest.approx([1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 6.0])

@@ -1,5 +1,6 @@
 """The replay page in headless Chromium, offline, from file://: it draws, plays, scrubs and
-orbits, and asks the network for nothing."""
+orbits, and asks the network for nothing; a keyboard alone works it, its landmark, heading
+and controls have names, and a reader who asked for reduced motion finds it paused."""
 
 import time
 
@@ -58,3 +59,38 @@ def test_the_replay_page_plays_scrubs_and_orbits_offline(replay_file):
             browser.close()
     assert not errors
     assert all(url.startswith(("file:", "blob:", "data:")) for url in requests), requests
+
+
+def test_the_replay_page_is_named_and_worked_by_keys(replay_file):
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as playwright:
+        browser = launch(playwright)
+        try:
+            page = browser.new_page()
+            page.goto(replay_file.as_uri())
+            page.wait_for_function("() => window.msdlabViews?.[0]?.stats.drawn > 0")
+            assert page.get_by_role("main").get_by_role("heading", level=1).count() == 1
+            scrub = page.get_by_role("slider", name="frame of the replay")
+            status = page.locator(".msdlab-status")
+            page.locator(".msdlab-live").focus()
+            page.keyboard.press("Space")  # it played by itself: a key pauses it
+            assert page.get_by_role("button", name="play the replay (space)").count() == 1
+            page.keyboard.press("Home")
+            page.keyboard.press("ArrowRight")
+            page.keyboard.press("ArrowRight")
+            page.wait_for_function("() => document.querySelector('.msdlab-scrub').value === '2'")
+            assert status.get_attribute("data-frame") == "2"
+            assert scrub.get_attribute("aria-valuetext").endswith("frame 3 of 31")
+            page.keyboard.press("End")
+            page.wait_for_function("() => document.querySelector('.msdlab-scrub').value === '30'")
+            page.keyboard.press("Tab")  # on to the body, the play button and the scrubber
+            page.keyboard.press("Tab")
+            assert page.evaluate("() => document.activeElement.textContent") == "▶ play"
+            still = browser.new_page(reduced_motion="reduce")
+            still.goto(replay_file.as_uri())
+            still.wait_for_function("() => window.msdlabViews?.[0]?.stats.drawn > 5")
+            assert still.locator(".msdlab-status").get_attribute("data-frame") == "0"
+            assert still.get_by_role("button", name="play the replay (space)").count() == 1
+        finally:
+            browser.close()

@@ -324,3 +324,71 @@ def test_the_hands_work_has_a_bar_of_its_own_colour(widget_page_in_air, tmp_path
     assert colours["drag"] == [0xD6, 0x27, 0x28]
     others = [colour for name, colour in colours.items() if name != "hand's work"]
     assert colours["hand's work"] not in others
+
+
+FOCUS_RING = """() => { const v = window.msdlabViews[0], p = v.focus;
+const [x, y] = [v.painter.screen[2 * p] + 12, v.painter.screen[2 * p + 1]];
+return Array.from(v.canvas.getContext('2d').getImageData(Math.round(x), Math.round(y), 1, 1)
+  .data.slice(0, 3)); }"""
+
+
+def told(page, kernel, words: str) -> str:
+    """The body's line once it holds ``words`` (said every 2 s at most), frames running."""
+    for _ in range(40):
+        line = page.locator(".msdlab-told").text_content()
+        if words in line:
+            return line
+        kernel.frames()
+        page.wait_for_timeout(100)
+    raise AssertionError(f"the live region never said {words!r}: {line!r}")
+
+
+def test_the_keyboard_alone_takes_a_particle_moves_it_and_hears_the_body(widget_page):
+    """Tab to the body, the arrow key to the hung mass, Enter takes it, three presses of the
+    right arrow move it, Enter lets go; the live regions say each and what the body does."""
+    page, kernel = widget_page
+    view = kernel.view
+    page.locator(".msdlab-live").focus()
+    page.keyboard.press("Tab")  # the body's canvas
+    assert page.evaluate("() => document.activeElement.className") == "msdlab-canvas"
+    said = page.locator(".msdlab-said")
+    assert said.text_content().startswith("particle 0 of 2, pinned")
+    page.keyboard.press("ArrowDown")
+    assert said.text_content() == "particle 1 of 2, at x 0, y -1.35 m"
+    kernel.frames()
+    ring = page.evaluate(FOCUS_RING)
+    assert ring[2] > 150 and ring[0] < 80  # the focus ring's blue, beside the mass
+    page.keyboard.press("Enter")
+    step = float(said.text_content().split("move it by ")[1].split()[0])
+    for _ in range(3):
+        page.keyboard.press("ArrowRight")
+    assert said.text_content().startswith("particle 1 at x ")
+    for _ in range(12):  # the moves go within 100 ms, each played back over 50 ms at most
+        kernel.frames()
+        page.wait_for_timeout(20)
+    assert view.grab.particle == 1
+    assert view.sim.body.positions[1, 0] == pytest.approx(3 * step, abs=1e-6)
+    assert "Particle 1 in hand at x " in told(page, kernel, "in hand")
+    page.keyboard.press("Enter")
+    assert said.text_content().startswith("let go of particle 1")
+    kernel.frames(3)
+    assert view.grab.particle is None
+    assert told(page, kernel, "The body is swinging.")
+    page.keyboard.press("d")
+    kernel.frames()
+    full = page.locator(".msdlab-full")
+    assert full.is_visible()
+    assert full.text_content().startswith(
+        "A 2-D body of 2 particles and 1 spring, 1 of them pinned."
+    )
+    page.keyboard.press("a")  # a tone: two octaves above 220 Hz when all is kinetic
+    kernel.frames(2)
+    page.evaluate("() => new Promise((done) => requestAnimationFrame(done))")  # the last shown
+    assert page.get_by_role("button", name="a tone").get_attribute("aria-pressed") == "true"
+    e = view.energy
+    share = e["kinetic"] / (e["kinetic"] + e["elastic"] + abs(e["gravitational"]))
+    tone = page.evaluate("() => window.msdlabViews[0].tone.frequency")
+    assert tone == pytest.approx(220 * 4**share, rel=1e-6) and tone > 221  # it swings
+    page.keyboard.press("p")  # pins the hung mass where it is
+    kernel.frames()
+    assert view.sim.body.fixed[1]
