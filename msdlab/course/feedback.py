@@ -102,10 +102,15 @@ def returned(value: object, what: str) -> object:
     """``value``, the result of the student's ``what``; a `CheckFailed` naming the mistake once
     where it is None (the function returns nothing: a ``return`` is missing)."""
     if value is None:
-        function = what.split("(")[0].split()[0]
-        mistake = f"no return statement: {function} must end with return and its result"
+        mistake = no_return(what.split("(")[0].split()[0])
         raise CheckFailed(f"{what} returned None. {MISTAKE_SENTENCE.format(mistake)}", mistake)
     return value
+
+
+def no_return(function: str) -> Recognised:
+    """The mistake of a student's ``function`` that returns None, in the words every check
+    names it with (so the report names it once)."""
+    return Recognised(f"no return statement: {function} must end with return and its result")
 
 
 def as_array(value: object, what: str, shape: tuple[int, ...] | None = None) -> np.ndarray:

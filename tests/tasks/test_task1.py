@@ -15,6 +15,7 @@ from msdlab.course.feedback import (
     as_array,
     expect,
     matching_variant,
+    no_return,
     num,
     relative_error,
     returned,
@@ -151,7 +152,8 @@ def test_height_after_as_template(task1, own_numbers):
     first = int(floor_step(bottom, g)[0])
     heights = free_fall_heights(bottom, DT, g, first + 60)
     for n in (0, 1, 2, 10, 100, first - 1, first + 50):
-        got = float(returned(task1.height_after(n, bottom, DT, g), f"height_after({n}, ...)"))
+        call = f"height_after({n}, {bottom}, {DT}, {g})"
+        got = float(returned(task1.height_after(n, bottom, DT, g), call))
         parabola = bottom + 0.5 * g * (n * DT) ** 2
         cause = (
             Recognised(
@@ -182,6 +184,22 @@ def floor_step(bottom: float, g: float) -> np.ndarray:
     on_floor = np.flatnonzero(frames[:, :, 0, :, 1].min(axis=(1, 2)) <= 0.0)
     first = int(on_floor[0])
     return np.array([first, frames[first - 1, :, 0, :, 1].min()])
+
+
+def floor_answer(task1, *arguments: float) -> object:
+    """The student's steps_to_floor(*arguments); where it fails while their height_after
+    returns nothing, a failure naming that mistake (it is what steps_to_floor stumbled on)."""
+    try:
+        return task1.steps_to_floor(*arguments)
+    except Exception as error:
+        try:
+            height = task1.height_after(1, 1.0, DT, -0.0015)
+        except Exception:
+            raise error from None
+        if height is not None:
+            raise
+        call = f"steps_to_floor({', '.join(map(str, arguments))})"
+        expect(False, saw=f"{call} fails ({type(error).__name__})", cause=no_return("height_after"))
 
 
 def not_own_numbers(task1, own_numbers, got) -> Recognised | None:
@@ -217,8 +235,8 @@ def test_steps_to_floor_as_template(task1, own_numbers):
     first, height = floor_step(bottom, g)
     first = int(first)
     for got, call in (
-        (returned(task1.steps_to_floor(), "steps_to_floor()"), "steps_to_floor()"),
-        (task1.steps_to_floor(bottom, DT, g), f"steps_to_floor({bottom}, {DT}, {g})"),
+        (returned(floor_answer(task1), "steps_to_floor()"), "steps_to_floor()"),
+        (floor_answer(task1, bottom, DT, g), f"steps_to_floor({bottom}, {DT}, {g})"),
     ):
         expect(
             got == first,
