@@ -409,9 +409,7 @@ def test_measured_stable_dt_as_predicted(task5):
     """measured_stable_dt(λ) agrees with the engine's prediction for your DampedVerlet(λ) (for
     eq. (1.4): √(4 - 2λ)/ω, smaller with damping); this check is about the measurement."""
     for lam in (0.0, 0.5):
-        measured = float(
-            returned(task5.measured_stable_dt(lam, 3, 300, 0.01), "measured_stable_dt")
-        )
+        measured = float(returned(measurement(task5, lam), "measured_stable_dt"))
         predicted, whose = own_limit(task5, lam)
         expect(
             abs(measured / predicted - 1) < 0.06,
@@ -419,6 +417,24 @@ def test_measured_stable_dt_as_predicted(task5):
             f"predicted limit of {whose} is {num(predicted)}",
             cause="a different body than jelly(n), a measurement that does not use your "
             "DampedVerlet, or the damping λ is not passed on",
+        )
+
+
+def measurement(task5, lam):
+    """The student's measured_stable_dt(λ, 3, 300, 0.01); where it fails while their
+    DampedVerlet has a recognised mistake (unstable at any dt, nothing can be measured), a
+    failure naming that mistake."""
+    try:
+        return task5.measured_stable_dt(lam, 3, 300, 0.01)
+    except Exception as error:
+        mistake = scheme_mistake(task5, lam) or scheme_mistake(task5)
+        if not mistake:
+            raise
+        expect(
+            False,
+            saw=f"measured_stable_dt({lam}, 3, 300, 0.01) fails ({type(error).__name__}: "
+            f"{error}): your DampedVerlet({lam}) is what is measured",
+            cause=mistake,
         )
 
 
