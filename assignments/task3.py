@@ -43,15 +43,23 @@ def flatness(positions: np.ndarray) -> float:
 def _checked_axis(axis: Sequence[float]) -> np.ndarray:
     axis = np.asarray(axis, dtype=float)
     if axis.shape != (3,) or not np.all(np.isfinite(axis)) or not np.any(axis):
-        raise ValueError(f"the rotation axis must be a non-zero 3-vector, got {axis.tolist()}")
+        order = (
+            ": the angle? rotation_matrix takes (angle_degrees, axis), as msd.rotation_matrix does"
+            if axis.shape == ()
+            else ""
+        )
+        raise ValueError(
+            f"the rotation axis must be a non-zero 3-vector, got {axis.tolist()}{order}"
+        )
     return axis
 
 
 # --------------------------------------------------------------------------- your answers
-def rotation_matrix(axis: Sequence[float], angle_degrees: float) -> np.ndarray:
+def rotation_matrix(angle_degrees: float, axis: Sequence[float]) -> np.ndarray:
     """The (3, 3) matrix of a right-handed rotation by ``angle_degrees`` about ``axis``.
 
-    ``axis`` is any non-zero 3-vector (its length does not matter). Rodrigues:
+    ``axis`` is any non-zero 3-vector (its length does not matter); the arguments come in
+    the order of the engine's ``msd.rotation_matrix(angle_degrees, axis)``. Rodrigues:
     R = cos θ I + sin θ [n]× + (1 - cos θ) n nᵀ with n the unit axis.
     """
     axis = _checked_axis(axis)
@@ -70,8 +78,8 @@ def rotate_layout(positions: np.ndarray, axis: Sequence[float], angle_degrees: f
     if positions.shape[-1] != 3:
         raise ValueError(f"positions must have shape (..., 3), got {positions.shape}")
     raise NotImplementedError(
-        "Task 3: rotate every position about the centroid with rotation_matrix(axis, "
-        "angle_degrees)."
+        "Task 3: rotate every position about the centroid with rotation_matrix(angle_degrees, "
+        "axis)."
     )
 
 

@@ -152,7 +152,8 @@ def steps_to_floor(y0: float = ORIGIN[1], dt: float = DT, g: float = GRAVITY[1])
 
     That is the first step n whose new height (before the clamp) is <= 0: the
     step in which the floor clamp first acts on it. For the bottom layer of
-    your template (y0 = ORIGIN[1] = {{ y0 }}) this is close to {{ parabola_step }}.
+    your template (y0 = ORIGIN[1] = {{ y0 }}) the exact free fall y0 + ½ g t²
+    would land at t = {{ fall_time }}: the template's steps fall a little faster.
     Needs y0 > 0, g < 0 and dt > 0: raise ValueError otherwise (a particle that
     starts on or below the floor, or does not fall, has no first contact to count).
     """

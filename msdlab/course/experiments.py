@@ -19,6 +19,8 @@ import functools
 from collections.abc import Sequence
 from typing import Any
 
+from .feedback import returned
+
 
 @functools.lru_cache(maxsize=64)  # per task module (one submission) and setting
 def cube_ratio(
@@ -27,5 +29,7 @@ def cube_ratio(
     """The flatness ratio (after / before) of ``task.drop_rotated_cube(axis, angle,
     neighbours)``, with ``steps=steps`` where ``steps`` is given (> 0)."""
     if steps:
-        return float(task.drop_rotated_cube(axis, angle, neighbours, steps=steps))
-    return float(task.drop_rotated_cube(axis, angle, neighbours))
+        ratio = task.drop_rotated_cube(axis, angle, neighbours, steps=steps)
+    else:
+        ratio = task.drop_rotated_cube(axis, angle, neighbours)
+    return float(returned(ratio, "drop_rotated_cube"))

@@ -5,7 +5,8 @@ through the checks, "Failing test case: test_x(task2=<...>, seed=0,  # or any ot
 generated value)"). A student needs two things from it:
 
 - `raised_in`: the line of their own task file where an error was raised, as Python's
-  tracebacks name it (file, line, function and the line's code);
+  tracebacks name it (file, line, function and the line's code); where it was raised in
+  the task file's given code, the student's line that called it (`outside_given_code`);
 - `failing_inputs`: the inputs a property check (Hypothesis ``@given``) failed on, said
   plainly, or that it fails whatever the input.
 """
@@ -25,6 +26,9 @@ EXAMPLE_NOTE = re.compile(r"^(Falsifying example|Failing test case): \w+\((?P<ar
 ANY_VALUE = "# or any other generated value"
 """Hypothesis' comment on an argument the failure does not depend on."""
 
+SECTION = re.compile(r"^# -{10,} (?P<name>.+?)\s*$")
+"""A task file's section header, ``# ----...---- given code`` or ``... your answers``."""
+
 
 def raised_in(error: BaseException, folder: Path | None, code: bool = True) -> str:
     """'in your code: assignments/task2.py, line 51, in spring_acceleration' and (with
@@ -41,12 +45,33 @@ def raised_in(error: BaseException, folder: Path | None, code: bool = True) -> s
     ]
     if not frames:
         return ""
-    frame, line = frames[-1]
+    frame, line = frames[outside_given_code([(f.f_code.co_filename, n) for f, n in frames])]
     path = frame.f_code.co_filename
     name = getattr(frame.f_code, "co_qualname", frame.f_code.co_name)  # Python 3.11+
     where = f"{WHERE}{folder.name}/{Path(path).name}, line {line}, in {name}"
     text = linecache.getline(path, line).strip() if code else ""
     return f"{where}\n    {text}" if text else where
+
+
+def outside_given_code(frames: list[tuple[str, int]]) -> int:
+    """Which of the frames (file, line) of a student's task files, outermost first, names
+    where an error comes from: the innermost one outside the files' given code (the section
+    under ``# ---- given code``), that is, the student's line that called the given code
+    which raised; the innermost where all of them are given code."""
+    for index in range(len(frames) - 1, -1, -1):
+        if not in_given_code(*frames[index]):
+            return index
+    return len(frames) - 1
+
+
+def in_given_code(path: str, line: int) -> bool:
+    """Whether ``line`` of the task file ``path`` is in its section of given code."""
+    section = ""
+    for number in range(1, line + 1):
+        header = SECTION.match(linecache.getline(path, number))
+        if header:
+            section = header["name"]
+    return section == "given code"
 
 
 def failing_inputs(note: str) -> str:

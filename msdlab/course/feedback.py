@@ -66,6 +66,16 @@ def num(value: float, digits: int = 3) -> str:
     return f"{value:.{digits}g}" if value != 0 else "0"  # no "-0"
 
 
+def apart(first: float, second: float, digits: int = 3) -> tuple[str, str]:
+    """Two different numbers written with at least ``digits`` significant digits and as many
+    more as it takes to tell them apart: (1.499992, 1.49999) -> ('1.499992', '1.49999')."""
+    for more in range(digits, 18):
+        shown = num(first, more), num(second, more)
+        if shown[0] != shown[1] or float(first) == float(second):
+            return shown
+    return shown
+
+
 def vec(values: Sequence[float] | np.ndarray, digits: int = 3) -> str:
     """A short vector, e.g. '(0.1, -0.002, 0)'."""
     return "(" + ", ".join(num(v, digits) for v in np.ravel(values)) + ")"
@@ -88,8 +98,24 @@ def relative_error(got: np.ndarray, expected: np.ndarray) -> float:
     return error / scale if scale > 0 else error
 
 
+def returned(value: object, what: str) -> object:
+    """``value``, the result of the student's ``what``; a `CheckFailed` naming the mistake once
+    where it is None (the function returns nothing: a ``return`` is missing)."""
+    if value is None:
+        mistake = no_return(what.split("(")[0].split()[0])
+        raise CheckFailed(f"{what} returned None. {MISTAKE_SENTENCE.format(mistake)}", mistake)
+    return value
+
+
+def no_return(function: str) -> Recognised:
+    """The mistake of a student's ``function`` that returns None, in the words every check
+    names it with (so the report names it once)."""
+    return Recognised(f"no return statement: {function} must end with return and its result")
+
+
 def as_array(value: object, what: str, shape: tuple[int, ...] | None = None) -> np.ndarray:
     """``value`` as a float array, or a `CheckFailed` saying what came back instead."""
+    returned(value, what)
     expect(
         not np.iscomplexobj(value),
         saw=f"{what} returned complex numbers",

@@ -205,7 +205,7 @@ def spring_list_mistakes(
     if constant is not None and not np.isclose(stiffness, constant):
         mistakes[
             f"the stiffness argument is ignored (your STIFFNESS = {constant:g} used instead "
-            f"of k = {stiffness:g})"
+            "of the k given)"
         ] = right * constant / stiffness
     mistakes |= {
         "-f_ij is never added to particle j: each spring acts on both of its ends": one_sided,
@@ -259,13 +259,13 @@ def axis_spring_mistakes(
     if not np.isclose(spacing, 1.0):
         mistakes[
             "rest length 1 in world units: 'rest length 1' means one grid spacing, "
-            f"l = spacing = {spacing:g}"
+            "l = the spacing given"
         ] = spring_acceleration(spring_body(flat, springs, 1.0, stiffness), flat).reshape(x.shape)
     constant = task_constant(task, "SPACING")
     if constant is not None and not np.isclose(spacing, constant):
         mistakes[
             f"the spacing argument is ignored (your SPACING = {constant:g} used as the rest "
-            f"length instead of the spacing {spacing:g})"
+            "length instead of the spacing given)"
         ] = spring_acceleration(spring_body(flat, springs, constant, stiffness), flat).reshape(
             x.shape
         )

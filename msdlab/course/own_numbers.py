@@ -6,8 +6,10 @@ whose cost is measured), the course may give every student their own parameters.
 are derived from the roster id alone (SHA-256 of the id as the seed), so the release,
 the student's ``msdlab check`` and the grader agree without sharing a file:
 
-- task 1: the height y0 of the bottom layer (``ORIGIN[1]``, 1.5 by default) and the
-  template's acceleration g (``GRAVITY[1]``, -0.001);
+- tasks 1 and 2: the height y0 of the bottom layer (``ORIGIN[1]``, 1.5 by default) and
+  the template's acceleration g (``GRAVITY[1]``, -0.001), in both task files (task 2 is
+  the template with springs); task 5's check of the template's trajectory drops the grid
+  from the same height;
 - task 4: the grid size n of the cost measurement (6 by default).
 
 The numbers a student reads (the task files' docstrings, the notebooks' text) are written
@@ -89,12 +91,13 @@ def enabled(course: Path) -> bool:
 
 def shown(own: Numbers) -> dict[str, str]:
     """The numbers a student reads, by marker name: ``y0`` (the bottom layer's height),
-    ``g`` (the template's acceleration), ``parabola_step`` (the step in which the exact
-    free fall y0 + ½ g t² reaches the floor, t = n·DT: close to the template's answer)."""
+    ``g`` (the template's acceleration), ``fall_time`` (the time t at which the exact free
+    fall y0 + ½ g t² reaches the floor, in the template's time units: a time, not a step,
+    so that no step a check rejects is read as the answer)."""
     return {
         "y0": repr(own.bottom),
         "g": repr(own.gravity),
-        "parabola_step": str(math.floor(math.sqrt(2.0 * own.bottom / -own.gravity) / DT)),
+        "fall_time": f"{math.sqrt(2.0 * own.bottom / -own.gravity):.1f}",
     }
 
 
@@ -110,11 +113,15 @@ def filled(text: str, own: Numbers, where: str = "the text") -> str:
     return MARKER.sub(lambda match: numbers[match[1]], text)
 
 
+OWN_CONSTANTS = (1, 2)
+"""The tasks whose files hold the template's ``ORIGIN`` and ``GRAVITY``, given as own numbers."""
+
+
 def personalised(task: int, source: str, own: Numbers) -> str:
     """The template (or solution) text of ``task`` with ``own`` numbers in its constants
     and in its markers (`filled`)."""
     source = filled(source, own, f"task{task}.py")
-    if task != 1:
+    if task not in OWN_CONSTANTS:
         return source
     replaced = {
         "ORIGIN": f"(-1.0, {own.bottom!r}, -1.0)",
@@ -156,7 +163,7 @@ def announced(folder: Path) -> str | None:
         return None
     own = numbers(student)
     return (
-        f"your own numbers (student {student}): task 1 y0 = ORIGIN[1] = {own.bottom!r} and "
-        f"g = GRAVITY[1] = {own.gravity!r}; task 4's step_cost is checked on a "
+        f"your own numbers (student {student}): tasks 1 and 2 y0 = ORIGIN[1] = {own.bottom!r} "
+        f"and g = GRAVITY[1] = {own.gravity!r}; task 4's step_cost is checked on a "
         f"{own.cost_size}×{own.cost_size}×{own.cost_size} grid"
     )

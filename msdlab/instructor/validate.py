@@ -171,10 +171,12 @@ def run_checks(
     *,
     seconds: float = 30.0,
     stop_at_first_failure: bool = False,
+    numbers: own_numbers.Numbers = own_numbers.DEFAULT,
 ) -> dict[str, Outcome]:
     """Each check's `Outcome` on ``module`` (a task module loaded from ``folder``), called
     in this process with the fixtures the course's pytest plugin gives (`check_arguments`:
-    the template's own numbers), its refusal of delegation and a time limit."""
+    the template's own numbers unless a student's ``numbers``), its refusal of delegation
+    and a time limit."""
     outcomes: dict[str, Outcome] = {}
     for check in checks:
         try:
@@ -185,9 +187,7 @@ def run_checks(
                 np.errstate(all="ignore"),
             ):
                 warnings.simplefilter("ignore")
-                check.function(
-                    **check_arguments(check.function, check.task, module, own_numbers.DEFAULT)
-                )
+                check.function(**check_arguments(check.function, check.task, module, numbers))
         except (KeyboardInterrupt, SystemExit):
             raise
         except BaseException as error:  # whatever the code under test raises

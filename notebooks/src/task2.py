@@ -140,7 +140,7 @@ with course.attempt():
 #
 # `task2.run` and `task2.msd_kernel` are the template with your springs. A
 # $8 \times 8 \times 8$ grid (spacing $h$, $k = 0.5$) is dropped from
-# $y = 1.5$ and followed for 1200 steps.
+# $y = {{ y0 }}$ and followed for 1200 steps.
 
 
 # %%

@@ -41,9 +41,9 @@ print(f"task files: {course.label}")
 # %%
 # NBVAL_CHECK_OUTPUT
 with course.attempt():
-    print(np.round(task3.rotation_matrix((0, 0, 1), 90), 6) + 0.0)
+    print(np.round(task3.rotation_matrix(90, (0, 0, 1)), 6) + 0.0)
     axis = np.array([1.0, 2.0, 2.0])
-    R = task3.rotation_matrix(axis, 58.3)
+    R = task3.rotation_matrix(58.3, axis)
     print("orthogonal:", np.allclose(R.T @ R, np.eye(3)))
     print("determinant +1:", np.isclose(np.linalg.det(R), 1.0))
     print("keeps its axis:", np.allclose(R @ axis, axis))

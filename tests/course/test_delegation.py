@@ -83,7 +83,7 @@ def test_an_instructor_can_allow_delegation_per_task(tmp_path):
     folder = tmp_path / "delegating"
     shutil.copytree(PROJECT_ROOT / "solutions", folder)
     task3 = folder / "task3.py"
-    solution = "rotation = rotation_matrix(axis, angle_degrees)"
+    solution = "rotation = rotation_matrix(angle_degrees, axis)"
     task3.write_text(
         task3.read_text().replace(solution, "rotation = msd.rotation_matrix(angle_degrees, axis)")
     )

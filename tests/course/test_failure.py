@@ -28,6 +28,28 @@ def test_the_line_of_the_task_file_that_raised(tmp_path):
     assert failure.raised_in(error, None) == ""
 
 
+def test_an_error_in_the_given_code_names_the_students_line_that_called_it(tmp_path):
+    """A task file's given code raising on what the student's function handed it: the
+    student's call is named, not the line of the given code."""
+    folder = tmp_path / "assignments"
+    folder.mkdir()
+    bar = "# " + "-" * 75
+    (folder / "task3.py").write_text(
+        f"{bar} given code\ndef checked(axis):\n    raise ValueError('not a 3-vector')\n\n\n"
+        f"{bar} your answers\ndef turn(angle, axis):\n    return checked(angle)\n"
+    )
+    namespace: dict = {}
+    exec(compile((folder / "task3.py").read_text(), str(folder / "task3.py"), "exec"), namespace)
+    with pytest.raises(ValueError) as raised:
+        namespace["turn"](30.0, (0, 0, 1))
+    assert failure.raised_in(raised.value, folder) == (
+        "in your code: assignments/task3.py, line 8, in turn\n    return checked(angle)"
+    )
+    with pytest.raises(ValueError) as raised:  # called by a check: the given code's line
+        namespace["checked"](30.0)
+    assert "line 3, in checked" in failure.raised_in(raised.value, folder)
+
+
 def test_the_failing_input_plainly():
     note = (
         "Falsifying example: test_rotation(\n    task2=<task module /a/task2.py>,\n"
@@ -81,4 +103,28 @@ def test_the_line_of_a_sandboxed_task_file_that_raised(serve_task):
         remote.task(5).push(None)
     assert str(error.value).endswith(
         "\nin your code: task5.py, line 6, in push\n    return x + [1, 2]"
+    )
+
+
+def test_an_error_in_sandboxed_given_code_names_the_students_line(serve_task):
+    """In the grader's sandbox too, an error raised in the given code names the student's
+    line that called it."""
+    bar = "# " + "-" * 75
+    remote = serve_task(
+        "task3.py",
+        f"""\
+        {bar} given code
+        def checked(axis):
+            raise ValueError("not a 3-vector")
+
+
+        {bar} your answers
+        def turn(angle, axis):
+            return checked(angle)
+        """,
+    )
+    with pytest.raises(ValueError) as error:
+        remote.task(3).turn(30.0, (0, 0, 1))
+    assert str(error.value).endswith(
+        "\nin your code: task3.py, line 8, in turn\n    return checked(angle)"
     )

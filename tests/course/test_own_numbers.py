@@ -77,9 +77,11 @@ def test_own_template_changes_only_its_numbers():
         ("GRAVITY = (0.0, -0.001, 0.0)  # the template's acceleration a",
          f"GRAVITY = (0.0, {alice.gravity}, 0.0)  # the template's acceleration a"),
         ("    y in [1.5, 1.5 + EDGE).", f"    y in [{alice.bottom}, {alice.bottom} + EDGE)."),
-        ("    your template (y0 = ORIGIN[1] = 1.5) this is close to 547.",
-         f"    your template (y0 = ORIGIN[1] = {alice.bottom}) this is close to "
-         f"{shown['parabola_step']}."),
+        ("    your template (y0 = ORIGIN[1] = 1.5) the exact free fall y0 + ½ g t²",
+         f"    your template (y0 = ORIGIN[1] = {alice.bottom}) the exact free fall y0 + ½ g t²"),
+        ("    would land at t = 54.8: the template's steps fall a little faster.",
+         f"    would land at t = {shown['fall_time']}: the template's steps fall a little "
+         "faster."),
     ]  # fmt: skip
 
 
@@ -87,7 +89,8 @@ def test_own_template_changes_only_its_numbers():
 def test_the_given_code_runs_on_the_students_own_numbers(student, tmp_path):
     """The template's given code computes from its constants: the student's own grid starts
     at their y0, and their running template reaches the floor in the step the check asks
-    for, close to the step the docstring names."""
+    for, close to the time the docstring names; the docstring names no step, so neither
+    the right one nor one a check rejects."""
     own = own_numbers.numbers(student)
     text = templates.render(PROJECT_ROOT / "solutions", own)["task1.py"]
     (tmp_path / "task1.py").write_text(text, encoding="utf-8")
@@ -105,12 +108,16 @@ def test_the_given_code_runs_on_the_students_own_numbers(student, tmp_path):
         acceleration=(0.0, own.gravity, 0.0),
     )  # fmt: skip
     assert step == int(np.flatnonzero(expected[:, :, 0, :, 1].min(axis=(1, 2)) <= 0.0)[0])
-    assert abs(step - int(own_numbers.shown(own)["parabola_step"])) <= 2
+    landing = float(own_numbers.shown(own)["fall_time"]) / own_numbers.DT
+    assert abs(step - landing) < 2
+    docstring = template.steps_to_floor.__doc__
+    assert not [n for n in range(step - 2, step + 3) if number_in(str(n), docstring)]
 
 
 def test_a_student_reads_no_number_of_the_defaults_where_theirs_differ(tmp_path):
-    """The release of a student whose numbers both differ from the defaults: their
-    task1.py and task1 notebook show their numbers, none of the defaults', and no marker."""
+    """The release of a student whose numbers both differ from the defaults: their task
+    files and notebooks of tasks 1 and 2 show their numbers, none of the defaults', and no
+    marker."""
     student = next(s for s in ("alice", "bob", "carol", "dave", "erin") if different(s))
     own = own_numbers.numbers(student)
     (tmp_path / "course").mkdir()
@@ -119,17 +126,24 @@ def test_a_student_reads_no_number_of_the_defaults_where_theirs_differ(tmp_path)
     (course / own_numbers.SETTINGS_FILE).write_text('{"own_numbers": true}')
     out = tmp_path / "release"
     release.build(out, course, student=student)
-    task1 = (out / "assignments" / "task1.py").read_text(encoding="utf-8")
-    notebook = "\n".join(
-        cell["source"]
-        for cell in json.loads((out / "notebooks" / "task1.ipynb").read_text())["cells"]
-    )
+    files = {
+        task: (out / "assignments" / f"task{task}.py").read_text(encoding="utf-8")
+        for task in (1, 2)
+    }
+    notebooks = {
+        task: "\n".join(
+            cell["source"]
+            for cell in json.loads((out / "notebooks" / f"task{task}.ipynb").read_text())["cells"]
+        )
+        for task in (1, 2)
+    }
     default = own_numbers.shown(own_numbers.DEFAULT)
-    for text in (task1, notebook):
+    for text in (*files.values(), *notebooks.values()):
         assert "{{" not in text and number_in(str(own.bottom), text)
         assert not number_in(default["y0"], text) and not number_in(default["g"], text)
-    assert not number_in(default["parabola_step"], task1)
-    assert number_in(own_numbers.shown(own)["parabola_step"], task1)
+    task1, notebook = files[1], notebooks[1]
+    assert not number_in(default["fall_time"], task1)
+    assert number_in(own_numbers.shown(own)["fall_time"], task1)
     assert f"(0, {own.gravity}, 0)" in notebook
 
 
@@ -196,9 +210,12 @@ def test_a_release_for_one_student_holds_their_numbers(tmp_path):
     assignments = shutil.copytree(PROJECT_ROOT / "assignments", tmp_path / "assignments")
     release._personalise(assignments, PROJECT_ROOT / "solutions", "carol")
     carol = own_numbers.numbers("carol")
-    assert f"ORIGIN = (-1.0, {carol.bottom}, -1.0)" in (assignments / "task1.py").read_text()
+    for task in own_numbers.OWN_CONSTANTS:  # task 2 is the template with springs
+        text = (assignments / f"task{task}.py").read_text()
+        assert f"ORIGIN = (-1.0, {carol.bottom}, -1.0)" in text
+        assert f"GRAVITY = (0.0, {carol.gravity}, 0.0)" in text
     assert own_numbers.student_of(assignments) == "carol"
-    for task in (2, 3, 4, 5):
+    for task in (3, 4, 5):
         assert (assignments / f"task{task}.py").read_bytes() == (
             PROJECT_ROOT / "assignments" / f"task{task}.py"
         ).read_bytes()

@@ -106,6 +106,22 @@ def test_a_planted_bug_loses_points_and_the_first_failing_check_names_its_cause(
     assert bug.words in outcomes[own.name].message, f"{own.name} says: {outcomes[own.name].message}"
 
 
+def test_springs_listed_twice_are_said_as_such_with_an_example(harness):
+    """Springs listed from both ends: the pairs check shows a pair listed twice (never an
+    empty example), and the rest lengths' check says how many springs there are, not that
+    the body has none."""
+    bug = next(b for b in BUGS if b.name == "springs listed from both ends")
+    checks = [
+        harness.check(4, "grid_springs_each_pair_once"),
+        harness.check(4, "rest_lengths_unstressed"),
+    ]
+    outcomes = validate.run_source(bug.apply(harness.sources[4]), 4, checks, seconds=120)
+    pairs, rest = (outcomes[c.name].message for c in checks)
+    assert "listed twice (e.g. particles (0, 1))" in pairs, pairs
+    assert "850 springs where the (3, 4, 5) grid has 425" in rest, rest
+    assert "without real springs" not in rest and "[]" not in pairs
+
+
 @pytest.mark.parametrize("kind", trivial.KINDS)
 @pytest.mark.parametrize("task", TASKS)
 def test_a_trivial_answer_earns_no_point(task, kind, harness):

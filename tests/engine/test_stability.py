@@ -178,8 +178,22 @@ def test_non_finite_state_is_caught_at_once():
 
 
 def test_explicit_euler_blowup_says_it_is_unstable_at_any_dt():
-    with pytest.raises(msd.SimulationDiverged, match="unstable at any dt"):
+    with pytest.raises(msd.SimulationDiverged, match="unstable at any dt") as raised:
         msd.Simulation(kicked(chain()), msd.ExplicitEuler(), 0.3).run(steps=100_000)
+    assert "ExplicitEuler is unstable" in str(raised.value)
+    assert "use SymplecticEuler, Verlet" in str(raised.value)
+
+
+def test_a_users_integrator_that_blows_up_is_to_be_fixed_not_replaced():
+    """The integrator a user wrote (a course's task: the integrator is the exercise) is told
+    to be compared with its equation, never to be swapped for one of the engine's; the
+    message has no unit of length of its own (the course's are the template's)."""
+    with pytest.raises(msd.SimulationDiverged, match="unstable at any dt") as raised:
+        msd.Simulation(kicked(chain()), ForwardEuler(), 0.3).run(steps=100_000)
+    message = str(raised.value)
+    assert "your integrator is unstable" in message and "scheme's equation" in message
+    assert "ForwardEuler" not in message and "use SymplecticEuler" not in message
+    assert "ImplicitEuler" not in message and "m/s" not in message
 
 
 @pytest.mark.parametrize(

@@ -11,19 +11,20 @@ import msdlab as msd
 from msdlab.course import oracles
 from msdlab.course.feedback import (
     Recognised,
+    apart,
     as_array,
     expect,
     matching_variant,
+    no_return,
     num,
     relative_error,
+    returned,
 )
 from msdlab.course.reference_cache import cached
 
 pytestmark = pytest.mark.task1
 
 DT = oracles.TEMPLATE_DT
-G = oracles.TEMPLATE_GRAVITY[1]
-BOTTOM = 1.5  # height of the template's bottom layer
 
 
 @cached  # the same for every submission: computed once per grading run
@@ -38,16 +39,29 @@ def free_fall_heights(y0: float, dt: float, g: float, steps: int) -> np.ndarray:
 def test_particle_count(task1):
     """particle_count(n) is the number of particles of the template's n × n × n grid."""
     for n in (20, 30, 3):
-        got = task1.particle_count(n)
+        got = returned(task1.particle_count(n), f"particle_count({n})")
         expected = oracles.grid_body((n, n, n), 2.0 / n, 1.0).n_particles
         expect(
             got == expected,
             saw=f"particle_count({n}) = {got!r}, but a grid of {n} per edge has {expected} "
             "particles",
-            cause="a result that holds for the default N only (N³ for every n)"
-            if got == 20**3
-            else "counting one edge (n) or one layer (n²) instead of the whole cube (n³)",
+            cause=count_cause(got, n),
         )
+
+
+def count_cause(got: object, n: int) -> str:
+    """The cause of a wrong particle count ``got`` for ``n`` per edge: the hint of the mistake
+    it is, where it is one of the usual ones."""
+    causes = {  # where two coincide (n = 3: 3n = n²) the later one is said
+        3 * n: "n + n + n, a sum of the edges: the cube has n·n·n particles",
+        20**3: "a result that holds for the default N only (N³ for every n)",
+        n: "counting one edge (n) instead of the whole cube (n³)",
+        n**2: "counting one layer (n²) instead of the whole cube (n³)",
+        (n + 1) ** 3: "n + 1 particles per edge: the grid has n per edge, indices 0 .. n - 1",
+        (n - 1) ** 3: "n - 1 particles per edge: the grid has n per edge, indices 0 .. n - 1",
+    }
+    usual = "the grid has n particles along each of its three axes: n·n·n in all"
+    return causes.get(got, usual) if isinstance(got, (int, float, np.number)) else usual
 
 
 ACCEPTED_SCHEMES = ("position verlet", "symplectic euler")
@@ -131,13 +145,16 @@ def test_verlet_step_is_the_kernel(task1):
 
 
 @pytest.mark.points(2)
-def test_height_after_as_template(task1):
-    """height_after(n) is the height the running template reaches after n steps."""
-    steps = 600
-    heights = free_fall_heights(BOTTOM, DT, G, steps)
-    for n in (0, 1, 2, 10, 100, 547, 600):
-        got = float(task1.height_after(n, BOTTOM, DT, G))
-        parabola = BOTTOM + 0.5 * G * (n * DT) ** 2
+def test_height_after_as_template(task1, own_numbers):
+    """height_after(n) is the height the running template reaches after n steps (from the
+    student's own bottom layer and acceleration where each student has their own numbers)."""
+    bottom, g = own_numbers.bottom, own_numbers.gravity
+    first = int(floor_step(bottom, g)[0])
+    heights = free_fall_heights(bottom, DT, g, first + 60)
+    for n in (0, 1, 2, 10, 100, first - 1, first + 50):
+        call = f"height_after({n}, {bottom}, {DT}, {g})"
+        got = float(returned(task1.height_after(n, bottom, DT, g), call))
+        parabola = bottom + 0.5 * g * (n * DT) ** 2
         cause = (
             Recognised(
                 "that is the exact free fall y0 + ½ g t²; the template moves by g dt² in its "
@@ -147,10 +164,11 @@ def test_height_after_as_template(task1):
             else "the template's recurrence: each step adds g·dt² to the distance moved per "
             "step, so after n steps y = y0 + g dt² (1 + 2 + ... + n)"
         )
+        shown, running = apart(got, heights[n], 6)
         expect(
             abs(got - heights[n]) <= 1e-9,
-            saw=f"height_after({n}) = {num(got, 6)}, but the running template is at "
-            f"y = {num(heights[n], 6)} after {n} steps (y0 = {BOTTOM}, dt = {DT}, g = {G})",
+            saw=f"height_after({n}, {bottom}, {DT}, {g}) = {shown}, but the running template "
+            f"is at y = {running} after {n} steps (y0 = {bottom}, dt = {DT}, g = {g})",
             cause=cause,
         )
 
@@ -166,6 +184,22 @@ def floor_step(bottom: float, g: float) -> np.ndarray:
     on_floor = np.flatnonzero(frames[:, :, 0, :, 1].min(axis=(1, 2)) <= 0.0)
     first = int(on_floor[0])
     return np.array([first, frames[first - 1, :, 0, :, 1].min()])
+
+
+def floor_answer(task1, *arguments: float) -> object:
+    """The student's steps_to_floor(*arguments); where it fails while their height_after
+    returns nothing, a failure naming that mistake (it is what steps_to_floor stumbled on)."""
+    try:
+        return task1.steps_to_floor(*arguments)
+    except Exception as error:
+        try:
+            height = task1.height_after(1, 1.0, DT, -0.0015)
+        except Exception:
+            raise error from None
+        if height is not None:
+            raise
+        call = f"steps_to_floor({', '.join(map(str, arguments))})"
+        expect(False, saw=f"{call} fails ({type(error).__name__})", cause=no_return("height_after"))
 
 
 def not_own_numbers(task1, own_numbers, got) -> Recognised | None:
@@ -201,8 +235,8 @@ def test_steps_to_floor_as_template(task1, own_numbers):
     first, height = floor_step(bottom, g)
     first = int(first)
     for got, call in (
-        (task1.steps_to_floor(), "steps_to_floor()"),
-        (task1.steps_to_floor(bottom, DT, g), f"steps_to_floor({bottom}, {DT}, {g})"),
+        (returned(floor_answer(task1), "steps_to_floor()"), "steps_to_floor()"),
+        (floor_answer(task1, bottom, DT, g), f"steps_to_floor({bottom}, {DT}, {g})"),
     ):
         expect(
             got == first,

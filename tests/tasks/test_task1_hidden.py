@@ -34,15 +34,16 @@ def template_height(y0: float, dt: float, g: float, steps: int) -> float:
     dt=st.floats(0.01, 0.5),
     g=st.floats(-0.05, 0.05),
 )
-def test_height_after_for_any_start(task1, steps, y0, dt, g):
+def test_height_after_for_any_start(task1, own_numbers, steps, y0, dt, g):
     """height_after agrees with the running template for any steps, height, dt and g."""
     got = float(task1.height_after(steps, y0, dt, g))
     expected = template_height(y0, dt, g, steps)
-    defaults = {"y0": 1.5, "dt": 0.1, "g": -0.001}  # the template's values
+    defaults = {"y0": own_numbers.bottom, "dt": 0.1, "g": own_numbers.gravity}  # the template's
+    constants = {"y0": "ORIGIN[1]", "dt": "DT", "g": "GRAVITY[1]"}
     given_values = {"y0": y0, "dt": dt, "g": g}
     cause = next(
         (
-            f"the template's {name} = {value} used instead of the argument {name}"
+            f"your template's {constants[name]} = {value} used instead of the argument {name}"
             for name, value in defaults.items()
             if given_values[name] != value
             and np.isclose(got, template_height(**{**given_values, name: value}, steps=steps))
@@ -139,17 +140,18 @@ def answer_within(seconds: float, call: str) -> contextlib.AbstractContextManage
 @pytest.mark.points(1)
 def test_steps_to_floor_refuses_a_start_on_or_below_the_floor(task1):
     """steps_to_floor needs y0 > 0, g < 0, dt > 0: anything else is refused with ValueError."""
+    g = -0.0015  # no student's own acceleration
     cases = (
-        (0.0, 0.1, -0.001, "a particle that starts on the floor"),
-        (-0.5, 0.1, -0.001, "a particle that starts below the floor"),
+        (0.0, 0.1, g, "a particle that starts on the floor"),
+        (-0.5, 0.1, g, "a particle that starts below the floor"),
         (1.0, 0.1, 0.0, "a particle that does not fall (g = 0)"),
-        (1.0, 0.0, -0.001, "a time step of 0"),
+        (1.0, 0.0, g, "a time step of 0"),
     )
-    first = reference.first_floor_contact(1.0, 0.1, -0.001)
-    got = task1.steps_to_floor(1.0, 0.1, -0.001)
+    first = reference.first_floor_contact(1.0, 0.1, g)
+    got = task1.steps_to_floor(1.0, 0.1, g)
     expect(
         got == first,
-        saw=f"steps_to_floor(1.0, 0.1, -0.001) = {got!r} where the template first reaches the "
+        saw=f"steps_to_floor(1.0, 0.1, {g}) = {got!r} where the template first reaches the "
         f"floor in step {first}: refusing bad starts earns a point only together with "
         "counting the good ones",
         cause="an answer that returns a constant, or the refusal without the count",

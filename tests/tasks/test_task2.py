@@ -161,7 +161,7 @@ def size_cause(ratio, length, stiffness, constant):
     if ignored and np.isclose(ratio, constant / stiffness):
         return (
             f"the stiffness argument is ignored (your STIFFNESS = {constant:g} used instead "
-            f"of k = {stiffness:g})"
+            "of the k given)"
         )
     if np.isclose(ratio, 0.5):
         return (

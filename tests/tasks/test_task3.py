@@ -44,7 +44,7 @@ LEFT_HANDED = "a left-handed turn (the transpose): flip the sign of the sin term
 
 
 def matrix_mistakes(axis, angle):
-    """Matrices (3, 3) that typical mistakes in rotation_matrix(axis, angle) give, by cause."""
+    """Matrices (3, 3) that typical mistakes in rotation_matrix(angle, axis) give, by cause."""
     expected = msd.rotation_matrix(angle, axis)
     theta, n = np.radians(angle), np.asarray(axis, dtype=float)
     unit = n / np.linalg.norm(n)
@@ -72,7 +72,7 @@ def matrix_mistake(task3):
     """
     axis, angle = (1.0, -2.0, 0.5), 30.0
     try:
-        got = np.asarray(task3.rotation_matrix(axis, angle), dtype=float)
+        got = np.asarray(task3.rotation_matrix(angle, axis), dtype=float)
     except Exception:  # the checks say what is wrong
         return None
     if got.shape != (3, 3) or np.allclose(got, msd.rotation_matrix(angle, axis), atol=1e-12):
@@ -120,7 +120,7 @@ def layout_mistake(task3):
 def matrix_at_fault(task3, axis, angle):
     """Why rotate_layout may be wrong because rotation_matrix is, or None."""
     try:
-        got = np.asarray(task3.rotation_matrix(axis, angle), dtype=float)
+        got = np.asarray(task3.rotation_matrix(angle, axis), dtype=float)
     except Exception as error:
         return f"your rotation_matrix fails ({type(error).__name__}), and rotate_layout uses it"
     if got.shape != (3, 3) or not np.allclose(got, msd.rotation_matrix(angle, axis), atol=1e-9):
@@ -156,12 +156,12 @@ def student_acceleration(task3, positions, springs, rest, stiffness):
 
 @pytest.mark.points(2)
 def test_rotation_matrix_right_handed(task3):
-    """rotation_matrix(axis, angle) is a right-handed rotation, for an axis of any length."""
+    """rotation_matrix(angle, axis) is a right-handed rotation, for an axis of any length."""
     x, y = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
-    quarter = as_array(task3.rotation_matrix((0.0, 0.0, 1.0), 90.0), "rotation_matrix", (3, 3))
+    quarter = as_array(task3.rotation_matrix(90.0, (0.0, 0.0, 1.0)), "rotation_matrix", (3, 3))
     expect(
         np.allclose(quarter @ x, y, atol=1e-12),
-        saw=f"rotation_matrix((0, 0, 1), 90) turns the x axis into {vec(quarter @ x)}; a "
+        saw=f"rotation_matrix(90, (0, 0, 1)) turns the x axis into {vec(quarter @ x)}; a "
         "right-handed quarter turn about z takes x to y",
         cause=matrix_mistake(task3)
         or "the transpose (a left-handed turn: the sign of the sin terms) or radians "
@@ -169,13 +169,13 @@ def test_rotation_matrix_right_handed(task3):
     )
     for axis in AXES:
         for angle in (30.0, -58.3, 180.0):
-            got = as_array(task3.rotation_matrix(axis, angle), "rotation_matrix", (3, 3))
+            got = as_array(task3.rotation_matrix(angle, axis), "rotation_matrix", (3, 3))
             expected = msd.rotation_matrix(angle, axis)
             own = matching_variant(got, matrix_mistakes(axis, angle), rtol=1e-9)
             mistake = own and (matrix_mistake(task3) or own)
             expect(
                 np.allclose(got, expected, atol=1e-12),
-                saw=f"rotation_matrix({axis}, {angle}) has R Rᵀ = I off by "
+                saw=f"rotation_matrix({angle}, {axis}) has R Rᵀ = I off by "
                 f"{num(np.max(np.abs(got @ got.T - np.eye(3))))} and differs from the "
                 f"rotation by {angle}° about {axis} by {num(np.max(np.abs(got - expected)))}",
                 cause=mistake

@@ -10,7 +10,7 @@ from test_task3 import matrix_mistake, named, rotation_at_fault
 
 import msdlab as msd
 from msdlab.course.experiments import cube_ratio
-from msdlab.course.feedback import as_array, expect, num, relative_error
+from msdlab.course.feedback import as_array, expect, num, relative_error, returned
 
 import reference_hidden as reference
 
@@ -30,12 +30,12 @@ angles = st.floats(-360.0, 360.0)
 @given(axis=axes, first=angles, second=angles)
 def test_rotations_compose_and_invert(task3, axis, first, second):
     """About one axis, turns add up, a turn back is the transpose, and the axis length is free."""
-    r1 = as_array(task3.rotation_matrix(axis, first), "rotation_matrix", (3, 3))
-    r2 = as_array(task3.rotation_matrix(axis, second), "rotation_matrix", (3, 3))
-    both = as_array(task3.rotation_matrix(axis, first + second), "rotation_matrix", (3, 3))
-    back = as_array(task3.rotation_matrix(axis, -first), "rotation_matrix", (3, 3))
+    r1 = as_array(task3.rotation_matrix(first, axis), "rotation_matrix", (3, 3))
+    r2 = as_array(task3.rotation_matrix(second, axis), "rotation_matrix", (3, 3))
+    both = as_array(task3.rotation_matrix(first + second, axis), "rotation_matrix", (3, 3))
+    back = as_array(task3.rotation_matrix(-first, axis), "rotation_matrix", (3, 3))
     longer = as_array(
-        task3.rotation_matrix(tuple(3.0 * np.asarray(axis)), first), "rotation_matrix", (3, 3)
+        task3.rotation_matrix(first, tuple(3.0 * np.asarray(axis))), "rotation_matrix", (3, 3)
     )
     expect(
         np.allclose(r2 @ r1, both, atol=1e-9) and np.allclose(back, r1.T, atol=1e-9),
@@ -50,7 +50,7 @@ def test_rotations_compose_and_invert(task3, axis, first, second):
     )
     expect(
         np.allclose(r1, msd.rotation_matrix(first, axis), atol=1e-9),
-        saw=f"rotation_matrix({axis}, {num(first)}) is not the turn by {num(first)}° about {axis}",
+        saw=f"rotation_matrix({num(first)}, {axis}) is not the turn by {num(first)}° about {axis}",
         cause=matrix_mistake(task3)
         or "radians where degrees are given, or a term of Rodrigues' formula missing",
     )
@@ -90,7 +90,8 @@ def test_zero_length_spring_gives_no_nan(task3):
     """A spring whose ends coincide adds nothing: no NaN."""
     x = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
     springs = np.array([[0, 1], [1, 2]])
-    got = np.asarray(task3.spring_acceleration(x, springs, np.array([0.5, 0.5]), 1.0), float)
+    got = task3.spring_acceleration(x, springs, np.array([0.5, 0.5]), 1.0)
+    got = np.asarray(returned(got, "spring_acceleration"), float)
     expected = reference.pair_acceleration(x, springs, np.array([0.5, 0.5]), 1.0)
     expect(
         np.all(np.isfinite(got)),

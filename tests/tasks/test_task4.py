@@ -10,7 +10,16 @@ import pytest
 
 from msdlab.course import oracles
 from msdlab.course.experiments import cube_ratio
-from msdlab.course.feedback import Recognised, as_array, expect, matching_variant, num, percent
+from msdlab.course.feedback import (
+    CheckFailed,
+    Recognised,
+    as_array,
+    expect,
+    matching_variant,
+    num,
+    percent,
+    returned,
+)
 
 pytestmark = pytest.mark.task4
 
@@ -23,8 +32,77 @@ def engine_pairs(shape, neighbours):
     return {frozenset(p) for p in zip(body.edges().a.tolist(), body.edges().b.tolist())}, body
 
 
+def student_offsets(task4, wanted):
+    """The student's neighbour_offsets(wanted) as an array (a check fails if it returns None)."""
+    return np.asarray(returned(task4.neighbour_offsets(wanted), f"neighbour_offsets({wanted})"))
+
+
+def engine_offsets(wanted):
+    """The offsets (M, 3) in {-1, 0, 1}³ whose squared length is in ``wanted``, sorted."""
+    cube = np.stack(np.meshgrid(*3 * [(-1, 0, 1)], indexing="ij"), axis=-1).reshape(-1, 3)
+    return cube[np.isin(np.sum(cube**2, axis=1), wanted)]
+
+
+OFFSET_WANTS = ((1,), (2,), (3,), (1, 2, 3))
+BY_LENGTH = (
+    "neighbour_offsets keeps an offset by its length √(di² + dj² + dk²), not by its squared "
+    "length di² + dj² + dk²: squared_distances lists squared lengths (2 and 3 keep nothing)"
+)
+
+
+@functools.lru_cache(maxsize=16)  # per task module: the checks of one submission ask often
+def offsets_of(task4):
+    """The student's neighbour_offsets for each of `OFFSET_WANTS`, sorted (raises where the
+    function does)."""
+    return [sorted(map(tuple, student_offsets(task4, w).tolist())) for w in OFFSET_WANTS]
+
+
+def offsets_mistake(task4):
+    """The mistake recognised in the student's neighbour_offsets, run on its own, or None: its
+    offsets for (1,), (2,), (3,) and (1, 2, 3) are those of an offset's length compared with
+    the squared lengths asked for."""
+    try:
+        got = offsets_of(task4)
+    except Exception:  # the checks say what is wrong
+        return None
+    by_length = [
+        sorted(map(tuple, engine_offsets([s for s in w if math.isqrt(s) ** 2 == s]).tolist()))
+        for w in OFFSET_WANTS
+    ]
+    return Recognised(BY_LENGTH) if got == by_length else None
+
+
+def offsets_wrong(task4):
+    """Why neighbour_offsets is wrong (its recognised mistake, that it fails, or that its
+    offsets differ from those asked for), or None where it is right."""
+    try:
+        got = offsets_of(task4)
+    except Exception as error:
+        return f"your neighbour_offsets fails ({type(error).__name__}), and grid_springs uses it"
+    if got != [sorted(map(tuple, engine_offsets(w).tolist())) for w in OFFSET_WANTS]:
+        return offsets_mistake(task4) or (
+            "your neighbour_offsets is wrong (see its check), and grid_springs uses it"
+        )
+    return None
+
+
+def called_grid_springs(task4, shape, spacing, neighbours):
+    """The student's grid_springs(shape, spacing, neighbours); where it fails and their
+    neighbour_offsets, which it uses, has a recognised mistake, a failure naming that one."""
+    call = f"grid_springs({shape}, {spacing}, {tuple(neighbours)})"
+    try:
+        return returned(task4.grid_springs(shape, spacing, neighbours), call)
+    except CheckFailed:
+        raise
+    except Exception as error:
+        upstream = offsets_mistake(task4)
+        if not upstream:
+            raise
+        expect(False, saw=f"{call} fails ({type(error).__name__}: {error})", cause=upstream)
+
+
 def student_springs(task4, shape, spacing, neighbours):
-    springs, rest = task4.grid_springs(shape, spacing, neighbours)
+    springs, rest = called_grid_springs(task4, shape, spacing, neighbours)
     springs = np.asarray(springs)
     rest = as_array(rest, "grid_springs (rest lengths)")
     expect(
@@ -66,10 +144,13 @@ def springs_mistake(task4):
     try:
         every = student_springs(task4, shape, spacing, (1, 2, 3))
         axis = student_springs(task4, shape, spacing, (1,))
-    except Exception:  # the checks say what is wrong
-        return None
+    except Exception:  # the checks say what is wrong; a mistake upstream is the cause
+        return offsets_mistake(task4)
     found = sorted(tuple(sorted(p)) for p in every[0].tolist())
-    return pairs_mistake(found, shape, axis[0]) or rest_mistake(every, shape, spacing)
+    own = pairs_mistake(found, shape, axis[0]) or rest_mistake(every, shape, spacing)
+    if own or grid_springs_wrong(task4):  # the neighbour_offsets it uses is named first
+        return offsets_mistake(task4) or own
+    return None
 
 
 def pairs_mistake(found, shape, axis_springs):
@@ -135,8 +216,8 @@ def rest_mistake(springs_and_rest, shape, spacing):
 def cube_mistake(task4):
     """The mistake recognised in drop_rotated_cube, or None: the same ratio whatever
     squared_distances (the springs of every kind, or axis springs only, are built), where the
-    student's grid_springs has no mistake of its own."""
-    if springs_mistake(task4):
+    student's neighbour_offsets and grid_springs, run on their own, are right."""
+    if springs_mistake(task4) or springs_wrong(task4):
         return None
     try:
         axis_only = cube_ratio(task4, (0.0, 0.0, 1.0), 45.0, (1,))
@@ -154,9 +235,21 @@ def cube_mistake(task4):
 def springs_at_fault(task4):
     """Why drop_rotated_cube may be wrong because of grid_springs, or of the springs it
     builds (the mistake recognised there, where there is one), or None."""
-    recognised = springs_mistake(task4) or cube_mistake(task4)
-    if recognised:
-        return recognised
+    return springs_mistake(task4) or springs_wrong(task4) or cube_mistake(task4)
+
+
+def springs_wrong(task4):
+    """Why the springs the cube is built from are wrong, or None where grid_springs, run on
+    its own, is right: where it is wrong, the neighbour_offsets it uses, where that is
+    wrong too."""
+    wrong = grid_springs_wrong(task4)
+    return wrong and (offsets_wrong(task4) or wrong)
+
+
+@functools.lru_cache(maxsize=16)
+def grid_springs_wrong(task4):
+    """Why the student's grid_springs of a 2 × 2 × 3 grid with all neighbours is wrong, or
+    None where its springs and rest lengths are the engine's."""
     expected, body = engine_pairs((2, 2, 3), (1, 2, 3))
     try:
         springs, rest = student_springs(task4, (2, 2, 3), 1.0, (1, 2, 3))
@@ -183,7 +276,7 @@ def missing_and_extra(springs, expected):
 def test_neighbour_offsets_26(task4):
     """6 axis, 12 face-diagonal and 8 body-diagonal neighbours, each offset once, both signs."""
     for wanted, count in (((1,), 6), ((2,), 12), ((3,), 8), ((1, 2, 3), 26)):
-        offsets = np.asarray(task4.neighbour_offsets(wanted))
+        offsets = student_offsets(task4, wanted)
         expect(
             offsets.ndim == 2 and offsets.shape[1:] == (3,),
             saw=f"neighbour_offsets({wanted}) has shape {offsets.shape}, expected (M, 3)",
@@ -227,7 +320,7 @@ def test_grid_springs_each_pair_once(task4):
         expected, _ = engine_pairs(SHAPE, neighbours)
         missing, extra, repeated = missing_and_extra(springs, expected)
         kinds = "+".join(KINDS[n] for n in neighbours)
-        example = sorted(tuple(sorted(p)) for p in (missing or extra))[:1]
+        example = example_pair(springs, missing, extra)
         expect(
             not missing and not extra and repeated == 0,
             saw=f"for {kinds} springs of a {SHAPE} grid you give {len(springs)} springs, "
@@ -237,6 +330,16 @@ def test_grid_springs_each_pair_once(task4):
             or every_kind_cause(springs, neighbours)
             or pairs_cause(missing, extra, repeated, len(springs), len(expected)),
         )
+
+
+def example_pair(springs, missing, extra):
+    """One pair of particles that is wrong: missing, else not neighbours, else listed twice."""
+    wrong = missing or extra
+    if not wrong:
+        seen, wrong = set(), set()
+        for pair in map(frozenset, springs.tolist()):
+            (wrong if pair in seen else seen).add(pair)
+    return sorted(tuple(sorted(p)) for p in wrong)[0] if wrong else None
 
 
 def every_kind_cause(springs, neighbours):
@@ -266,12 +369,18 @@ def test_rest_lengths_unstressed(task4):
     springs, rest = student_springs(task4, SHAPE, spacing, (1, 2, 3))
     positions = oracles.template_positions(SHAPE, spacing, (0.0, 0.0, 0.0)).reshape(-1, 3)
     expected, _ = engine_pairs(SHAPE, (1, 2, 3))
+    to_itself = int(np.sum(springs[:, 0] == springs[:, 1]))
     expect(
-        len(springs) == len(expected) and np.all(springs[:, 0] != springs[:, 1]),
-        saw=f"grid_springs gives {len(springs)} springs, "
-        f"{int(np.sum(springs[:, 0] == springs[:, 1]))} of them joining a particle to itself, "
-        f"where the {SHAPE} grid has {len(expected)}: a body without real springs is "
-        "unstressed trivially, so this earns no point",
+        len(springs) == len(expected) and to_itself == 0,
+        saw=f"grid_springs gives {len(springs)} springs where the {SHAPE} grid has "
+        f"{len(expected)}"
+        + (
+            f", {to_itself} of them joining a particle to itself (a spring without length is "
+            "unstressed trivially)"
+            if to_itself
+            else ""
+        )
+        + ": the rest lengths are judged on the grid's springs, so this earns no point",
         cause=springs_mistake(task4)
         or "springs missing, listed twice, or spring ends left at zero",
     )
@@ -335,7 +444,7 @@ def test_step_cost_reports_springs_and_time(task4, own_numbers):
     """step_cost gives the number of springs of the n³ grid and a plausible time per step."""
     n = own_numbers.cost_size
     for neighbours in ((1,), (1, 2, 3)):
-        springs, seconds = task4.step_cost(n, neighbours, 5)
+        springs, seconds = returned(task4.step_cost(n, neighbours, 5), "step_cost")
         expected = oracles.grid_body((n, n, n), 1.0, 1.0, neighbours).n_springs
         expect(
             springs == expected,

@@ -10,7 +10,15 @@ import pytest
 
 import msdlab as msd
 from msdlab.course import oracles
-from msdlab.course.feedback import as_array, expect, matching_variant, num, percent, vec
+from msdlab.course.feedback import (
+    as_array,
+    expect,
+    matching_variant,
+    num,
+    percent,
+    returned,
+    vec,
+)
 from msdlab.course.reference_cache import cached
 
 pytestmark = pytest.mark.task5
@@ -112,7 +120,9 @@ def check_one_step(task5, lam, cause=""):
     dt = 0.4
     dynamics, x, v = one_step_case()
     expected = engine_step(lam, x, v, dt, dynamics)
-    result = damped_verlet(task5, lam).step(x.copy(), v.copy(), dt, dynamics)
+    result = returned(
+        damped_verlet(task5, lam).step(x.copy(), v.copy(), dt, dynamics), "DampedVerlet.step"
+    )
     expect(
         isinstance(result, tuple) and len(result) == 2,
         saw=f"step returned {type(result).__name__}, not the pair (x_new, v_new)",
@@ -183,7 +193,10 @@ def test_velocity_dependent_forces_see_the_velocity(task5):
     v = rng.standard_normal(x.shape)
     dynamics = msd.Dynamics(body, [msd.Gravity(GRAVITY), msd.ViscousDamping(0.3)])
     expected = engine_step(lam, x, v, dt, dynamics)
-    x_new = as_array(task5.DampedVerlet(lam).step(x.copy(), v.copy(), dt, dynamics)[0], "step")
+    result = returned(
+        task5.DampedVerlet(lam).step(x.copy(), v.copy(), dt, dynamics), "DampedVerlet.step"
+    )
+    x_new = as_array(result[0], "step")
     still = np.zeros_like(v)
     mistakes = {
         "the acceleration evaluated at zero velocity, a(x, 0): dashpots and drag depend on "
@@ -205,14 +218,18 @@ def test_velocity_dependent_forces_see_the_velocity(task5):
 
 
 @pytest.mark.points(3)
-def test_no_damping_reproduces_the_template(task5):
-    """λ = 0 reproduces the template's falling grid step for step (to rounding), floor included."""
-    shape, spacing, origin, steps = (3, 2, 4), 0.1, (-1.0, 1.5, -1.0), 600
-    template = oracles.template_run(
-        oracles.template_positions(shape, spacing, origin).reshape(-1, 3), steps
-    )
+def test_no_damping_reproduces_the_template(task5, own_numbers):
+    """λ = 0 reproduces the template's falling grid step for step (to rounding), floor included
+    (the grid of task 1, dropped from the student's own height under their own acceleration
+    where each student has their own numbers)."""
+    shape, spacing, origin = (3, 2, 4), 0.1, (-1.0, own_numbers.bottom, -1.0)
+    gravity = (0.0, own_numbers.gravity, 0.0)
+    start = oracles.template_positions(shape, spacing, origin).reshape(-1, 3)
+    landing = template_landing(own_numbers.bottom, own_numbers.gravity)
+    steps = landing + 50
+    template = oracles.template_run(start, steps, acceleration=gravity)
     body = msd.Body.grid(shape, spacing, neighbours=(), origin=origin)
-    forces = [msd.Gravity(GRAVITY), msd.Ground(0.0)]
+    forces = [msd.Gravity(gravity), msd.Ground(0.0)]
     frames = (
         msd.Simulation(body, task5.DampedVerlet(0.0), oracles.TEMPLATE_DT, forces)
         .run(steps=steps)
@@ -224,13 +241,25 @@ def test_no_damping_reproduces_the_template(task5):
     expect(
         np.all(error <= tolerance),
         saw=f"with λ = 0 the grid leaves the template's trajectory in step {first} (off by "
-        f"{num(error[first])}; the bottom layer meets the floor in step 548)",
+        f"{num(error[first])}; dropped from y = {own_numbers.bottom}, its bottom layer meets "
+        f"the floor in step {landing})",
         cause="a scheme other than eq. (1.3), or a different start: the template begins with "
         "old = current (zero velocity)"
-        if first < 548
+        if first < landing
         else "a velocity that is not (x(t+dt) - x(t))/dt: the floor edits it and the next "
         "step must recover x(t - dt) from it",
     )
+
+
+def template_landing(bottom: float, g: float) -> int:
+    """The step in which the template's grid, its bottom layer at rest at height ``bottom``
+    under the acceleration (0, ``g``, 0), first reaches the floor (task 1's answer)."""
+    height, speed, step = bottom, 0.0, 0
+    while height > 0.0:
+        speed += g * oracles.TEMPLATE_DT**2  # the template's distance per step grows by g dt²
+        height += speed
+        step += 1
+    return step
 
 
 @pytest.mark.points(2)
@@ -312,7 +341,7 @@ def test_damping_acts_on_velocity_only(task5):
     pull = np.array([0.2, -0.5, 0.1])
     dynamics = msd.Dynamics(body, [msd.Gravity(pull)])
     for _ in range(5):
-        x_new, v_new = integrator.step(x, v.copy(), dt, dynamics)
+        x_new, v_new = returned(integrator.step(x, v.copy(), dt, dynamics), "DampedVerlet.step")
         v_new = as_array(v_new, "step", x.shape)
         expected = (1 - lam) * v + pull * dt
         worst = int(np.argmax(np.linalg.norm(v_new - expected, axis=1)))
@@ -333,7 +362,7 @@ def check_free_particles(task5, integrator, dynamics, x, v, lam, dt):
     step, and the velocity array given is left alone. Returns the last x and v."""
     for _ in range(5):
         given = v.copy()
-        x_new, v_new = integrator.step(x, given, dt, dynamics)
+        x_new, v_new = returned(integrator.step(x, given, dt, dynamics), "DampedVerlet.step")
         x_new, v_new = as_array(x_new, "step", x.shape), as_array(v_new, "step", x.shape)
         expect(
             np.array_equal(given, v),
@@ -380,7 +409,7 @@ def test_measured_stable_dt_as_predicted(task5):
     """measured_stable_dt(λ) agrees with the engine's prediction for your DampedVerlet(λ) (for
     eq. (1.4): √(4 - 2λ)/ω, smaller with damping); this check is about the measurement."""
     for lam in (0.0, 0.5):
-        measured = float(task5.measured_stable_dt(lam, 3, 300, 0.01))
+        measured = float(returned(measurement(task5, lam), "measured_stable_dt"))
         predicted, whose = own_limit(task5, lam)
         expect(
             abs(measured / predicted - 1) < 0.06,
@@ -388,6 +417,24 @@ def test_measured_stable_dt_as_predicted(task5):
             f"predicted limit of {whose} is {num(predicted)}",
             cause="a different body than jelly(n), a measurement that does not use your "
             "DampedVerlet, or the damping λ is not passed on",
+        )
+
+
+def measurement(task5, lam):
+    """The student's measured_stable_dt(λ, 3, 300, 0.01); where it fails while their
+    DampedVerlet has a recognised mistake (unstable at any dt, nothing can be measured), a
+    failure naming that mistake."""
+    try:
+        return task5.measured_stable_dt(lam, 3, 300, 0.01)
+    except Exception as error:
+        mistake = scheme_mistake(task5, lam) or scheme_mistake(task5)
+        if not mistake:
+            raise
+        expect(
+            False,
+            saw=f"measured_stable_dt({lam}, 3, 300, 0.01) fails ({type(error).__name__}: "
+            f"{error}): your DampedVerlet({lam}) is what is measured",
+            cause=mistake,
         )
 
 

@@ -175,7 +175,7 @@ def describe_blowup(
     else:
         speed = np.linalg.norm(v_new, axis=1)
         fastest = int(np.argmax(speed))
-        lines.append(f"particle {fastest} moves at {speed[fastest]:.3g} m/s")
+        lines.append(f"particle {fastest} moves at {speed[fastest]:.3g} length units a second")
     if body.n_springs:
         edges = body.edges()
         stretch = numpy_backend.vectors(edges, x)[1] / edges.rest_lengths
@@ -189,22 +189,30 @@ def describe_blowup(
 
 
 def _against_the_limit(integrator: Integrator, dt: float, mode: Mode) -> str:
-    """What dt (s) is against the predicted stable limit of ``integrator`` for ``mode``."""
-    name = type(integrator).__name__
+    """What dt (s) is against the predicted stable limit of ``integrator`` for ``mode``; the
+    advice to change integrators only for one of the engine's own (a user's own integrator,
+    such as one a course asks for, is to be fixed, not replaced)."""
+    own = type(integrator).__module__ == Integrator.__module__
+    name = type(integrator).__name__ if own else "your integrator"
     try:
         limit = stability_limit(integrator, mode)
     except Exception as error:  # a user's integrator that cannot step a one-mode system
-        return f"(no stability prediction: {name}.step failed on a test mode: {error!r})"
+        return f"(no stability prediction: the step of {name} failed on a test mode: {error!r})"
     if limit == 0.0:
+        advice = (
+            "use SymplecticEuler, Verlet, VelocityVerlet or ImplicitEuler, or add dashpots"
+            if own
+            else "compare its step with the scheme's equation, term by term"
+        )
         return (
             f"{name} is unstable at any dt for these springs (its energy grows every step): "
-            "use SymplecticEuler, Verlet, VelocityVerlet or ImplicitEuler, or add dashpots"
+            f"{advice}"
         )
     if dt > limit:
         return (
             f"dt = {dt:.3g} s is {dt / limit:.3g}× the predicted stable limit {limit:.3g} s "
             f"of {name} (stiffest mode ω = {mode.omega:.3g} rad/s, period {mode.period:.3g} s): "
-            f"use dt < {0.9 * limit:.3g} s, softer springs, or ImplicitEuler"
+            f"use dt < {0.9 * limit:.3g} s, softer springs{', or ImplicitEuler' if own else ''}"
         )
     return (
         f"dt = {dt:.3g} s is below the predicted linear limit {limit:.3g} s of {name}, so "

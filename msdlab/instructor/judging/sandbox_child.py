@@ -34,7 +34,7 @@ def main(config: dict[str, Any]) -> None:
     import scipy.sparse.linalg  # noqa: F401  what the engine imports only when used
 
     import msdlab  # noqa: F401
-    from msdlab.course import delegation
+    from msdlab.course import delegation, failure  # noqa: F401  failure: _raised_in's
     from msdlab.instructor.judging import wire
 
     _load_engine()
@@ -385,8 +385,9 @@ def _describe(error: BaseException, folder: str) -> dict:
 
 
 def _raised_in(error: BaseException, folder: str) -> dict:
-    """The innermost line of the submission's files in ``error``'s traceback: its file (from
-    ``folder``), line, function (a method with its class) and code; {} where there is none."""
+    """The innermost line of the submission's files in ``error``'s traceback outside their
+    given code (`outside_given_code`): its file (from ``folder``), line, function (a method
+    with its class) and code; {} where there is none."""
     frames = [
         (frame, line)
         for frame, line in traceback.walk_tb(error.__traceback__)
@@ -394,7 +395,9 @@ def _raised_in(error: BaseException, folder: str) -> dict:
     ]
     if not frames:
         return {}
-    frame, line = frames[-1]
+    from msdlab.course.failure import outside_given_code  # loaded before the guard: main
+
+    frame, line = frames[outside_given_code([(f.f_code.co_filename, n) for f, n in frames])]
     path = frame.f_code.co_filename
     return {
         "file": os.path.relpath(path, folder),

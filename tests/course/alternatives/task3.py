@@ -8,7 +8,7 @@ import numpy as np
 import scipy.linalg
 
 
-def rotation_matrix(axis, angle_degrees):
+def rotation_matrix(angle_degrees, axis):
     n = np.asarray(axis, dtype=float)
     n = n / np.linalg.norm(n)
     cross = np.array([[0.0, -n[2], n[1]], [n[2], 0.0, -n[0]], [-n[1], n[0], 0.0]])
@@ -19,7 +19,7 @@ def rotate_layout(positions, axis, angle_degrees):
     positions = np.asarray(positions, dtype=float)
     flat = positions.reshape(-1, 3)
     centre = flat.sum(axis=0) / len(flat)
-    turned = [rotation_matrix(axis, angle_degrees) @ (p - centre) + centre for p in flat]
+    turned = [rotation_matrix(angle_degrees, axis) @ (p - centre) + centre for p in flat]
     return np.array(turned).reshape(positions.shape)
 
 

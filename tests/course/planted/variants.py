@@ -142,7 +142,7 @@ BUGS = [
         T1_HEIGHT,
         T1_HEIGHT.replace("y0 +", "ORIGIN[1] +"),
         "height_after_for_any_start",
-        "y0 = 1.5 used instead of the argument y0",
+        "ORIGIN[1] = 1.5 used instead of the argument y0",
     ),
     bug(
         "height ignores g",
@@ -150,7 +150,7 @@ BUGS = [
         T1_HEIGHT,
         T1_HEIGHT.replace("g *", "GRAVITY[1] *"),
         "height_after_for_any_start",
-        "g = -0.001 used instead of the argument g",
+        "GRAVITY[1] = -0.001 used instead of the argument g",
     ),
     Variant(  # a friend's copy of the template: another student's own numbers
         "constants copied from another student",
@@ -197,6 +197,22 @@ BUGS = [
         "    return msd.Verlet().step(flat, velocity, dt, dynamics)[0].reshape(current.shape)",
         "verlet_step_is_the_kernel",
         "asks for your own implementation",
+    ),
+    bug(
+        "count: n + 1 per edge",
+        1,
+        "return n**3",
+        "return (n + 1) ** 3",
+        "particle_count",
+        "n + 1 particles per edge",
+    ),
+    bug(
+        "height: no return",
+        1,
+        T1_HEIGHT,
+        T1_HEIGHT.replace("return ", "height = "),
+        "height_after_as_template",
+        "height_after must end with return",
     ),
 ]
 
@@ -426,6 +442,14 @@ BUGS += [
         "matches_equations_on_a_deformed_grid",
         "asks for your own implementation",
     ),
+    bug(
+        "no return",
+        2,
+        "    return a\n",
+        "",
+        "grid_at_rest_feels_no_force",
+        "spring_acceleration must end with return",
+    ),
 ]
 
 ALTERNATIVES += [
@@ -540,8 +564,8 @@ BUGS += [
     bug(
         "layout angle fixed",
         3,
-        "rotation = rotation_matrix(axis, angle_degrees)",
-        "rotation = rotation_matrix(axis, 45.0)",
+        "rotation = rotation_matrix(angle_degrees, axis)",
+        "rotation = rotation_matrix(45.0, axis)",
         "rotate_layout_turns_about_centroid",
         "the angle argument is ignored",
     ),
@@ -620,6 +644,14 @@ BUGS += [
         "    i, j = springs[:, 0], springs[:, 1]\n",
         "spring_acceleration_matches_equations",
         "asks for your own implementation",
+    ),
+    bug(
+        "rotation_matrix called axis first",
+        3,
+        "rotation = rotation_matrix(angle_degrees, axis)",
+        "rotation = rotation_matrix(axis, angle_degrees)",
+        "rotate_layout_turns_about_centroid",
+        "rotation_matrix takes (angle_degrees, axis)",
     ),
 ]
 
@@ -846,6 +878,22 @@ BUGS += [
         "    index = np.arange(np.prod(shape)).reshape(shape)\n",
         "grid_springs_each_pair_once",
         "asks for your own implementation",
+    ),
+    bug(
+        "offsets by length, not squared length",
+        4,
+        T4_TEST,
+        "if np.sqrt(di * di + dj * dj + dk * dk) in wanted",
+        "neighbour_offsets_26",
+        "neighbour_offsets keeps an offset by its length",
+    ),
+    bug(
+        "springs: no return",
+        4,
+        "return np.concatenate(pairs).astype(int), np.concatenate(rest)",
+        "springs = np.concatenate(pairs).astype(int), np.concatenate(rest)",
+        "grid_springs_each_pair_once",
+        "grid_springs must end with return",
     ),
 ]
 
