@@ -310,8 +310,8 @@ class Session:
             grade = grading.Grade(entry.id, None, [entry.problem])
             status = gradebook_db.ABSENT if entry.absent else gradebook_db.NOT_GRADED
             self._commit(shown(grade, entry), status)
-            if entry.absent:
-                print(f"{entry.id}: {entry.problem}", file=sys.stderr)
+            where = f" (nothing at {entry.source})" if entry.absent and entry.source.name else ""
+            print(f"{entry.id}: {entry.problem}{where}", file=sys.stderr)
             unusable.append(grade)
         return unusable
 

@@ -92,7 +92,7 @@ def zip_time(members: list[zipfile.ZipInfo], zone: tzinfo | None) -> HandIn:
         if not files:
             raise ValueError("the zip holds no files")
         return HandIn(max(_entry_time(m, zone) for m in tasks or files), NAMES["zip"], STUDENT)
-    except (ValueError, OverflowError) as error:
+    except (ValueError, OverflowError, OSError) as error:
         return unreadable("zip", str(error))
 
 
@@ -115,7 +115,11 @@ def modification_time(seconds: list[float]) -> HandIn:
     """The newest of the task files' modification times (``seconds`` since the epoch)."""
     if not seconds:
         return unreadable("mtime", "no task files to read the time of")
-    return HandIn(datetime.fromtimestamp(max(seconds), timezone.utc), NAMES["mtime"], STUDENT)
+    try:
+        newest = datetime.fromtimestamp(max(seconds), timezone.utc)
+    except (ValueError, OverflowError, OSError):
+        return unreadable("mtime", f"{max(seconds):.0f} s since 1970 is no date a calendar holds")
+    return HandIn(newest, NAMES["mtime"], STUDENT)
 
 
 def under_policy(handed: HandIn, policy: str, collected: datetime) -> HandIn:
