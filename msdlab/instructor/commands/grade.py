@@ -288,6 +288,7 @@ class Session:
         known = {*self.entries, *(record.id for record in records)}
         changes = [c for listed in self.terms.changes.values() for c in listed]
         found = adjustments.against_class(changes, str(path), None, known)
+        found += term_options.extensions_against_class(self.args, self.terms, known)
         rows = {record.id: record.final for record in records}
         regraded = [entry.id for entry in todo]
         where = str(gradebook_db.beside(self.args.out))

@@ -50,6 +50,7 @@ from pathlib import Path
 
 from ...course import TASKS
 from ...course.report import CheckReport, CheckResult
+from ..outputs import output_files
 from ..rules.final_points import COLUMNS as FINAL_COLUMNS
 
 SCHEMA_VERSION = 1
@@ -60,6 +61,8 @@ BUSY_SECONDS = 120.0
 CHECK_FIELDS = tuple(field.name for field in dataclasses.fields(CheckResult))
 """The ``checks`` table's columns after ``submission`` and ``position``: a field added to
 `CheckResult` later is added to an older gradebook's table when it is opened."""
+JOURNALS = ("-wal", "-shm", "-journal")
+"""The files SQLite keeps beside the gradebook."""
 SETTLED = [column for column in FINAL_COLUMNS if column not in ("handed_in", "handed_in_from")]
 
 _SCHEMA = f"""
@@ -130,6 +133,7 @@ def connect(path: Path) -> sqlite3.Connection:
     """The gradebook at ``path``, created if new, ready for another run beside this one
     (WAL journal, a busy timeout of `BUSY_SECONDS`). Commit with ``with connection:``."""
     path = Path(path)
+    _not_linked(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     connection = sqlite3.connect(path, timeout=BUSY_SECONDS, isolation_level=None)
     try:
@@ -146,6 +150,13 @@ def connect(path: Path) -> sqlite3.Connection:
             f"{path} is not a gradebook msdlab can read ({error}); give another --out"
         ) from None
     return connection
+
+
+def _not_linked(path: Path) -> None:
+    """Refuse a gradebook (or its journal files, its folder) that is a symbolic link: the
+    class's rows would be written wherever it points."""
+    for place in (path, *(path.with_name(path.name + end) for end in JOURNALS)):
+        output_files.not_a_link(place, "gradebook")
 
 
 @contextlib.contextmanager
