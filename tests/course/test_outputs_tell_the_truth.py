@@ -167,6 +167,7 @@ def test_a_typo_in_the_extensions_is_warned_about_and_a_lookalike_refused():
         p.what: p for p in term_options.extensions_against_class(args, terms, {"alice", "bob"})
     }
     assert not found["no submission has the id 'bbo'"].refused
+    assert "did you mean 'bob'?" in str(found["no submission has the id 'bbo'"])
     assert found["no submission has the id 'Alice'"].refused
     assert "did you mean 'alice'" in str(found["no submission has the id 'Alice'"])
 

@@ -4,6 +4,7 @@ and the instructor's files, checked whole."""
 from __future__ import annotations
 
 import argparse
+import difflib
 import sys
 import tempfile
 from collections.abc import Collection, Mapping
@@ -93,9 +94,11 @@ def extensions_against_class(
         alike = sorted(
             k for k in known if adjustments.plain_id(k) == adjustments.plain_id(identifier)
         )
+        near = difflib.get_close_matches(identifier, sorted(known), n=1)
+        hint = f" (did you mean {near[0]!r}?)" if near else ""
         problem = Problem(str(args.extensions), f"no submission has the id {identifier!r}",
                           f"did you mean {alike[0]!r}? write the id exactly" if alike else
-                          "its extension waits for one; check the id against the roster",
+                          f"its extension waits for one; check the id against the roster{hint}",
                           refused=bool(alike))  # fmt: skip
         found.append(problem)
     return found
