@@ -6,6 +6,7 @@ hand-in's row says what could not be read; the rest of the class is taken in."""
 from __future__ import annotations
 
 import stat
+import subprocess
 import tracemalloc
 import zipfile
 from datetime import datetime, timezone
@@ -17,7 +18,7 @@ from dulwich.repo import Repo
 
 from msdlab.course import PROJECT_ROOT
 from msdlab.instructor import intake
-from msdlab.instructor.intake import archive, fresh, submissions
+from msdlab.instructor.intake import archive, fresh, git_objects, submissions
 
 TASK1 = (PROJECT_ROOT / "solutions" / "task1.py").read_bytes()
 HUGE = 30_000_000  # inflated bytes of zeros: a few tens of kB in a pack or a loose object
@@ -69,6 +70,25 @@ def test_a_huge_git_object_is_left_out_by_its_header_before_it_is_read(tmp_path,
     assert entry.problem is None and files == ["task1.py"]
     assert any("task2.py was left out: larger than" in note for note in entry.notes)
     assert peak < HUGE / 10, f"the intake allocated {peak} bytes for a {HUGE}-byte object"
+
+
+def test_a_repository_git_packed_into_deltas_is_read_by_its_headers(tmp_path):
+    clone = tmp_path / "alice"
+    (clone / "assignments").mkdir(parents=True)
+    git = ["git", "-C", str(clone), "-c", "user.name=A", "-c", "user.email=a@b"]
+    subprocess.run([*git[:3], "init", "-q"], check=True)
+    text = TASK1 * 40
+    for version in range(4):  # versions of one file: git stores them as deltas
+        text += f"# version {version}\n".encode()
+        (clone / "assignments" / "task1.py").write_bytes(text)
+        subprocess.run([*git, "add", "."], check=True)
+        subprocess.run([*git, "commit", "-qm", f"v{version}"], check=True)
+    subprocess.run([*git, "gc", "-q", "--aggressive"], check=True)
+    store = git_objects.BoundedStore(clone / ".git" / "objects", fresh.MAX_TOTAL_BYTES)
+    for sha in store:
+        assert store.size(sha) >= len(store[sha].as_raw_string())
+    entry, files = taken_alone(clone)
+    assert entry.problem is None and files == ["task1.py"] and not entry.notes
 
 
 def test_a_commit_time_no_calendar_holds_is_unreadable_and_the_class_taken_in(tmp_path):

@@ -47,8 +47,9 @@ class BoundedStore(DiskObjectStore):
         return super().__getitem__(sha)
 
     def size(self, sha: bytes) -> int:
-        """The largest inflated size among the object ``sha`` and its delta bases, read from
-        their headers; a KeyError if the store does not hold it."""
+        """The most bytes reading the object ``sha`` inflates: the largest size among it,
+        its delta bases and their deltas, read from their headers; a KeyError if the store
+        does not hold it."""
         return self._size(sha, 0)
 
     def _size(self, sha: bytes, depth: int) -> int:

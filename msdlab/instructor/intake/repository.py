@@ -207,7 +207,8 @@ def _take(store: BoundedStore, path: bytes, mode: int, sha: bytes, fresh: FreshF
     elif mode == 0o160000:
         fresh.leave_out(name, "a submodule (another repository) in the commit")
     elif stat.S_ISREG(mode) and store.size(sha) > MAX_FILE_BYTES:
-        fresh.leave_out(name, f"larger than {MAX_FILE_BYTES} bytes (not read)")
+        fresh.leave_out(name, f"larger than {MAX_FILE_BYTES} bytes, or stored in the "
+                        "repository as a change to such an object (not read)")  # fmt: skip
     elif stat.S_ISREG(mode):
         blob = store[sha]
         if not isinstance(blob, Blob):
