@@ -103,6 +103,11 @@ def test_a_grader_failed_row_has_no_points_and_a_status_in_every_output(tmp_path
     assert cells == {"": "95", "1": "75", "3": "0", "4": ""}
     said = capsys.readouterr().err
     assert "'dave': the grader failed on this submission" in said and "left empty" in said
+    moodle = tmp_path / "moodle.csv"
+    assert main(["export", str(out), "--roster", str(tmp_path / "roster.csv"),
+                 "--format", "moodle", "--out", str(moodle)]) == 0  # fmt: skip
+    dave = next(row for row in csv.DictReader(moodle.open()) if row["Full name"] == "D")
+    assert (dave["msdlab"], dave["Feedback"]) == ("", "")
 
 
 # ------------------------------------------------- the roster and the hand-ins, both ways

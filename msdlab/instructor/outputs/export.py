@@ -168,8 +168,9 @@ def _moodle(book: Gradebook, people: list[dict[str, str]], assignment: str) -> l
 
 
 def _how(row: dict[str, str]) -> str:
-    """How the total was made, in a line: checks, late penalty, adjustment."""
-    if not row:
+    """How the total was made, in a line: checks, late penalty, adjustment ('' for a row
+    without a total: none, or the grader's failure)."""
+    if not row.get("total"):
         return ""
     parts = [f"checks {row.get('points') or row.get('total', '')}"]
     if row.get("late_penalty"):
