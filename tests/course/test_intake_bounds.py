@@ -24,15 +24,17 @@ TASK1 = (PROJECT_ROOT / "solutions" / "task1.py").read_bytes()
 HUGE = 30_000_000  # inflated bytes of zeros: a few tens of kB in a pack or a loose object
 
 
-def commit_of(folder: Path, files: dict[bytes, bytes], time: int, packed: bool) -> None:
-    """A repository at ``folder`` of one commit of ``files`` in ``assignments/`` made at
-    ``time`` (seconds since 1970), its objects loose or in one pack."""
+def commit_of(folder: Path, files: dict[bytes, bytes] | list[tuple[bytes, bytes]], time: int,
+              packed: bool) -> None:  # fmt: skip
+    """A repository at ``folder`` of one commit of ``files`` (a list may name one twice)
+    in ``assignments/`` made at ``time`` (seconds since 1970), its objects loose or in one
+    pack."""
     folder.mkdir(parents=True)
     repo = Repo.init(str(folder))
-    blobs = {name: Blob.from_string(content) for name, content in files.items()}
-    inner = Tree()
-    for name, blob in blobs.items():
-        inner.add(name, 0o100644, blob.id)
+    pairs = files if isinstance(files, list) else list(files.items())
+    named = [(name, Blob.from_string(content)) for name, content in pairs]
+    raw = b"".join(b"100644 " + name + b"\0" + blob.sha().digest() for name, blob in named)
+    inner = Tree.from_raw_string(Tree.type_num, raw)
     top = Tree()
     top.add(b"assignments", stat.S_IFDIR, inner.id)
     commit = Commit()
@@ -40,7 +42,7 @@ def commit_of(folder: Path, files: dict[bytes, bytes], time: int, packed: bool) 
     commit.author = commit.committer = b"Student <student@example.org>"
     commit.author_time = commit.commit_time = time
     commit.author_timezone = commit.commit_timezone = 0
-    objects = [*blobs.values(), inner, top, commit]
+    objects = [*(blob for _, blob in named), inner, top, commit]
     if packed:
         repo.object_store.add_objects([(obj, None) for obj in objects])
     else:
@@ -102,6 +104,13 @@ def test_a_commit_time_no_calendar_holds_is_unreadable_and_the_class_taken_in(tm
         assert mallory.handed_in.time is None and mallory.handed_in.control == "unreadable"
         assert "no date a calendar holds" in mallory.handed_in.note
         assert bob.problem is None and bob.handed_in.time is not None
+
+
+def test_a_commit_naming_one_file_twice_is_refused_with_the_name(tmp_path):
+    twice = [(b"task1.py", TASK1), (b"task1.py", b"raise SystemExit\n")]
+    commit_of(tmp_path / "mallory", twice, 1_800_000_000, packed=False)
+    entry, _ = taken_alone(tmp_path / "mallory", "mallory")
+    assert "the commit's tree holds task1.py 2 times" in entry.problem
 
 
 def test_whatever_a_library_raises_on_one_hand_in_is_its_row_only(tmp_path, monkeypatch):

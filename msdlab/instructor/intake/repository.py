@@ -13,7 +13,8 @@ crafted tree can name files anywhere. Here git's objects are read as data, and o
   (`take_commit`); its time is the committer date, which the student's machine set;
 - of that commit's tree, the regular files directly in the graded folder are written
   into the fresh folder; a name that is absolute, ``..`` or ``.git`` refuses the
-  submission; links (mode 120000) and submodules (160000) are left out, with a note;
+  submission, and so does a name the graded folder's tree holds twice; links (mode
+  120000) and submodules (160000) are left out, with a note;
 - every object's size is read from its header before it is read (`git_objects`): a file
   larger than `fresh.MAX_FILE_BYTES` is left out unread, a tree or commit larger than
   `fresh.MAX_TOTAL_BYTES` makes the repository unreadable;
@@ -23,6 +24,7 @@ crafted tree can name files anywhere. Here git's objects are read as data, and o
 
 from __future__ import annotations
 
+import collections
 import os
 import re
 import stat
@@ -68,7 +70,9 @@ def take_commit(
         part = graded_folder(
             lambda p: _names(store, tree, p)[0], lambda p: _names(store, tree, p)[1]
         )
-        for name, mode, sha in _subtree(store, tree, part).items():
+        graded = _subtree(store, tree, part)
+        _refuse_twins(graded)
+        for name, mode, sha in graded.items():
             _take(store, name, mode, sha, fresh)
     except (KeyError, ObjectFormatException, ValueError, OSError, AssertionError,
             zlib.error) as error:  # fmt: skip
@@ -195,6 +199,22 @@ def _names(store: BoundedStore, tree: Tree, part: str) -> tuple[set[str], list[s
         return set(), []
     files = {os.fsdecode(e.path) for e in entries if stat.S_ISREG(e.mode)}
     return files, sorted(os.fsdecode(e.path) for e in entries if stat.S_ISDIR(e.mode))
+
+
+def _refuse_twins(tree: Tree) -> None:
+    """Refuse a graded folder whose tree names one file twice (git itself never writes one;
+    a parsed tree keeps only the last, so its raw entries are counted)."""
+    raw, names, at = tree.as_raw_string(), [], 0
+    while at < len(raw):
+        space, end = raw.index(b" ", at), raw.index(b"\0", at)
+        names.append(raw[space + 1 : end])
+        at = end + 1 + 20
+    counts = collections.Counter(names)
+    twins = sorted(name for name, count in counts.items() if count > 1)
+    if twins:
+        name = readable(os.fsdecode(twins[0]))
+        raise Refused(f"not graded: the commit's tree holds {name} {counts[twins[0]]} "
+                      "times (which one was meant cannot be told)")  # fmt: skip
 
 
 def _take(store: BoundedStore, path: bytes, mode: int, sha: bytes, fresh: FreshFolder) -> None:
