@@ -165,6 +165,14 @@ def test_feedback_opens_with_the_final_total_and_one_time_zone(tmp_path):
     assert "due 2027-03-01 23:59 UTC+0100" in text and "handed in 2027-03-02 16:00 UTC+0100" in text
 
 
+def test_a_forged_time_at_the_end_of_the_calendar_is_charged_not_a_crash(tmp_path):
+    handed = HandIn(datetime(9999, 12, 31, 23, 59, tzinfo=timezone.utc), "last commit", "student")
+    terms = Terms(
+        DUE, late.LatePolicy.parse("penalty=10%/day,cap=50%"), handed_in={"alice": handed}
+    )
+    assert rows_of(class_of(tmp_path, terms))["alice"]["total"] == "37.5"
+
+
 def test_a_typo_in_the_extensions_is_warned_about_and_a_lookalike_refused():
     args = argparse.Namespace(extensions=Path("extensions.csv"))
     terms = Terms(DUE, own_due={"bbo": DUE, "Alice": DUE, "bob": DUE})

@@ -131,10 +131,19 @@ def _charge(row: dict[str, str], points: Fraction, due: datetime, terms: Terms, 
         return
     handed = datetime.fromisoformat(row["handed_in"])
     lateness = terms.policy.charge(points, handed - due)
-    shown = _shown(handed.astimezone(due.tzinfo))  # one zone for both: the due date's
+    shown = _shown(_in_zone(handed, due))
     when = f"due {_shown(due)}{' (your extension)' if own else ''}, handed in {shown}"
     row["late"] = f"{when} ({_evidence(row)}): {lateness.reason}"
     row["late_penalty"] = format_points(lateness.penalty) if lateness.penalty else ""
+
+
+def _in_zone(moment: datetime, due: datetime) -> datetime:
+    """``moment`` on the due date's clock (as read where that clock has no such date: a
+    forged time at the end of year 9999)."""
+    try:
+        return moment.astimezone(due.tzinfo)
+    except OverflowError:
+        return moment
 
 
 def _evidence(row: dict[str, str]) -> str:
