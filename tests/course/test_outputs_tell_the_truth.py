@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import os
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
@@ -163,6 +164,25 @@ def test_feedback_opens_with_the_final_total_and_one_time_zone(tmp_path):
     headline = text.splitlines()[2]
     assert headline.startswith("**67.5 of 95 points** (the checks gave 75;"), headline
     assert "due 2027-03-01 23:59 UTC+0100" in text and "handed in 2027-03-02 16:00 UTC+0100" in text
+
+
+def test_a_students_notes_give_times_in_the_due_dates_zone_and_no_instructors_path(tmp_path):
+    (alice,) = hand_ins(tmp_path / "class", "alice")
+    moment = datetime(2027, 3, 2, 10, 0, tzinfo=timezone.utc).timestamp()
+    os.utime(alice / "task1.py", (moment, moment))
+    with intake.Intake(intake.Rules(due_of=lambda identifier: DUE)) as found:
+        (note,) = found.add("alice", alice).notes
+    assert note == "hand-in time not verified: file modification time " \
+                   "(2027-03-02T11:00+01:00) set by the student's machine"  # fmt: skip
+    out = tmp_path / "grades.csv"
+    connection = gradebook_db.connect(gradebook_db.beside(out))
+    place = tmp_path / "class" / "mallory"
+    why = f"not graded: mallory resolves to {tmp_path}/x, outside the folder {place.parent}"
+    gradebook_db.record(connection, gradebook_db.Result(
+        "mallory", str(place), gradebook_db.NOT_GRADED, [why]), None)  # fmt: skip
+    render.render(connection, out, Terms(), tmp_path / "feedback")
+    text = (tmp_path / "feedback" / "students" / "mallory.md").read_text()
+    assert "resolves to x, outside the folder class" in text and str(tmp_path) not in text
 
 
 def test_a_forged_time_at_the_end_of_the_calendar_is_charged_not_a_crash(tmp_path):

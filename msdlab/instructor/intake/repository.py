@@ -39,7 +39,7 @@ from dulwich.walk import Walker
 from .fresh import MAX_FILE_BYTES, MAX_TOTAL_BYTES, FreshFolder, Refused, graded_folder
 from .git_objects import BoundedStore
 from .names import readable, unsafe_name
-from .times import NAMES, STUDENT, HandIn, unreadable
+from .times import NAMES, STUDENT, HandIn, shown, unreadable
 
 MAX_COMMITS = 10_000
 _SHA = re.compile(rb"^[0-9a-f]{40}$")
@@ -91,7 +91,7 @@ def take_commit(
     note = None
     if commit.id != newest:
         note = (f"commits after the cutoff ignored; graded commit {commit.id.decode()[:10]} "
-                f"of {when.isoformat()}")  # fmt: skip
+                f"of {shown(when, cutoff)}")  # fmt: skip
     return HandIn(when, NAMES["git"], STUDENT, note)
 
 

@@ -227,12 +227,14 @@ class Intake(contextlib.AbstractContextManager):
                 f"the {METADATA} among the student's files was ignored: a student can write "
                 "it; Gradescope's own lies beside the submission"
             )
-        if handed is not None and rules.due_of(entry.id) is not None:
-            handed = entry.handed_in = under_policy(handed, rules.unverified, rules.collected)
+        due = rules.due_of(entry.id)
+        if handed is not None and due is not None:
+            handed = under_policy(handed, rules.unverified, rules.collected, due)
+            entry.handed_in = handed
             if handed.note:
                 entry.notes.append(handed.note)
             if not handed.verified and rules.unverified == "flag":
-                entry.notes.append(flag(handed))
+                entry.notes.append(flag(handed, due))
         if not task_files(entry.folder):
             entry.problem = f"no task files ({TASK_FILES[0]} ... {TASK_FILES[-1]}) handed in"
 

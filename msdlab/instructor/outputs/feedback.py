@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import collections
+import os
 import re
 import statistics
 from collections.abc import Sequence
@@ -35,13 +36,14 @@ if TYPE_CHECKING:
     from ..points.gradebook_db import Record
 
 
-def for_student(grade: Grade, total: str | None = None) -> str:
+def for_student(grade: Grade, total: str | None = None, source: str = "") -> str:
     """The Markdown feedback a student may read, opening with the final ``total`` (the
-    term's rules applied; None: the checks' points are the total)."""
+    term's rules applied; None: the checks' points are the total); paths in it are
+    relative, as seen from above the folder of the hand-in ``source`` (`student_notes`)."""
     lines = [f"# Feedback: {grade.submission}", ""]
     if grade.report is None:
         lines += ["Your submission could not be graded:", ""]
-        lines += [f"- {note}" for note in student_notes(grade.notes)]
+        lines += [f"- {note}" for note in student_notes(grade.notes, source)]
         return "\n".join(lines) + "\n"
     report = grade.report
     public = [c for c in report.checks if not c.hidden]
@@ -54,7 +56,7 @@ def for_student(grade: Grade, total: str | None = None) -> str:
         + f": public checks {_earned(public)} of {_points(public)}, hidden checks "
         f"{_earned(hidden)} of {_points(hidden)}."
     )
-    lines += ["", *[f"Note: {note}" for note in student_notes(grade.notes)]]
+    lines += ["", *[f"Note: {note}" for note in student_notes(grade.notes, source)]]
     for task in report.tasks():
         checks = [c for c in report.checks if c.task == task]
         lines += ["", _task_heading(task, checks)]
@@ -83,10 +85,14 @@ def for_student(grade: Grade, total: str | None = None) -> str:
     return "\n".join(lines) + "\n"
 
 
-def student_notes(notes: Sequence[str]) -> list[str]:
+def student_notes(notes: Sequence[str], source: str = "") -> list[str]:
     """The notes a student reads: without the grader's own (how it isolated the checks),
-    with no path of the grader's temporary folders."""
-    return [scrub(note) for note in notes if not note.startswith(GRADER_ONLY)]
+    with no path of the grader's temporary folders, and paths below the folder that holds
+    the hand-ins' folder (of the hand-in ``source``) relative to it: ``class/alice``, not
+    the instructor's whole path."""
+    above = os.path.dirname(os.path.dirname(source.rstrip("/")))
+    kept = [scrub(note) for note in notes if not note.startswith(GRADER_ONLY)]
+    return [note.replace(above + "/", "") if len(above) > 1 else note for note in kept]
 
 
 def for_instructor(grade: Grade, source: str = "", hint: str | None = None) -> str:

@@ -140,7 +140,8 @@ def write_feedback(
         if record.status == GRADER_FAILED:  # nothing to hand out: the grader's failure
             student.unlink(missing_ok=True)
         else:
-            text = feedback.for_student(grade, rows[record.id].get("total"))
+            source = intake.unescaped(record.source)
+            text = feedback.for_student(grade, rows[record.id].get("total"), source)
             _write(student, final_points.with_section(text, section))
         text = feedback.for_instructor(grade, record.source, record.hint)
         noted = [*record.explained, *private.get(record.id, [])]

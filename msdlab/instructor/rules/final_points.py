@@ -24,6 +24,7 @@ from pathlib import Path
 
 from ...course import TASKS
 from ..intake import HandIn, file_stem
+from ..intake.times import in_zone
 from ..outputs import output_files
 from .adjustments import Change
 from .late import LatePolicy, format_points
@@ -131,19 +132,10 @@ def _charge(row: dict[str, str], points: Fraction, due: datetime, terms: Terms, 
         return
     handed = datetime.fromisoformat(row["handed_in"])
     lateness = terms.policy.charge(points, handed - due)
-    shown = _shown(_in_zone(handed, due))
+    shown = _shown(in_zone(handed, due))
     when = f"due {_shown(due)}{' (your extension)' if own else ''}, handed in {shown}"
     row["late"] = f"{when} ({_evidence(row)}): {lateness.reason}"
     row["late_penalty"] = format_points(lateness.penalty) if lateness.penalty else ""
-
-
-def _in_zone(moment: datetime, due: datetime) -> datetime:
-    """``moment`` on the due date's clock (as read where that clock has no such date: a
-    forged time at the end of year 9999)."""
-    try:
-        return moment.astimezone(due.tzinfo)
-    except OverflowError:
-        return moment
 
 
 def _evidence(row: dict[str, str]) -> str:
