@@ -54,6 +54,7 @@ from .times import (
 
 GRADESCOPE_FILES = "submission"
 NOTHING_HANDED_IN = "nothing handed in"
+"""What the row of a roster student who handed in nothing says (0 points)."""
 NOT_ON_ROSTER = "which is not on the roster"
 """What the row of a hand-in whose id is no roster student's says (not graded)."""
 
@@ -116,8 +117,9 @@ class Intake(contextlib.AbstractContextManager):
     def add(self, identifier: str, source: Path, given_in: Path | None = None,
             known: set[str] | None = None) -> Entry | None:  # fmt: skip
         """Take in the submission at ``source`` under ``identifier``; a link leading out of
-        ``given_in`` (default: its parent) is not followed. An id that is not acceptable, or
-        not in ``known`` when given, refuses the submission: no entry, a line in `refused`."""
+        ``given_in`` (default: its parent) is not followed. An id that is not acceptable
+        refuses the submission: no entry, a line in `refused`; one not in ``known`` (when
+        given) is an entry that says so and is not taken (`unlisted`)."""
         source = Path(os.path.abspath(source))
         problem = self._id_problem(readable(identifier))
         if problem is not None:
@@ -313,8 +315,12 @@ def beside_the_roster(students: list[Student]) -> list[Path]:
         return []
     folder = Path(os.path.commonpath([path.parent for path in listed]))
     named = {place for path in (*listed, PROJECT_ROOT) for place in (path, *path.parents)}
+    try:
+        items = sorted(folder.iterdir())
+    except OSError:  # no folder there, or not one to read: nothing beside to name
+        return []
     found = []
-    for item in sorted(folder.iterdir()) if folder.is_dir() else []:
+    for item in items:
         if item in named or item.name.startswith(".") or item.is_symlink():
             continue
         if (item.suffix.lower() == ".zip" and item.is_file()) or _holds_a_hand_in(item):
@@ -331,7 +337,8 @@ def _holds_a_hand_in(folder: Path) -> bool:
 
 def taken_in(paths: list[Path], roster: Path | None, rules: Rules | None = None) -> Intake:
     """The class as the commands take it in: the roster's folders when no ``paths`` are
-    given, else the ``paths`` (with a roster too, each one's id must be a roster id)."""
+    given, else the ``paths`` (with a roster too, a path's id not on it is `unlisted`, and
+    a roster student no path is for is absent)."""
     if not paths:
         return from_roster(roster, rules)
     students = read_roster(roster) if roster else []
