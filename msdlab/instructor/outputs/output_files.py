@@ -2,8 +2,9 @@
 
 A grades file, gradebook, feedback file, report or export that is a symbolic link would
 send this class's rows wherever the link points (another course's gradebook, a student's
-folder on a shared machine). So a path that is a link, or a folder of the outputs that is
-one, is refused with a clear error (`not_a_link`), and a file is written whole into a new
+folder on a shared machine). So an output path that is a link, or a folder msdlab fills
+(the feedback's ``students/`` and ``instructor/``) that is one, is refused with a clear
+error (`not_a_link`), and a file is written whole into a new
 file beside it and renamed over the old one (`write_text`): a rename replaces a link
 made in between instead of writing through it, and a crash leaves the old file or the
 whole new one.
@@ -21,14 +22,14 @@ class LinkRefused(ValueError):
 
 
 def not_a_link(path: Path, what: str = "output") -> Path:
-    """``path``, after checking that neither it nor its folder is a symbolic link."""
+    """``path``, after checking that it is not a symbolic link (the folders it lies in
+    are the instructor's choice: ``/tmp`` is a link on some systems)."""
     path = Path(path)
-    for place in (path, path.parent):
-        if place.is_symlink():
-            raise LinkRefused(
-                f"the {what} {place} is a symbolic link (to {os.readlink(place)}); msdlab "
-                "writes nothing through a link: remove the link or give another path"
-            )
+    if path.is_symlink():
+        raise LinkRefused(
+            f"the {what} {path} is a symbolic link (to {os.readlink(path)}); msdlab writes "
+            "nothing through a link: remove the link or give another path"
+        )
     return path
 
 
