@@ -111,6 +111,14 @@ def test_a_grader_failed_row_has_no_points_and_a_status_in_every_output(tmp_path
     assert (dave["msdlab"], dave["Feedback"]) == ("", "")
 
 
+def test_a_grader_failed_row_taken_in_again_from_its_grades_file_keeps_no_points(tmp_path):
+    out = class_of(tmp_path)
+    gradebook_db.beside(out).unlink()
+    assert main(["grade", "--out", str(out), "--render"]) == 0  # the CSV taken in afresh
+    dave = rows_of(out)["dave"]
+    assert (dave["status"], dave["total"], dave["task1"]) == ("grader failed", "", "")
+
+
 # ------------------------------------------------- the roster and the hand-ins, both ways
 def hand_ins(root: Path, *names: str) -> list[Path]:
     for name in names:

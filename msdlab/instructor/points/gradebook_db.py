@@ -271,19 +271,23 @@ def _record_checks(connection: sqlite3.Connection, identifier: str, report: Chec
 def record_imported(
     connection: sqlite3.Connection, row: dict[str, str], maximum: dict[str, str]
 ) -> None:
-    """Take in a row of an older grades file (no checks: its task points and columns)."""
+    """Take in a row of an older grades file (no checks: its task points and columns; its
+    status where it has one, so a row the grader failed on keeps having no points)."""
     graded = bool(row.get("fingerprint"))
+    status = row.get("status") if row.get("status") in STATUSES else None
+    status = status or (GRADED if graded else NOT_GRADED)
+    nothing = "" if status == GRADER_FAILED else "0"
     notes = [note for note in (row.get("notes") or "").split("; ") if note]
     connection.execute(
         "INSERT OR REPLACE INTO submissions (id, source, status, fingerprint, handed_in, "
         "handed_in_from, notes, graded_at) VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
-        (row["id"], row.get("source", ""), GRADED if graded else NOT_GRADED,
+        (row["id"], row.get("source", ""), status,
          row.get("fingerprint") or None, row.get("handed_in") or None,
          row.get("handed_in_from") or None, json.dumps(notes), now()),
     )  # fmt: skip
     connection.executemany(
         "INSERT OR REPLACE INTO tasks VALUES (?, ?, ?, ?)",
-        [(row["id"], t, row.get(f"task{t}") or "0", maximum.get(f"task{t}") or "0")
+        [(row["id"], t, row.get(f"task{t}") or nothing, maximum.get(f"task{t}") or "0")
          for t in TASKS],
     )  # fmt: skip
     settled = {column: row.get(column) or "" for column in SETTLED}
