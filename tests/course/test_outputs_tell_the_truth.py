@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import csv
 import os
+import shutil
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
@@ -160,6 +161,30 @@ def test_the_summary_names_hand_ins_not_on_the_roster(tmp_path):
     render.render(connection, out, Terms(), tmp_path / "feedback")
     summary = (tmp_path / "feedback" / "summary.md").read_text()
     assert "Handed in under an id not on the roster, not graded (1): mallory." in summary
+
+
+def test_a_run_with_a_roster_mismatch_and_an_extension_typo_says_each(tmp_path, capsys):
+    checks = tmp_path / "course" / "tests" / "tasks"
+    checks.mkdir(parents=True)
+    for name in ("conftest.py", "test_task1.py"):
+        shutil.copy(PROJECT_ROOT / "tests" / "tasks" / name, checks)
+    paths = hand_ins(tmp_path / "class", "alice", "mallory")
+    (tmp_path / "roster.csv").write_text("id,folder\nalice,class/alice\njudy,class/judy\n")
+    (tmp_path / "extensions.csv").write_text("id,extension\nalcie,2d\n")
+    out = tmp_path / "grades.csv"
+    status = main(["grade", *map(str, paths), "--roster", str(tmp_path / "roster.csv"),
+                   "--out", str(out), "--checks", str(checks), "--call-timeout", "30",
+                   "--due", "2027-03-01T23:59+01:00", "--feedback", str(tmp_path / "feedback"),
+                   "--extensions", str(tmp_path / "extensions.csv")])  # fmt: skip
+    said = capsys.readouterr().err
+    assert status == 1, said
+    assert "no submission has the id 'alcie'" in said and "did you mean 'alice'?" in said
+    assert "judy: nothing handed in" in said and "which is not on the roster" in said
+    rows = rows_of(out)
+    assert (rows["judy"]["status"], rows["judy"]["total"]) == ("absent", "0")
+    assert rows["mallory"]["status"] == "not graded" and rows["alice"]["status"] == "graded"
+    summary = (tmp_path / "feedback" / "summary.md").read_text()
+    assert "1 of 3 submissions graded" in summary and "Nothing handed in (1): judy" in summary
 
 
 # ------------------------------------------------- the student's feedback opens with the total
