@@ -132,9 +132,14 @@ def test_a_zip_of_thousands_of_entries_is_refused_from_its_end_record(tmp_path):
     with zipfile.ZipFile(tmp_path / "bomb.zip", "w") as bundle:
         bundle.writestr("task1.py", TASK1)
         for number in range(archive.MAX_ENTRIES + 1):
-            bundle.writestr(f"x{number}.py", b"")
+            bundle.writestr(f"{'x' * 600}{number}.py", b"")  # a directory of 3.3 MB
     entry, _ = taken_alone(tmp_path / "bomb.zip")
     assert f"holds {archive.MAX_ENTRIES + 2} entries" in entry.problem
+    data = (tmp_path / "bomb.zip").read_bytes()  # its end record made to say 1 entry
+    end = data.rindex(b"PK\x05\x06")
+    (tmp_path / "liar.zip").write_bytes(data[: end + 8] + b"\x01\x00\x01\x00" + data[end + 12 :])
+    entry, _ = taken_alone(tmp_path / "liar.zip")
+    assert "holds 1 entries in a directory of" in entry.problem
 
 
 def test_files_left_out_are_counted_in_a_few_notes_not_one_each(tmp_path):

@@ -1,7 +1,8 @@
 """A submission handed in as a zip file: its entries read as data, never unpacked in place.
 
 The bounds come first, from the zip's end record, before its directory is read: a zip of
-more than `MAX_ENTRIES` entries is refused. Then each rule names what it did in the row:
+more than `MAX_ENTRIES` entries, or whose directory is larger than `MAX_DIRECTORY_BYTES`
+(its count can lie), is refused. Then each rule names what it did in the row:
 
 - refused, the whole zip: an entry's name that is absolute, climbs out (``..``) or lies
   in a ``.git`` folder; two entries of one name in the graded folder (which one the
@@ -28,6 +29,8 @@ from .times import HandIn, zip_time
 
 MAX_ENTRIES = 5000
 """The most entries a zip handed in may hold (a course's bundle holds a few dozen)."""
+MAX_DIRECTORY_BYTES = MAX_ENTRIES * 512
+"""The largest central directory read (an entry's record is 46 bytes and its name)."""
 _LINK = 0o120000
 _END = b"PK\x05\x06"
 _END_SIZE, _COMMENT_MAX, _ZIP64 = 22, 65535, 0xFFFF
@@ -36,11 +39,14 @@ _END_SIZE, _COMMENT_MAX, _ZIP64 = 22, 65535, 0xFFFF
 def take_zip(archive: Path, fresh: FreshFolder, zone: tzinfo | None) -> HandIn:
     """Write the files of ``archive``'s graded folder into ``fresh`` (see the module);
     return the time of its entries (set by the student's machine)."""
-    count = entry_count(archive)
-    if count > MAX_ENTRIES:
+    count, size = directory(archive)
+    if count > MAX_ENTRIES or size > MAX_DIRECTORY_BYTES:
         more = " or more" if count == _ZIP64 else ""
-        raise Refused(f"not graded: {readable(archive.name)} holds {count}{more} entries, more "
-                      f"than the {MAX_ENTRIES} read; zip the assignments folder alone")  # fmt: skip
+        raise Refused(
+            f"not graded: {readable(archive.name)} holds {count}{more} entries in a directory "
+            f"of {size} bytes, more than the {MAX_ENTRIES} entries or {MAX_DIRECTORY_BYTES} "
+            "bytes read; zip the assignments folder alone"
+        )
     try:
         with zipfile.ZipFile(archive) as bundle:
             members = bundle.infolist()
@@ -58,9 +64,10 @@ def take_zip(archive: Path, fresh: FreshFolder, zone: tzinfo | None) -> HandIn:
         raise Refused(f"{archive.name} could not be read as a zip file: {error}") from None
 
 
-def entry_count(archive: Path) -> int:
+def directory(archive: Path) -> tuple[int, int]:
     """How many entries the zip's end record says it holds (a Zip64 zip's, 65535 or more,
-    as 65535)."""
+    as 65535), and the size of its central directory in bytes (what reading it costs,
+    whatever the count says)."""
     with archive.open("rb") as file:
         file.seek(0, 2)
         size = file.tell()
@@ -69,8 +76,8 @@ def entry_count(archive: Path) -> int:
     at = tail.rfind(_END)
     if at < 0 or len(tail) - at < _END_SIZE:
         raise Refused(f"{readable(archive.name)} could not be read as a zip file: no end record")
-    on_disk, total = struct.unpack("<HH", tail[at + 8 : at + 12])
-    return max(on_disk, total)
+    on_disk, total, size = struct.unpack("<HHI", tail[at + 8 : at + 16])
+    return max(on_disk, total), size
 
 
 def _refuse_twins(members: list[zipfile.ZipInfo], archive: Path) -> None:
