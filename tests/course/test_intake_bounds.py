@@ -5,15 +5,19 @@ hand-in's row says what could not be read; the rest of the class is taken in."""
 
 from __future__ import annotations
 
+import hashlib
 import stat
+import struct
 import subprocess
 import tracemalloc
 import zipfile
+import zlib
 from datetime import datetime, timezone
 from pathlib import Path
 
 import pytest
 from dulwich.objects import Blob, Commit, Tree
+from dulwich.pack import write_pack_index
 from dulwich.repo import Repo
 
 from msdlab.course import PROJECT_ROOT
@@ -91,6 +95,20 @@ def test_a_repository_git_packed_into_deltas_is_read_by_its_headers(tmp_path):
         assert store.size(sha) >= len(store[sha].as_raw_string())
     entry, files = taken_alone(clone)
     assert entry.problem is None and files == ["task1.py"] and not entry.notes
+
+
+def test_a_delta_naming_itself_as_its_base_is_refused_not_followed_forever(tmp_path):
+    itself = bytes(range(20))
+    delta = zlib.compress(b"\x05\x05\x90\x05")  # base 5 bytes, result 5: copy them
+    pack = b"PACK" + struct.pack(">II", 2, 1) + bytes([0x70 | 4]) + itself + delta
+    pack += hashlib.sha1(pack).digest()
+    (tmp_path / "pack").mkdir()
+    (tmp_path / "pack" / "pack-x.pack").write_bytes(pack)
+    with (tmp_path / "pack" / "pack-x.idx").open("wb") as index:
+        write_pack_index(index, [(itself, 12, 0)], hashlib.sha1(pack[:-20]).digest())
+    store = git_objects.BoundedStore(tmp_path, fresh.MAX_TOTAL_BYTES)
+    with pytest.raises(git_objects.TooLarge, match="a delta chain longer than"):
+        store[itself]
 
 
 def test_a_commit_time_no_calendar_holds_is_unreadable_and_the_class_taken_in(tmp_path):

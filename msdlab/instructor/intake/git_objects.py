@@ -18,8 +18,9 @@ from dulwich.object_store import DiskObjectStore
 from dulwich.objects import ShaFile, hex_to_sha, sha_to_hex
 from dulwich.pack import OFS_DELTA, REF_DELTA, Pack
 
-MAX_DELTA_DEPTH = 1000
-"""The longest delta chain read (git itself makes chains of at most 50 by default)."""
+MAX_DELTA_DEPTH = 300
+"""The longest delta chain read (git makes chains of at most 50 by default, ``gc
+--aggressive`` too; two stack frames a link stay within Python's recursion limit)."""
 _HEADER = 64
 """Bytes of a zlib stream inflated to read an object's or a delta's header."""
 _READ = 1024
