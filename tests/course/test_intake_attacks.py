@@ -289,7 +289,7 @@ def test_links_in_a_folder_and_a_zip_are_not_followed(tmp_path, take):
 
 
 # ------------------------------------------------- ids come from the roster
-def test_a_path_id_is_refused_where_the_roster_does_not_know_it(tmp_path):
+def test_a_path_id_the_roster_does_not_know_gets_a_row_saying_so_and_is_not_graded(tmp_path):
     alice = tmp_path / "class" / "sec1" / "alice"
     alice.mkdir(parents=True)
     (alice / "task1.py").write_bytes(TASK1)
@@ -297,8 +297,10 @@ def test_a_path_id_is_refused_where_the_roster_does_not_know_it(tmp_path):
     bob.mkdir()
     (bob / "task1.py").write_bytes(TASK1)
     with intake.from_paths([alice, bob], known={"alice", "bob"}) as found:
-        assert [entry.id for entry in found.entries] == ["bob"]
-        assert "the id 'sec1/alice' is not in the roster" in found.refused[0]
+        unlisted, graded = found.entries
+        assert [unlisted.id, graded.id] == ["sec1/alice", "bob"] and not found.refused
+        assert "the id 'sec1/alice', which is not on the roster" in unlisted.problem
+        assert graded.problem is None
 
 
 def test_the_roster_gives_the_id_whatever_the_path(tmp_path):

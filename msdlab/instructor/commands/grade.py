@@ -288,6 +288,7 @@ class Session:
         known = {*self.entries, *(record.id for record in records)}
         changes = [c for listed in self.terms.changes.values() for c in listed]
         found = adjustments.against_class(changes, str(path), None, known)
+        found += term_options.extensions_against_class(self.args, self.terms, known)
         rows = {record.id: record.final for record in records}
         regraded = [entry.id for entry in todo]
         where = str(gradebook_db.beside(self.args.out))
@@ -310,8 +311,8 @@ class Session:
             grade = grading.Grade(entry.id, None, [entry.problem])
             status = gradebook_db.ABSENT if entry.absent else gradebook_db.NOT_GRADED
             self._commit(shown(grade, entry), status)
-            if entry.absent:
-                print(f"{entry.id}: {entry.problem}", file=sys.stderr)
+            where = f" (nothing at {entry.source})" if entry.absent and entry.source.name else ""
+            print(f"{entry.id}: {entry.problem}{where}", file=sys.stderr)
             unusable.append(grade)
         return unusable
 

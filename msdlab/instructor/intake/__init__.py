@@ -17,11 +17,22 @@ gradebook read the fresh folders only.
 
 from .fresh import BUNDLE_FOLDER, LEFT_OUT, MAX_FILE_BYTES
 from .names import MAX_POINTS_ID, MAX_STEM, escaped, file_stem, readable, unescaped
-from .submissions import Entry, Intake, Rules, from_paths, from_roster, taken_in, task_files
+from .submissions import (
+    NOT_ON_ROSTER,
+    NOTHING_HANDED_IN,
+    Entry,
+    Intake,
+    Rules,
+    from_paths,
+    from_roster,
+    taken_in,
+    task_files,
+)
 from .times import SOURCES, UNVERIFIED_POLICIES, HandIn
 
 __all__ = [
-    "BUNDLE_FOLDER", "LEFT_OUT", "MAX_FILE_BYTES", "MAX_POINTS_ID", "MAX_STEM", "SOURCES",
+    "BUNDLE_FOLDER", "LEFT_OUT", "MAX_FILE_BYTES", "MAX_POINTS_ID", "MAX_STEM",
+    "NOTHING_HANDED_IN", "NOT_ON_ROSTER", "SOURCES",
     "UNVERIFIED_POLICIES", "Entry", "HandIn", "Intake", "Rules", "escaped", "file_stem",
     "from_paths", "from_roster", "readable", "taken_in", "task_files", "unescaped",
 ]  # fmt: skip

@@ -11,6 +11,7 @@ fingerprint) reads only this folder.
 
 from __future__ import annotations
 
+import collections
 import shutil
 from collections.abc import Callable
 from pathlib import Path
@@ -23,6 +24,8 @@ MAX_FILES = 200
 MAX_TOTAL_BYTES = 20_000_000
 BUNDLE_FOLDER = "assignments"
 TASK_FILES = tuple(f"task{task}.py" for task in TASKS)
+MAX_NOTES = 5
+"""Files left out that get a note each; the rest are counted in one."""
 LEFT_OUT = " was left out: "
 """What a note on a file the intake did not take says after the file's name."""
 
@@ -37,20 +40,31 @@ class FreshFolder:
     def __init__(self, path: Path) -> None:
         path.mkdir(parents=True)
         self.path = path
-        self.notes: list[str] = []
-        self._bytes = 0
+        self._left_out: list[tuple[str, str]] = []
+        self._bytes = self._files = 0
+
+    @property
+    def notes(self) -> list[str]:
+        """What was left out: a note per file for the first `MAX_NOTES`, then one counting
+        the rest by reason (a zip of 10 000 entries gets a few lines, not 10 000)."""
+        shown = [f"{readable(name)}{LEFT_OUT}{why}" for name, why in self._left_out[:MAX_NOTES]]
+        rest = collections.Counter(why for _, why in self._left_out[MAX_NOTES:])
+        if rest:
+            counted = "; ".join(f"{count} {why}" for why, count in rest.most_common(3))
+            others = f" and {len(rest) - 3} other reasons" if len(rest) > 3 else ""
+            shown.append(f"and {rest.total()} more files left out ({counted}{others})")
+        return shown
 
     def add(self, name: str, data: bytes) -> None:
         """Write ``data`` as the file ``name`` (one plain part), unless a bound is passed."""
         if len(data) > MAX_FILE_BYTES:
             self.leave_out(name, f"larger than {MAX_FILE_BYTES} bytes")
-        elif (
-            len(list(self.path.iterdir())) >= MAX_FILES or self._bytes + len(data) > MAX_TOTAL_BYTES
-        ):
+        elif self._files >= MAX_FILES or self._bytes + len(data) > MAX_TOTAL_BYTES:
             self.leave_out(name, f"more than {MAX_FILES} files or {MAX_TOTAL_BYTES} bytes in all")
         else:
             (self.path / name).write_bytes(data)
             self._bytes += len(data)
+            self._files += 1
 
     def clear(self) -> None:
         """Empty the folder again (what was written is not what is graded)."""
@@ -60,7 +74,7 @@ class FreshFolder:
     def leave_out(self, name: str, why: str) -> None:
         """Note that ``name`` was not taken, and why (only for files that could matter)."""
         if name.endswith(".py") or name == BUNDLE_FOLDER:
-            self.notes.append(f"{readable(name)}{LEFT_OUT}{why}")
+            self._left_out.append((name, why))
 
 
 def graded_folder(

@@ -13,25 +13,33 @@ crafted tree can name files anywhere. Here git's objects are read as data, and o
   (`take_commit`); its time is the committer date, which the student's machine set;
 - of that commit's tree, the regular files directly in the graded folder are written
   into the fresh folder; a name that is absolute, ``..`` or ``.git`` refuses the
-  submission; links (mode 120000) and submodules (160000) are left out, with a note.
+  submission, and so does a name the graded folder's tree holds twice; links (mode
+  120000) and submodules (160000) are left out, with a note;
+- every object's size is read from its header before it is read (`git_objects`): a file
+  larger than `fresh.MAX_FILE_BYTES` is left out unread, a tree or commit larger than
+  `fresh.MAX_TOTAL_BYTES` makes the repository unreadable;
+- a commit time no calendar can hold (year 0, past 9999) is an unreadable hand-in time;
+  the commit's files are graded.
 """
 
 from __future__ import annotations
 
+import collections
 import os
 import re
 import stat
+import zlib
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
 from dulwich.errors import ObjectFormatException
-from dulwich.object_store import DiskObjectStore
 from dulwich.objects import Blob, Commit, Tree
 from dulwich.walk import Walker
 
-from .fresh import MAX_TOTAL_BYTES, FreshFolder, Refused, graded_folder
+from .fresh import MAX_FILE_BYTES, MAX_TOTAL_BYTES, FreshFolder, Refused, graded_folder
+from .git_objects import BoundedStore
 from .names import readable, unsafe_name
-from .times import NAMES, STUDENT, HandIn, unreadable
+from .times import NAMES, STUDENT, HandIn, shown, unreadable
 
 MAX_COMMITS = 10_000
 _SHA = re.compile(rb"^[0-9a-f]{40}$")
@@ -54,7 +62,7 @@ def take_commit(
     folder ``inside`` (``assignments/``, '' the top) into ``fresh``; return the commit's
     time. Raises `Refused` or `Unreadable`."""
     git = _git_folder(repository)
-    store = DiskObjectStore(str(git / "objects"), loose_object_size_limit=MAX_TOTAL_BYTES)
+    store = BoundedStore(git / "objects", MAX_TOTAL_BYTES)
     try:
         head = _head(git)
         commit, newest = _last_commit(store, head, cutoff)
@@ -62,21 +70,28 @@ def take_commit(
         part = graded_folder(
             lambda p: _names(store, tree, p)[0], lambda p: _names(store, tree, p)[1]
         )
-        for name, mode, sha in _subtree(store, tree, part).items():
+        graded = _subtree(store, tree, part)
+        _refuse_twins(graded)
+        for name, mode, sha in graded.items():
             _take(store, name, mode, sha, fresh)
-    except (KeyError, ObjectFormatException, ValueError, OSError, AssertionError) as error:
+    except (KeyError, ObjectFormatException, ValueError, OSError, AssertionError,
+            zlib.error) as error:  # fmt: skip
         if isinstance(error, (Refused, Unreadable)):
             raise
         raise Unreadable(f"its .git could not be read ({type(error).__name__}: {error})") from None
     finally:
         store.close()
-    when = datetime.fromtimestamp(
-        commit.commit_time, timezone(timedelta(seconds=commit.commit_timezone))
-    )
+    try:
+        when = datetime.fromtimestamp(
+            commit.commit_time, timezone(timedelta(seconds=commit.commit_timezone))
+        )
+    except (ValueError, OverflowError, OSError):
+        return unreadable("git", f"the commit's time ({commit.commit_time} s, offset "
+                          f"{commit.commit_timezone} s) is no date a calendar holds")  # fmt: skip
     note = None
     if commit.id != newest:
         note = (f"commits after the cutoff ignored; graded commit {commit.id.decode()[:10]} "
-                f"of {when.isoformat()}")  # fmt: skip
+                f"of {shown(when, cutoff)}")  # fmt: skip
     return HandIn(when, NAMES["git"], STUDENT, note)
 
 
@@ -149,9 +164,7 @@ def _small(path: Path) -> bytes:
         return file.read(65536)
 
 
-def _last_commit(
-    store: DiskObjectStore, head: bytes, cutoff: datetime | None
-) -> tuple[Commit, bytes]:
+def _last_commit(store: BoundedStore, head: bytes, cutoff: datetime | None) -> tuple[Commit, bytes]:
     """The commit graded (HEAD's, or the newest no later than ``cutoff``) and HEAD's id."""
     if cutoff is None:
         commit = store[head]
@@ -165,7 +178,7 @@ def _last_commit(
     raise Unreadable(f"no commit made before the cutoff {cutoff.isoformat(timespec='minutes')}")
 
 
-def _subtree(store: DiskObjectStore, tree: Tree, part: str) -> Tree:
+def _subtree(store: BoundedStore, tree: Tree, part: str) -> Tree:
     """The tree of the folder ``part`` (parts ending in ``/``) below ``tree``."""
     for name in filter(None, part.split("/")):
         entries = {os.fsdecode(e.path): e for e in tree.items()}
@@ -178,7 +191,7 @@ def _subtree(store: DiskObjectStore, tree: Tree, part: str) -> Tree:
     return tree
 
 
-def _names(store: DiskObjectStore, tree: Tree, part: str) -> tuple[set[str], list[str]]:
+def _names(store: BoundedStore, tree: Tree, part: str) -> tuple[set[str], list[str]]:
     """The files and the folders directly in the folder ``part`` of ``tree``."""
     try:
         entries = _subtree(store, tree, part).items()
@@ -188,7 +201,23 @@ def _names(store: DiskObjectStore, tree: Tree, part: str) -> tuple[set[str], lis
     return files, sorted(os.fsdecode(e.path) for e in entries if stat.S_ISDIR(e.mode))
 
 
-def _take(store: DiskObjectStore, path: bytes, mode: int, sha: bytes, fresh: FreshFolder) -> None:
+def _refuse_twins(tree: Tree) -> None:
+    """Refuse a graded folder whose tree names one file twice (git itself never writes one;
+    a parsed tree keeps only the last, so its raw entries are counted)."""
+    raw, names, at = tree.as_raw_string(), [], 0
+    while at < len(raw):
+        space, end = raw.index(b" ", at), raw.index(b"\0", at)
+        names.append(raw[space + 1 : end])
+        at = end + 1 + 20
+    counts = collections.Counter(names)
+    twins = sorted(name for name, count in counts.items() if count > 1)
+    if twins:
+        name = readable(os.fsdecode(twins[0]))
+        raise Refused(f"not graded: the commit's tree holds {name} {counts[twins[0]]} "
+                      "times (which one was meant cannot be told)")  # fmt: skip
+
+
+def _take(store: BoundedStore, path: bytes, mode: int, sha: bytes, fresh: FreshFolder) -> None:
     name = os.fsdecode(path)
     why = unsafe_name(name)
     if why is not None or "/" in name:
@@ -197,6 +226,9 @@ def _take(store: DiskObjectStore, path: bytes, mode: int, sha: bytes, fresh: Fre
         fresh.leave_out(name, "a symbolic link in the commit (links are not followed)")
     elif mode == 0o160000:
         fresh.leave_out(name, "a submodule (another repository) in the commit")
+    elif stat.S_ISREG(mode) and store.size(sha) > MAX_FILE_BYTES:
+        fresh.leave_out(name, f"larger than {MAX_FILE_BYTES} bytes, or stored in the "
+                        "repository as a change to such an object (not read)")  # fmt: skip
     elif stat.S_ISREG(mode):
         blob = store[sha]
         if not isinstance(blob, Blob):

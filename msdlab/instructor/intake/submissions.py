@@ -8,12 +8,18 @@ and Gradescope's ``submission_metadata.json`` beside it). Each becomes an `Entry
 id, a fresh folder of the graded folder's plain files (`fresh`), the hand-in time with
 who controls it (`times`), notes, or the problem why it is not graded.
 
-Ids: from the roster (`from_roster`, or `from_paths` with ``known`` ids: a path's id must
-be one of them), else the path below the submissions' common folder, without a trailing
-``assignments`` or ``.zip`` (``class/alice/assignments`` → ``alice``). An id that is
-empty, has spaces around it, is the gradebook's ``(max points)``, starts with a
-character a spreadsheet takes for a formula, is not in the roster, or differs from
-another only in case, is refused for that one submission (`names.id_problem`).
+Ids: from the roster (`from_roster`, or `from_paths` with ``known`` ids), else the path
+below the submissions' common folder, without a trailing ``assignments`` or ``.zip``
+(``class/alice/assignments`` → ``alice``). An id that is empty, has spaces around it, is
+the gradebook's ``(max points)``, starts with a character a spreadsheet takes for a
+formula, or differs from another only in case, is refused for that one submission
+(`names.id_problem`): no row, a line on the console.
+
+With a roster, the class is the roster's students and nothing is left unsaid: a student
+who handed in nothing gets a row "nothing handed in" (`Entry.absent`), whether the run
+names SUBMISSIONs or not; a hand-in whose id is not on the roster (a SUBMISSION, or a
+hand-in lying beside the roster's ones that no roster line names: `beside_the_roster`)
+gets a row "not graded" that says so (`NOT_ON_ROSTER`), and is not graded.
 """
 
 from __future__ import annotations
@@ -28,11 +34,13 @@ from dataclasses import dataclass, field
 from datetime import datetime, timedelta, timezone, tzinfo
 from pathlib import Path
 
+from ...course import PROJECT_ROOT
 from .archive import take_zip
 from .folder import copy_files, graded_part, link_problem
 from .fresh import BUNDLE_FOLDER, TASK_FILES, FreshFolder, Refused
 from .names import id_problem, lookalike, readable
 from .repository import Unreadable, is_repository, take_commit, unreadable_repository
+from .roster import Student
 from .roster import read as read_roster
 from .times import (
     METADATA,
@@ -45,6 +53,10 @@ from .times import (
 )
 
 GRADESCOPE_FILES = "submission"
+NOTHING_HANDED_IN = "nothing handed in"
+"""What the row of a roster student who handed in nothing says (0 points)."""
+NOT_ON_ROSTER = "which is not on the roster"
+"""What the row of a hand-in whose id is no roster student's says (not graded)."""
 
 
 @dataclass
@@ -105,38 +117,43 @@ class Intake(contextlib.AbstractContextManager):
     def add(self, identifier: str, source: Path, given_in: Path | None = None,
             known: set[str] | None = None) -> Entry | None:  # fmt: skip
         """Take in the submission at ``source`` under ``identifier``; a link leading out of
-        ``given_in`` (default: its parent) is not followed. An id that is not acceptable, or
-        not in ``known`` when given, refuses the submission: no entry, a line in `refused`."""
+        ``given_in`` (default: its parent) is not followed. An id that is not acceptable
+        refuses the submission: no entry, a line in `refused`; one not in ``known`` (when
+        given) is an entry that says so and is not taken (`unlisted`)."""
         source = Path(os.path.abspath(source))
-        problem = self._id_problem(readable(identifier), known)
+        problem = self._id_problem(readable(identifier))
         if problem is not None:
             self.refused.append(f"not graded: {readable(str(source))}: {problem}")
             return None
         entry = Entry(readable(identifier), source, source)
         self.entries.append(entry)
-        entry.problem = link_problem(source, given_in or source.parent)
-        if entry.problem is None:
-            fresh = FreshFolder(self._scratch / str(len(self.entries)))
-            try:
+        if known is not None and entry.id not in known:
+            entry.problem = unlisted(entry.id, source)
+            return entry
+        try:
+            entry.problem = link_problem(source, given_in or source.parent)
+            if entry.problem is None:
+                fresh = FreshFolder(self._scratch / str(len(self.entries)))
                 entry.handed_in = self._take(entry, fresh, given_in or source.parent)
-            except Refused as refused:
-                entry.problem = str(refused)
-                return entry
-            entry.folder = fresh.path
-            entry.notes += fresh.notes
-            self._mark(entry)
+                entry.folder = fresh.path
+                entry.notes += fresh.notes
+                self._mark(entry)
+        except Refused as refused:
+            entry.problem = str(refused)
+        except Exception as error:  # whatever one hand-in raises stops its row only
+            entry.problem = unreadable_hand_in(source, error)
         return entry
 
     def add_absent(self, identifier: str, expected: Path | None) -> Entry | None:
-        """Add a roster's student who handed in nothing (nothing at ``expected``, or no path
-        given); an id that is not acceptable is refused as in `add`."""
-        problem = self._id_problem(readable(identifier), None)
+        """Add a roster's student who handed in nothing (nothing at ``expected``, the row's
+        source, or no path given): their row says "nothing handed in" and names no folder
+        (the student reads it); an id that is not acceptable is refused as in `add`."""
+        problem = self._id_problem(readable(identifier))
         if problem is not None:
             self.refused.append(f"not graded: {readable(identifier)!r}: {problem}")
             return None
-        where = f" (no folder or zip file at {readable(str(expected))})" if expected else ""
         entry = Entry(readable(identifier), expected or Path(), expected or Path(),
-                      problem=f"nothing handed in{where}", absent=True)  # fmt: skip
+                      problem=NOTHING_HANDED_IN, absent=True)  # fmt: skip
         self.entries.append(entry)
         return entry
 
@@ -146,10 +163,13 @@ class Intake(contextlib.AbstractContextManager):
         entry = Entry("submission", Path(os.path.abspath(root)) / GRADESCOPE_FILES, root)
         self.entries.append(entry)
         fresh = FreshFolder(self._scratch / str(len(self.entries)))
-        entry.handed_in = self._from_gradescope(entry.source.parent, fresh)
-        entry.folder = fresh.path
-        entry.notes += fresh.notes
-        self._mark(entry)
+        try:
+            entry.handed_in = self._from_gradescope(entry.source.parent, fresh)
+            entry.folder = fresh.path
+            entry.notes += fresh.notes
+            self._mark(entry)
+        except Exception as error:  # said in the row, as for any other hand-in
+            entry.problem = unreadable_hand_in(entry.source, error)
         return entry
 
     def _from_gradescope(self, root: Path, fresh: FreshFolder) -> HandIn:
@@ -159,11 +179,9 @@ class Intake(contextlib.AbstractContextManager):
             return gradescope_time(root / METADATA)
         return unreadable("gradescope", f"no {METADATA} beside the submission")
 
-    def _id_problem(self, identifier: str, known: set[str] | None) -> str | None:
+    def _id_problem(self, identifier: str) -> str | None:
         """Why ``identifier`` is not taken (see the module), or None."""
         problem = id_problem(identifier)
-        if problem is None and known is not None and identifier not in known:
-            problem = f"the id {identifier!r} is not in the roster"
         twin = next((e.id for e in self.entries if lookalike(e.id) == lookalike(identifier)), None)
         if problem is None and twin is not None:
             same = "is" if twin == identifier else "looks like"
@@ -211,14 +229,31 @@ class Intake(contextlib.AbstractContextManager):
                 f"the {METADATA} among the student's files was ignored: a student can write "
                 "it; Gradescope's own lies beside the submission"
             )
-        if handed is not None and rules.due_of(entry.id) is not None:
-            handed = entry.handed_in = under_policy(handed, rules.unverified, rules.collected)
+        due = rules.due_of(entry.id)
+        if handed is not None and due is not None:
+            handed = under_policy(handed, rules.unverified, rules.collected, due)
+            entry.handed_in = handed
             if handed.note:
                 entry.notes.append(handed.note)
             if not handed.verified and rules.unverified == "flag":
-                entry.notes.append(flag(handed))
+                entry.notes.append(flag(handed, due))
         if not task_files(entry.folder):
             entry.problem = f"no task files ({TASK_FILES[0]} ... {TASK_FILES[-1]}) handed in"
+
+
+def unreadable_hand_in(source: Path, error: Exception) -> str:
+    """The row's problem for a hand-in the intake could not read: what raised, in short
+    (no other hand-in is affected)."""
+    said = readable(str(error)).replace(str(source.parent), "").strip() or "no details"
+    return (f"not graded: {readable(source.name)} could not be read "
+            f"({type(error).__name__}: {said[:300]})")  # fmt: skip
+
+
+def unlisted(identifier: str, source: Path) -> str:
+    """The row's problem for a hand-in whose id no roster line gives."""
+    return (f"not graded: {readable(source.name)} was handed in under the id "
+            f"{identifier!r}, {NOT_ON_ROSTER}; add a roster line 'id,folder' for it if it is "
+            "a student's")  # fmt: skip
 
 
 def _not_from(source: str, form: str) -> HandIn:
@@ -266,16 +301,52 @@ def from_roster(roster: Path, rules: Rules | None = None) -> Intake:
             intake.add_absent(student.id, student.folder)
         else:
             intake.add(student.id, student.folder)
+    for path in beside_the_roster(students):
+        intake.add(_path_id(path, path.parent), path, known=set())
     return intake
+
+
+def beside_the_roster(students: list[Student]) -> list[Path]:
+    """The hand-ins no roster line names in the folder that holds the roster's hand-ins: a
+    zip file, or a folder with task files (in itself or its ``assignments/``, or a git
+    repository), hidden names and the course's own clone (its templates) left out."""
+    listed = [Path(os.path.abspath(s.folder)) for s in students if s.folder is not None]
+    if not listed:
+        return []
+    folder = Path(os.path.commonpath([path.parent for path in listed]))
+    named = {place for path in (*listed, PROJECT_ROOT) for place in (path, *path.parents)}
+    try:
+        items = sorted(folder.iterdir())
+    except OSError:  # no folder there, or not one to read: nothing beside to name
+        return []
+    found = []
+    for item in items:
+        if item in named or item.name.startswith(".") or item.is_symlink():
+            continue
+        if (item.suffix.lower() == ".zip" and item.is_file()) or _holds_a_hand_in(item):
+            found.append(item)
+    return found
+
+
+def _holds_a_hand_in(folder: Path) -> bool:
+    """Whether ``folder`` (a real folder) holds task files or is a git repository."""
+    if not folder.is_dir() or folder.is_symlink():
+        return False
+    return is_repository(folder) or bool(task_files(folder / graded_part(folder)))
 
 
 def taken_in(paths: list[Path], roster: Path | None, rules: Rules | None = None) -> Intake:
     """The class as the commands take it in: the roster's folders when no ``paths`` are
-    given, else the ``paths`` (with a roster too, each one's id must be a roster id)."""
+    given, else the ``paths`` (with a roster too, a path's id not on it is `unlisted`, and
+    a roster student no path is for is absent)."""
     if not paths:
         return from_roster(roster, rules)
-    known = {student.id for student in read_roster(roster)} if roster else None
-    return from_paths(paths, rules, known)
+    students = read_roster(roster) if roster else []
+    intake = from_paths(paths, rules, {student.id for student in students} if roster else None)
+    handed = {entry.id for entry in intake.entries}
+    for student in (s for s in students if s.id not in handed):
+        intake.add_absent(student.id, None)
+    return intake
 
 
 def _path_id(path: Path, base: Path) -> str:

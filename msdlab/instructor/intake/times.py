@@ -92,7 +92,7 @@ def zip_time(members: list[zipfile.ZipInfo], zone: tzinfo | None) -> HandIn:
         if not files:
             raise ValueError("the zip holds no files")
         return HandIn(max(_entry_time(m, zone) for m in tasks or files), NAMES["zip"], STUDENT)
-    except (ValueError, OverflowError) as error:
+    except (ValueError, OverflowError, OSError) as error:
         return unreadable("zip", str(error))
 
 
@@ -115,27 +115,46 @@ def modification_time(seconds: list[float]) -> HandIn:
     """The newest of the task files' modification times (``seconds`` since the epoch)."""
     if not seconds:
         return unreadable("mtime", "no task files to read the time of")
-    return HandIn(datetime.fromtimestamp(max(seconds), timezone.utc), NAMES["mtime"], STUDENT)
+    try:
+        newest = datetime.fromtimestamp(max(seconds), timezone.utc)
+    except (ValueError, OverflowError, OSError):
+        return unreadable("mtime", f"{max(seconds):.0f} s since 1970 is no date a calendar holds")
+    return HandIn(newest, NAMES["mtime"], STUDENT)
 
 
-def under_policy(handed: HandIn, policy: str, collected: datetime) -> HandIn:
+def under_policy(handed: HandIn, policy: str, collected: datetime, due: datetime) -> HandIn:
     """``handed`` as the instructor's ``policy`` for unverified times takes it
-    (`UNVERIFIED_POLICIES`); ``collected``: when this grading run took the submission in."""
+    (`UNVERIFIED_POLICIES`); ``collected``: when this grading run took the submission in;
+    its note gives times in the zone of the ``due`` date."""
     if handed.verified or policy != "late":
         return handed
-    read = handed.time.isoformat(timespec="minutes") if handed.time else "unreadable"
+    read = shown(handed.time, due) if handed.time else "unreadable"
     note = (
         f"hand-in time not verified ({handed.source}: {read}, {_who(handed)}): charged as "
-        f"handed in when it was taken in for grading, {collected.isoformat(timespec='minutes')} "
+        f"handed in when it was taken in for grading, {shown(collected, due)} "
         "(--unverified-time late)"
     )
     return replace(handed, time=collected, note=note)
 
 
-def flag(handed: HandIn) -> str:
-    """The note that marks a time the grader could not verify."""
-    read = handed.time.isoformat(timespec="minutes") if handed.time else "none"
+def flag(handed: HandIn, due: datetime) -> str:
+    """The note that marks a time the grader could not verify (in the ``due`` date's zone)."""
+    read = shown(handed.time, due) if handed.time else "none"
     return f"hand-in time not verified: {handed.source} ({read}) {_who(handed)}"
+
+
+def shown(moment: datetime, due: datetime) -> str:
+    """``moment`` to the minute on the clock of the ``due`` date's zone (`in_zone`)."""
+    return in_zone(moment, due).isoformat(timespec="minutes")
+
+
+def in_zone(moment: datetime, due: datetime) -> datetime:
+    """``moment`` on the clock of the ``due`` date's zone (as read where that clock has no
+    such date: a forged time at the end of year 9999)."""
+    try:
+        return moment.astimezone(due.tzinfo)
+    except OverflowError:
+        return moment
 
 
 def _who(handed: HandIn) -> str:

@@ -6,9 +6,12 @@
 files (at the top of ``/autograder/submission`` or in its ``assignments/``, taken in by `intake`)
 with the instructor's checks, hidden ones included, by the same `grading.grade`
 as ``msdlab grade``, and writes ``/autograder/results/results.json`` in
-Gradescope's format: the total ``score``, one test per check (``name``,
-``score``, ``max_score``, ``status``, ``output`` for the student, ``visibility``)
-and the per-task totals in ``output`` and ``extra_data``.
+Gradescope's format: the total ``score``, one test per public check (``name``,
+``score``, ``max_score``, ``status``, ``output`` for the student, ``visibility``), one
+test per task for its hidden checks (their points only, shown as the setting
+``hidden_visibility`` says), and the per-task totals in ``output`` and ``extra_data``.
+A student reads there what the local feedback says: no hidden check's name or message,
+no note about the grader itself (`outputs.feedback.student_notes`).
 
 Isolation: each submission already runs in its own throw-away container on
 Gradescope, which holds nothing but the autograder and that one submission, so
@@ -36,8 +39,9 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from ...course import own_numbers
-from ...course.report import CheckResult
+from ...course.report import CheckReport, CheckResult
 from .. import intake
+from ..outputs import feedback
 from . import grading
 
 CONFIG = "msdlab-autograder.json"
@@ -120,36 +124,49 @@ def build(out: Path, project: Path, checks: Path, settings: Settings) -> list[st
 
 def results(grade: grading.Grade, hidden_visibility: str) -> dict[str, object]:
     """The results.json content for one graded submission (Gradescope's format)."""
+    notes = feedback.student_notes(grade.notes)
     if grade.report is None:
-        reason = "\n".join(f"- {note}" for note in grade.notes)
+        reason = "\n".join(f"- {note}" for note in notes)
         output = f"Your submission could not be graded:\n{reason}"
         test = {"name": "Grading", "score": 0, "max_score": 0, "status": "failed",
                 "output": output, "visibility": "visible"}  # fmt: skip
-        return {"score": 0, "output": output, "tests": [test], "extra_data": {"notes": grade.notes}}
+        return {"score": 0, "output": output, "tests": [test], "extra_data": {"notes": notes}}
     tasks = {f"task{task}": {"score": grade.points(task), "max_score": _possible(grade, task)}
              for task in grade.report.tasks()}  # fmt: skip
     lines = [f"{grade.total}/{grade.report.points} points"]
     lines += [f"{name}: {t['score']}/{t['max_score']}" for name, t in tasks.items()]
-    lines += [f"Note: {note}" for note in grade.notes]
-    tests, numbers = [], dict.fromkeys(tasks, 0)
-    for check in grade.report.checks:
-        numbers[f"task{check.task}"] += 1
-        tests.append({
-            "name": f"Task {check.task}: {check.name}",
-            "number": f"{check.task}.{numbers[f'task{check.task}']}",
-            "score": check.earned,
-            "max_score": check.points,
-            "status": "passed" if check.passed else "failed",
-            "output": _output(check),
-            "visibility": hidden_visibility if check.hidden else "visible",
-        })  # fmt: skip
+    lines += [f"Note: {note}" for note in notes]
     return {
         "score": grade.total,
         "execution_time": round(grade.seconds),
         "output": "\n".join(lines),
-        "tests": tests,
-        "extra_data": {"tasks": tasks, "notes": grade.notes},
+        "tests": _tests(grade.report, hidden_visibility),
+        "extra_data": {"tasks": tasks, "notes": notes},
     }
+
+
+def _tests(report: CheckReport, hidden_visibility: str) -> list[dict[str, object]]:
+    """Gradescope's tests: each public check with what a failing one saw; a task's hidden
+    checks as one test of their points only (no name, no message), shown as
+    ``hidden_visibility`` says, as the local feedback shows them."""
+    tests = []
+    for task in report.tasks():
+        checks = [c for c in report.checks if c.task == task]
+        for number, check in enumerate((c for c in checks if not c.hidden), start=1):
+            tests.append({"name": f"Task {task}: {check.name}", "number": f"{task}.{number}",
+                          "score": check.earned, "max_score": check.points,
+                          "status": "passed" if check.passed else "failed",
+                          "output": _output(check), "visibility": "visible"})  # fmt: skip
+        hidden = [c for c in checks if c.hidden]
+        if hidden:
+            plural = "s" * (len(hidden) != 1)
+            tests.append({"name": f"Task {task}: {len(hidden)} hidden check{plural}",
+                          "number": f"{task}.hidden",
+                          "score": sum(c.earned for c in hidden),
+                          "max_score": sum(c.points for c in hidden),
+                          "status": "passed" if all(c.passed for c in hidden) else "failed",
+                          "output": "", "visibility": hidden_visibility})  # fmt: skip
+    return tests
 
 
 def run_autograder(root: Path) -> dict[str, object]:

@@ -16,14 +16,13 @@ from __future__ import annotations
 
 import csv
 import io
-import os
 import re
-import tempfile
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..rules.problems import Problem
+from . import output_files
 
 FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r", "\uff1d", "\uff0b", "\uff0d", "\uff20")
 """A cell starting with one of these is a formula to a spreadsheet (full-width forms too)."""
@@ -58,20 +57,8 @@ def csv_text(lines: Iterable[Sequence[object]], header: Sequence[str] | None = N
 def write_csv(path: Path, lines: Iterable[Sequence[object]], header: Sequence[str] | None = None
               ) -> None:  # fmt: skip
     """Write ``lines`` as a UTF-8 CSV file at ``path`` (`csv_text`), atomically: a crash
-    leaves the old file or the whole new one."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(handle, "w", encoding="utf-8", newline="") as out:
-            out.write(csv_text(lines, header))
-            out.flush()
-            os.fsync(out.fileno())
-        os.chmod(temporary, 0o644)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
+    leaves the old file or the whole new one; a path that is a link is refused."""
+    output_files.write_text(path, csv_text(lines, header), "CSV file", durable=True)
 
 
 def read_csv(path: Path) -> list[list[str]]:

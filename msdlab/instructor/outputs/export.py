@@ -16,8 +16,11 @@ roster ``msdlab grade --roster`` reads, with ``folder`` as its second column.
   address``, the assignment's points and a feedback line (how the total was made); map
   ``Email address`` or ``ID number`` to the user when importing.
 - ``csv``: one row per student with the roster's columns, the task points, ``points``,
-  ``late_penalty``, ``adjustment``, ``total``, ``max_points``, and ``source`` relative to
-  the exported file's folder.
+  ``late_penalty``, ``adjustment``, ``total``, ``status``, ``max_points``, and ``source``
+  relative to the exported file's folder.
+
+A row the grader failed on (status ``grader failed``) has no points: its cells are left
+empty in every format, never 0, and the console says so for each such student.
 """
 
 from __future__ import annotations
@@ -79,6 +82,7 @@ def table(
     book = settled(grades)
     people = roster if roster is not None else [{"id": i} for i in book.rows]
     _warn_unmatched(book, people, grades)
+    _warn_no_points(book, {person["id"] for person in people})
     if form == "canvas":
         return _canvas(book, people, assignment)
     if form == "moodle":
@@ -119,8 +123,19 @@ def _warn_unmatched(book: Gradebook, people: list[dict[str, str]], grades: Path)
         print(f"warning: {identifier!r} has grades but is not in the roster: left out",
               file=sys.stderr)  # fmt: skip
     for identifier in sorted(listed - set(book.rows)):
-        print(f"warning: {identifier!r} is in the roster but not in {grades}: no grade given",
-              file=sys.stderr)  # fmt: skip
+        print(f"warning: {identifier!r} is in the roster but not in {grades}: no grade given, "
+              "the cell is left empty (an LMS keeps the grade it had); msdlab grade --roster "
+              "gives a student who handed in nothing a row of 0", file=sys.stderr)  # fmt: skip
+
+
+def _warn_no_points(book: Gradebook, exported: set[str]) -> None:
+    """Say which exported rows have no points because the grader failed on them."""
+    for identifier in sorted(exported & set(book.rows)):
+        if book.rows[identifier].get("status") == gradebook_db.GRADER_FAILED:
+            print(f"warning: {identifier!r}: the grader failed on this submission (not the "
+                  "student's failure): no points exported, the cell is left empty (an LMS "
+                  "keeps the grade it had); run msdlab grade again with --resume",
+                  file=sys.stderr)  # fmt: skip
 
 
 def _warn_unnamed(people: list[dict[str, str]], keys: tuple[str, ...], form: str) -> None:
@@ -153,8 +168,9 @@ def _moodle(book: Gradebook, people: list[dict[str, str]], assignment: str) -> l
 
 
 def _how(row: dict[str, str]) -> str:
-    """How the total was made, in a line: checks, late penalty, adjustment."""
-    if not row:
+    """How the total was made, in a line: checks, late penalty, adjustment ('' for a row
+    without a total: none, or the grader's failure)."""
+    if not row.get("total"):
         return ""
     parts = [f"checks {row.get('points') or row.get('total', '')}"]
     if row.get("late_penalty"):
@@ -166,7 +182,8 @@ def _how(row: dict[str, str]) -> str:
 
 def _plain(book: Gradebook, people: list[dict[str, str]], out: Path) -> list[list[str]]:
     personal = list(dict.fromkeys(key for person in people for key in person))
-    points = [f"task{t}" for t in TASKS] + ["points", "late_penalty", "adjustment", "total"]
+    points = [f"task{t}" for t in TASKS] + ["points", "late_penalty", "adjustment", "total",
+                                            "status"]  # fmt: skip
     lines = [[*personal, "source", *points, "max_points"]]
     for person in people:
         row = book.rows.get(person["id"], {})

@@ -1,9 +1,11 @@
 """Feedback files of a grading run: one to hand to each student, one for the instructor.
 
-- `for_student`: the public checks in full (points, result, what a failing one saw);
-  hidden checks only as "N hidden checks: P of Q points" per task, with no name,
-  message or generated input; a task not attempted (or whose file did not load)
-  as one line; no path of the grader's temporary folders.
+- `for_student`: the final total first (the term's rules applied; how it was reached in
+  the section below it), the public checks in full (points, result, what a failing one
+  saw); hidden checks only as "N hidden checks: P of Q points" per task, with no name,
+  message or generated input; a task not attempted (or whose file did not load) as one
+  line; no path of the grader's temporary folders and no note about the grader itself
+  (`student_notes`). Gradescope's results say the same (`judging.gradescope`).
 - `for_instructor`: every check with its full message, and the grading notes.
 - `class_summary`: over the whole class, the score distribution per task, the checks
   failed most often, and who handed in nothing or could not be graded.
@@ -12,38 +14,49 @@
 from __future__ import annotations
 
 import collections
+import os
 import re
 import statistics
 from collections.abc import Sequence
+from fractions import Fraction
 from typing import TYPE_CHECKING
 
 from ...course import TASKS
 from ...course.report import CheckResult, without_mistake
+from ..intake import NOT_ON_ROSTER
 from ..judging.grading import Grade
 from ..judging.temporary_paths import scrub
 from ..points.gradebook_db import ABSENT, GRADER_FAILED
+
+GRADER_ONLY = ("graded with the weaker isolation",)
+"""How the notes the grader makes about itself start: the instructor's, not a student's."""
 
 if TYPE_CHECKING:
     from ..points.gradebook import Gradebook
     from ..points.gradebook_db import Record
 
 
-def for_student(grade: Grade) -> str:
-    """The Markdown feedback a student may read."""
+def for_student(grade: Grade, total: str | None = None, source: str = "") -> str:
+    """The Markdown feedback a student may read, opening with the final ``total`` (the
+    term's rules applied; None: the checks' points are the total); paths in it are
+    relative, as seen from above the folder of the hand-in ``source`` (`student_notes`)."""
     lines = [f"# Feedback: {grade.submission}", ""]
     if grade.report is None:
         lines += ["Your submission could not be graded:", ""]
-        lines += [f"- {scrub(note)}" for note in grade.notes]
+        lines += [f"- {note}" for note in student_notes(grade.notes, source)]
         return "\n".join(lines) + "\n"
     report = grade.report
     public = [c for c in report.checks if not c.hidden]
     hidden = [c for c in report.checks if c.hidden]
+    final = total if total not in (None, "") else str(grade.total)
+    changed = Fraction(final) != grade.total
     lines.append(
-        f"**{grade.total} of {report.points} points**: public checks "
-        f"{_earned(public)} of {_points(public)}, hidden checks {_earned(hidden)} of "
-        f"{_points(hidden)}."
+        f"**{final} of {report.points} points**"
+        + (f" (the checks gave {grade.total}; late work and manual changes below)" * changed)
+        + f": public checks {_earned(public)} of {_points(public)}, hidden checks "
+        f"{_earned(hidden)} of {_points(hidden)}."
     )
-    lines += ["", *[f"Note: {scrub(note)}" for note in grade.notes]]
+    lines += ["", *[f"Note: {note}" for note in student_notes(grade.notes, source)]]
     for task in report.tasks():
         checks = [c for c in report.checks if c.task == task]
         lines += ["", _task_heading(task, checks)]
@@ -70,6 +83,16 @@ def for_student(grade: Grade) -> str:
                 f"- {len(secret)} hidden checks: {_earned(secret)} of {_points(secret)} points"
             )
     return "\n".join(lines) + "\n"
+
+
+def student_notes(notes: Sequence[str], source: str = "") -> list[str]:
+    """The notes a student reads: without the grader's own (how it isolated the checks),
+    with no path of the grader's temporary folders, and paths below the folder that holds
+    the hand-ins' folder (of the hand-in ``source``) relative to it: ``class/alice``, not
+    the instructor's whole path."""
+    above = os.path.dirname(os.path.dirname(source.rstrip("/")))
+    kept = [scrub(note) for note in notes if not note.startswith(GRADER_ONLY)]
+    return [note.replace(above + "/", "") if len(above) > 1 else note for note in kept]
 
 
 def for_instructor(grade: Grade, source: str = "", hint: str | None = None) -> str:
@@ -103,6 +126,10 @@ def class_summary(book: Gradebook, records: Sequence[Record], grades: Sequence[G
     absent = [r.id for r in records if r.status == ABSENT]
     if absent:
         lines += [f"Nothing handed in ({len(absent)}): {', '.join(absent)}.", ""]
+    unlisted = [r.id for r in records if any(NOT_ON_ROSTER in note for note in r.notes)]
+    if unlisted:
+        lines += [f"Handed in under an id not on the roster, not graded ({len(unlisted)}): "
+                  f"{', '.join(unlisted)}.", ""]  # fmt: skip
     failed = [r.id for r in records if r.status == GRADER_FAILED]
     if failed:
         lines += [f"Could not be graded, the grader's failure and not the students' "

@@ -6,6 +6,8 @@ import html
 from collections.abc import Iterable
 from pathlib import Path
 
+from . import output_files
+
 
 def write_page(path: Path, title: str, style: str, parts: Iterable[str]) -> None:
     """Write ``parts`` (HTML fragments; empty ones left out) as one UTF-8 page."""
@@ -15,4 +17,4 @@ def write_page(path: Path, title: str, style: str, parts: Iterable[str]) -> None
         + "\n".join(part for part in parts if part)
         + "\n</body></html>\n"
     )
-    path.write_text(page, encoding="utf-8")
+    output_files.write_text(path, page, "page")

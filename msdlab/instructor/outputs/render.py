@@ -27,7 +27,7 @@ from ..points import gradebook_db
 from ..points.gradebook import Gradebook, check_column
 from ..points.gradebook_db import GRADED, GRADER_FAILED, Record
 from ..rules import adjustments, final_points
-from . import class_report, feedback
+from . import class_report, feedback, output_files
 
 
 def render(
@@ -68,8 +68,9 @@ def render(
 def row_of(record: Record) -> dict[str, str]:
     """The grades file's row of ``record``, before the term's rules are applied (the late
     columns of the last settling kept: a run without ``--due`` charges no new penalty)."""
-    row = {"id": record.id, "source": record.source}
-    row.update({f"task{t}": record.tasks.get(t, ("0", "0"))[0] for t in TASKS})
+    row = {"id": record.id, "source": record.source, "status": record.status}
+    nothing = "" if record.status == GRADER_FAILED else "0"  # the grader's failure: no points
+    row.update({f"task{t}": record.tasks.get(t, (nothing, "0"))[0] for t in TASKS})
     row.update(record.final)
     row["points"] = ""  # from the task points, settled again
     row["handed_in"] = record.handed_in or ""
@@ -122,6 +123,7 @@ def write_feedback(
     with its section on late work and manual changes brought up to date."""
     private = private or {}
     for kind in ("students", "instructor"):
+        output_files.not_a_link(folder / kind, "feedback folder")
         (folder / kind).mkdir(parents=True, exist_ok=True)
     possible = book.maximum.get("total", "")
     for record in records:
@@ -138,7 +140,9 @@ def write_feedback(
         if record.status == GRADER_FAILED:  # nothing to hand out: the grader's failure
             student.unlink(missing_ok=True)
         else:
-            _write(student, final_points.with_section(feedback.for_student(grade), section))
+            source = intake.unescaped(record.source)
+            text = feedback.for_student(grade, rows[record.id].get("total"), source)
+            _write(student, final_points.with_section(text, section))
         text = feedback.for_instructor(grade, record.source, record.hint)
         noted = [*record.explained, *private.get(record.id, [])]
         own_section = final_points.feedback_section(rows[record.id], noted, possible)
@@ -149,6 +153,7 @@ def write_feedback(
 
 
 def _write(path: Path, text: str) -> None:
-    """Write ``text`` unless the file holds it already."""
+    """Write ``text`` unless the file holds it already (a link is refused, never read)."""
+    output_files.not_a_link(path, "feedback file")
     if not path.is_file() or path.read_text(encoding="utf-8") != text:
-        path.write_text(text, encoding="utf-8")
+        output_files.write_text(path, text, "feedback file")

@@ -2,7 +2,9 @@
 
 Columns: ``id``, ``source`` (the folder or zip handed in, named exactly: see
 `intake.escaped`), ``task1`` ... ``task5`` (the checks' points), ``points`` (their sum),
-the late work and manual changes (`final_points`), ``total``, optionally one column per check
+the late work and manual changes (`final_points`), ``total``, ``status`` (graded, not graded,
+absent, grader failed: `gradebook_db.STATUSES`; a row the grader failed on has no points
+at all, never 0), optionally one column per check
 (``--detail``: ``task2 rest_state_feels_no_force``), ``notes`` and ``fingerprint`` (a hash
 of the checks and the submission's task files).
 The first row, id ``(max points)``, holds what each column is worth.
@@ -26,7 +28,7 @@ from ..judging.temporary_paths import scrub
 from ..outputs.csv_files import read_csv, write_csv
 from ..rules.final_points import COLUMNS as FINAL_COLUMNS
 
-FIRST = ["id", "source", *(f"task{t}" for t in TASKS), *FINAL_COLUMNS, "total"]
+FIRST = ["id", "source", *(f"task{t}" for t in TASKS), *FINAL_COLUMNS, "total", "status"]
 LAST = ["notes", "fingerprint"]
 
 

@@ -50,6 +50,7 @@ from pathlib import Path
 
 from ...course import TASKS
 from ...course.report import CheckReport, CheckResult
+from ..outputs import output_files
 from ..rules.final_points import COLUMNS as FINAL_COLUMNS
 
 SCHEMA_VERSION = 1
@@ -60,6 +61,8 @@ BUSY_SECONDS = 120.0
 CHECK_FIELDS = tuple(field.name for field in dataclasses.fields(CheckResult))
 """The ``checks`` table's columns after ``submission`` and ``position``: a field added to
 `CheckResult` later is added to an older gradebook's table when it is opened."""
+JOURNALS = ("-wal", "-shm", "-journal")
+"""The files SQLite keeps beside the gradebook."""
 SETTLED = [column for column in FINAL_COLUMNS if column not in ("handed_in", "handed_in_from")]
 
 _SCHEMA = f"""
@@ -130,6 +133,7 @@ def connect(path: Path) -> sqlite3.Connection:
     """The gradebook at ``path``, created if new, ready for another run beside this one
     (WAL journal, a busy timeout of `BUSY_SECONDS`). Commit with ``with connection:``."""
     path = Path(path)
+    _not_linked(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     connection = sqlite3.connect(path, timeout=BUSY_SECONDS, isolation_level=None)
     try:
@@ -146,6 +150,13 @@ def connect(path: Path) -> sqlite3.Connection:
             f"{path} is not a gradebook msdlab can read ({error}); give another --out"
         ) from None
     return connection
+
+
+def _not_linked(path: Path) -> None:
+    """Refuse a gradebook (or its journal files, its folder) that is a symbolic link: the
+    class's rows would be written wherever it points."""
+    for place in (path, *(path.with_name(path.name + end) for end in JOURNALS)):
+        output_files.not_a_link(place, "gradebook")
 
 
 @contextlib.contextmanager
@@ -260,19 +271,23 @@ def _record_checks(connection: sqlite3.Connection, identifier: str, report: Chec
 def record_imported(
     connection: sqlite3.Connection, row: dict[str, str], maximum: dict[str, str]
 ) -> None:
-    """Take in a row of an older grades file (no checks: its task points and columns)."""
+    """Take in a row of an older grades file (no checks: its task points and columns; its
+    status where it has one, so a row the grader failed on keeps having no points)."""
     graded = bool(row.get("fingerprint"))
+    status = row.get("status") if row.get("status") in STATUSES else None
+    status = status or (GRADED if graded else NOT_GRADED)
+    nothing = "" if status == GRADER_FAILED else "0"
     notes = [note for note in (row.get("notes") or "").split("; ") if note]
     connection.execute(
         "INSERT OR REPLACE INTO submissions (id, source, status, fingerprint, handed_in, "
         "handed_in_from, notes, graded_at) VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
-        (row["id"], row.get("source", ""), GRADED if graded else NOT_GRADED,
+        (row["id"], row.get("source", ""), status,
          row.get("fingerprint") or None, row.get("handed_in") or None,
          row.get("handed_in_from") or None, json.dumps(notes), now()),
     )  # fmt: skip
     connection.executemany(
         "INSERT OR REPLACE INTO tasks VALUES (?, ?, ?, ?)",
-        [(row["id"], t, row.get(f"task{t}") or "0", maximum.get(f"task{t}") or "0")
+        [(row["id"], t, row.get(f"task{t}") or nothing, maximum.get(f"task{t}") or "0")
          for t in TASKS],
     )  # fmt: skip
     settled = {column: row.get(column) or "" for column in SETTLED}

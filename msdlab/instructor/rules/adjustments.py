@@ -241,8 +241,8 @@ def _unknown(change: Change, known: Collection[str], where: str) -> Problem | No
     warned about (a student not graded yet)."""
     if change.id in known:
         return None
-    plain = _plain(change.id)
-    alike = sorted(k for k in known if _plain(k) == plain)
+    plain = plain_id(change.id)
+    alike = sorted(k for k in known if plain_id(k) == plain)
     at = f"{where}, line {change.line}"
     if alike:
         return Problem(
@@ -258,7 +258,8 @@ def _unknown(change: Change, known: Collection[str], where: str) -> Problem | No
     )
 
 
-def _plain(identifier: str) -> str:
+def plain_id(identifier: str) -> str:
+    """An id as a lookalike reads it: case and runs of spaces ignored."""
     return " ".join(identifier.split()).casefold()
 
 

@@ -2,6 +2,9 @@
 
     total = points (the checks') − late_penalty + adjustment
 
+A row without any task points (the grader failed on it: its task cells are empty, not 0)
+gets no points, no penalty and no total: nothing that reads as a grade.
+
 Task changes (`adjustments`) come first; the late penalty is taken from the points after
 them; then the changes to the total. ``adjustment`` is whatever the manual changes added
 in all. Every grading run settles every row of the grades file again, so a row kept from
@@ -21,6 +24,8 @@ from pathlib import Path
 
 from ...course import TASKS
 from ..intake import HandIn, file_stem
+from ..intake.times import in_zone
+from ..outputs import output_files
 from .adjustments import Change
 from .late import LatePolicy, format_points
 from .problems import Problem
@@ -32,7 +37,7 @@ controls the hand-in time's record, `intake.times`)."""
 MARK = "<!-- msdlab: late work and manual changes -->"
 END = "<!-- msdlab: end of late work and manual changes -->"
 _SECTION = re.compile(re.escape(MARK) + ".*?" + re.escape(END) + "\n*", re.S)
-_HEADLINE = re.compile(r"^(\*\*[\d.]+ of [\d.]+ points\*\*|[\d.]+/[\d.]+ points).*\n", re.M)
+_HEADLINE = re.compile(r"^(\*\*-?[\d.]+ of [\d.]+ points\*\*|[\d.]+/[\d.]+ points).*\n", re.M)
 """The feedback's first line of points: the student's ``**P of Q points**``, the
 instructor's ``P/Q points``; the section goes right below it."""
 
@@ -68,6 +73,10 @@ def settle(rows: dict[str, dict[str, str]], terms: Terms) -> dict[str, list[str]
 
 
 def _settle_row(identifier: str, row: dict[str, str], terms: Terms) -> list[str]:
+    if not any(row.get(f"task{t}") for t in TASKS):  # no points at all: the grader failed
+        row.update({column: "" for column in ("points", "late", "late_penalty", "adjustment")})
+        row["total"] = ""
+        return []
     checks = {t: Fraction(row.get(f"task{t}") or 0) for t in TASKS}
     row["points"] = row.get("points") or format_points(sum(checks.values()))
     changes = terms.changes.get(identifier, [])
@@ -123,7 +132,8 @@ def _charge(row: dict[str, str], points: Fraction, due: datetime, terms: Terms, 
         return
     handed = datetime.fromisoformat(row["handed_in"])
     lateness = terms.policy.charge(points, handed - due)
-    when = f"due {_shown(due)}{' (your extension)' if own else ''}, handed in {_shown(handed)}"
+    shown = _shown(in_zone(handed, due))
+    when = f"due {_shown(due)}{' (your extension)' if own else ''}, handed in {shown}"
     row["late"] = f"{when} ({_evidence(row)}): {lateness.reason}"
     row["late_penalty"] = format_points(lateness.penalty) if lateness.penalty else ""
 
@@ -178,10 +188,10 @@ def refresh_feedback(
         shown = lines.get(identifier, [])
         for kind, extra in (("students", []), ("instructor", (private or {}).get(identifier, []))):
             section = feedback_section(row, [*shown, *extra], possible)
-            path = Path(folder) / kind / f"{file_stem(identifier)}.md"
+            path = output_files.not_a_link(Path(folder) / kind / f"{file_stem(identifier)}.md")
             if path.is_file():
-                path.write_text(with_section(path.read_text(encoding="utf-8"), section),
-                                encoding="utf-8")  # fmt: skip
+                text = with_section(path.read_text(encoding="utf-8"), section)
+                output_files.write_text(path, text, "feedback file")
 
 
 def with_section(text: str, section: str) -> str:

@@ -4,9 +4,10 @@ and the instructor's files, checked whole."""
 from __future__ import annotations
 
 import argparse
+import difflib
 import sys
 import tempfile
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from datetime import datetime, timezone
 from fractions import Fraction
 from pathlib import Path
@@ -81,6 +82,26 @@ def terms(args: argparse.Namespace) -> tuple[Terms, list[Problem]]:
     changes, wrong = adjustments.parse(path)
     found += wrong + adjustments.problems(changes, str(path))
     return Terms(due, policy, own, changes=adjustments.by_student(changes)), found
+
+
+def extensions_against_class(
+    args: argparse.Namespace, terms: Terms, known: Collection[str]
+) -> list[Problem]:
+    """The --extensions file's ids that no submission has: a lookalike of one (case,
+    spaces) is refused, any other warned about (a typo, or a student not taken in yet)."""
+    found = []
+    for identifier in sorted(set(terms.own_due) - set(known)):
+        alike = sorted(
+            k for k in known if adjustments.plain_id(k) == adjustments.plain_id(identifier)
+        )
+        near = difflib.get_close_matches(identifier, sorted(known), n=1)
+        hint = f" (did you mean {near[0]!r}?)" if near else ""
+        problem = Problem(str(args.extensions), f"no submission has the id {identifier!r}",
+                          f"did you mean {alike[0]!r}? write the id exactly" if alike else
+                          f"its extension waits for one; check the id against the roster{hint}",
+                          refused=bool(alike))  # fmt: skip
+        found.append(problem)
+    return found
 
 
 def possible_points(maximum: Mapping[str, str], checks: Path) -> dict[str, Fraction]:
