@@ -85,3 +85,24 @@ def test_the_page_breaks_no_wcag_rule_axe_checks(which, request, browser):
         assert not violations, "\n".join(violations)
     finally:
         page.close()
+
+
+def test_the_check_map_says_each_result_in_marks_and_words_not_colour_alone(tmp_path):
+    """Each failed cell of the map is marked × and each cell not run –, and the table
+    beside it says every student's result of every check in words."""
+    book, grades = Gradebook(), [Grade(s, report_of(s)) for s in FAILS]
+    first_only = report_of("ada")
+    grades.append(Grade("ed", CheckReport("submission", first_only.checks[:1])))  # 2 not run
+    for grade in grades:
+        book.record(grade, Entry(grade.submission, tmp_path, tmp_path), "print", detail=True)
+    rows = class_report.rows_of(book, grades)
+    marks = class_report.heatmap(rows).axes[0].collections  # the ×s, then the dashes
+    failed = sum(len(fails) for fails in FAILS.values())
+    assert [len(mark.get_offsets()) for mark in marks] == [failed, 2]
+    class_report.write_html(rows, book.maximum, tmp_path / "grades.class.html")
+    page = (tmp_path / "grades.class.html").read_text(encoding="utf-8")
+    table = page.split("The map as a table")[1].split("</details>")[0]
+    assert table.count("<td>✗ failed</td>") == failed and table.count("<td>not run</td>") == 2
+    assert table.count("<td>passed</td>") == (len(FAILS) + 1) * len(CHECKS) - failed - 2
+    for student in [*FAILS, "ed"]:
+        assert f"<th scope='row'>{student}</th>" in table
