@@ -55,13 +55,13 @@ def class_page(tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="module")
 def similarity_page(tmp_path_factory) -> Path:
-    """The similarity page of the planted class of tests/course/similarity (a copied
-    student, two disguised copies, honest solutions)."""
+    """The similarity page of three students of the planted class of tests/course/similarity:
+    a student, a disguised copy, one who wrote their own."""
     copies = module_at(TESTS / "course" / "similarity" / "copies.py", "msdlab_planted_copies")
     root = tmp_path_factory.mktemp("similarity")
     folders = copies.write_class(root / "class")
     with contextlib.redirect_stdout(io.StringIO()):
-        given = [str(folder) for folder in folders.values()]
+        given = [str(folders[student]) for student in ("original", "renamed", "honest_plain")]
         assert main(["similarity", *given, "--out", str(root / "report")]) == 0
     return root / "report" / "similarity.html"
 

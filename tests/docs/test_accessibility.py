@@ -33,6 +33,10 @@ COLOURS = {
 }
 
 
+TYPESET = "() => window.MathJax?.Hub && new Promise((done) => MathJax.Hub.Queue(done))"
+"""Waits for MathJax, where a page has it, to have typeset its formulas."""
+
+
 def pages(site: Path) -> list[str]:
     """Every HTML page of the site, as a path under it (not the files beside the pages in
     _static, _images, ...)."""
@@ -47,6 +51,7 @@ def test_every_page_breaks_no_wcag_rule_axe_checks(site, server, browser):
     try:
         for path in pages(site):
             page.goto(f"{server}/{path}", wait_until="load", timeout=60_000)
+            page.evaluate(TYPESET)
             violations = axe_violations(page, colours=path in COLOURS)
             if violations:
                 broken[path] = violations
