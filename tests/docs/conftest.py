@@ -45,7 +45,7 @@ class QuietHandler(http.server.SimpleHTTPRequestHandler):
         pass
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def server(site):
     """The built site on http://127.0.0.1:PORT, as `python -m http.server` serves it."""
     handler = functools.partial(QuietHandler, directory=str(site))
@@ -57,9 +57,10 @@ def server(site):
     httpd.server_close()
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def browser():
-    """Headless Chromium (`browser.launch`), one for all the site's tests."""
+    """Headless Chromium (`browser.launch`), one for a test file's pages (closed with it:
+    a Playwright left running would meet the next file's own)."""
     pytest.importorskip("playwright", reason="needs playwright (pip install -e '.[test]')")
     from playwright.sync_api import sync_playwright
 
