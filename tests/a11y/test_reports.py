@@ -57,6 +57,7 @@ def class_page(tmp_path_factory) -> Path:
 def similarity_page(tmp_path_factory) -> Path:
     """The similarity page of three students of the planted class of tests/course/similarity:
     a student, a disguised copy, one who wrote their own."""
+    pytest.importorskip("copydetect", reason="needs copydetect (pip install -e '.[grade]')")
     copies = module_at(TESTS / "course" / "similarity" / "copies.py", "msdlab_planted_copies")
     root = tmp_path_factory.mktemp("similarity")
     folders = copies.write_class(root / "class")
