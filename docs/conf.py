@@ -28,6 +28,7 @@ extensions = [
     "architecture",
     "docstrings",
     "public_names",
+    "sidebar_names",
 ]
 
 # scenes/ holds the gallery's sources; gallery/ its generated pages, whose .ipynb downloads
@@ -92,7 +93,8 @@ sphinx_gallery_conf = {
     "examples_dirs": "scenes",
     "gallery_dirs": "gallery",
     "filename_pattern": r"/scene_",
-    "image_scrapers": ("matplotlib", "gallery_scraper.animation_scraper"),
+    # pictures with a text alternative in numbers, animations folded until played
+    "image_scrapers": ("gallery_scraper.picture_scraper", "gallery_scraper.animation_scraper"),
     "download_all_examples": False,
     "remove_config_comments": True,
     "show_memory": False,
@@ -124,5 +126,7 @@ html_theme_options = {
     "secondary_sidebar_items": ["page-toc"],
     "use_edit_page_button": False,
 }
+# accessibility.css: the gallery's thumbnail links keep their names for screen readers
+html_css_files = ["accessibility.css"]
 html_show_sourcelink = False
 html_copy_source = False

@@ -8,15 +8,12 @@ theme), every picture must load, and the formulas must be typeset. Screenshots g
 
 from __future__ import annotations
 
-import functools
-import http.server
 import os
-import threading
 from pathlib import Path
 from urllib.parse import urlparse
 
 import pytest
-from browser import CHROMIUM, launch
+from browser import CHROMIUM
 
 MATHJAX = Path("/usr/share/javascript/mathjax/MathJax.js")
 
@@ -37,34 +34,6 @@ PAGES = {
     "module": "api/generated/msdlab.engine.simulation.simulation.html",
     "equations": "engine/equations.html",
 }
-
-
-class QuietHandler(http.server.SimpleHTTPRequestHandler):
-    def log_message(self, format, *args) -> None:
-        pass
-
-
-@pytest.fixture(scope="module")
-def server(site):
-    """The built site on http://127.0.0.1:PORT, as `python -m http.server` serves it."""
-    handler = functools.partial(QuietHandler, directory=str(site))
-    httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
-    thread = threading.Thread(target=httpd.serve_forever, daemon=True)
-    thread.start()
-    yield f"http://127.0.0.1:{httpd.server_address[1]}"
-    httpd.shutdown()
-    httpd.server_close()
-
-
-@pytest.fixture(scope="module")
-def browser():
-    pytest.importorskip("playwright", reason="needs playwright (pip install -e '.[test]')")
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as playwright:
-        browser = launch(playwright)
-        yield browser
-        browser.close()
 
 
 def screenshot_folder(tmp_path: Path) -> Path:

@@ -247,8 +247,7 @@ def write_html(rows: Sequence[ClassRow], maximum: dict[str, str], path: Path) ->
         "<h1>The class at a glance</h1>",
         f"<p>{len(graded)} of {len(rows)} students graded. It reports; it changes no points.</p>",
         "<h2>Points per task</h2>",
-        _picture(histograms(columns, maximum), "points per task") if graded else "",
-        _statistics_table(columns, maximum) if graded else "",
+        _histograms_part(columns, maximum) if graded else "",
         "<h2>Checks failed most often</h2>",
         _rates_table(failure_rates(rows)),
         "<h2>Usual causes</h2>",
@@ -272,12 +271,45 @@ table { border-collapse: collapse; margin: 1em 0; }
 th, td { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; vertical-align: top; }
 td.number { text-align: right; font-variant-numeric: tabular-nums; }
 img { max-width: 100%; height: auto; }
-.bar { display: inline-block; height: 0.8em; background: #d9534f; }
+.bar { display: inline-block; height: 0.8em; background: #b0413e; }
+details { margin: 0.5em 0 1em; }
+summary { cursor: pointer; }
 """
+MAP_COLOURS = {PASSED: "#56b4e9", FAILED: "#d55e00", NOT_RUN: "#eeeeee"}
+"""The check × student map's colours (Okabe and Ito's, told apart with any colour vision);
+a failed cell is marked × too, one not run with a dash."""
+MAP_WORDS = {PASSED: "passed", FAILED: "✗ failed", NOT_RUN: "not run"}
+MAP_LEGEND = "blue passed, orange × failed, light grey – not run"
+
+
+def _histograms_part(columns: list[tuple[str, list[float]]], maximum: dict[str, str]) -> str:
+    """The histograms, their statistics, and the counts they draw as a table."""
+    text = (
+        f"Histograms of the points of the {len(columns[0][1])} students graded, one per "
+        "task and one of the totals; the tables below give their numbers"
+    )
+    counts = "".join(
+        f"<tr><th scope='row'>{html.escape(name)}</th><td>{_counts(points)}</td></tr>"
+        for name, points in columns
+    )
+    return (
+        _picture(histograms(columns, maximum), text)
+        + _statistics_table(columns, maximum)
+        + "<details><summary>How many students had each number of points</summary><table>"
+        + "<tr><th scope='col'>column</th><th scope='col'>points: students</th></tr>"
+        + f"{counts}</table></details>"
+    )
+
+
+def _counts(points: list[float]) -> str:
+    """``points`` as "0: 1, 3: 4" (points: how many students had them), lowest first."""
+    tally = sorted(collections.Counter(points).items())
+    return ", ".join(f"{value:g}: {count}" for value, count in tally)
 
 
 def _statistics_table(columns: list[tuple[str, list[float]]], maximum: dict[str, str]) -> str:
-    head = "<tr><th></th><th>worth</th><th>mean</th><th>median</th><th>min</th><th>max</th></tr>"
+    names = ("column", "worth", "mean", "median", "min", "max")
+    head = "<tr>" + "".join(f"<th scope='col'>{name}</th>" for name in names) + "</tr>"
     rows = [
         f"<tr><th>{name}</th>"
         + "".join(
@@ -331,10 +363,29 @@ def _list(lines: list[str], empty: str) -> str:
 
 
 def _heatmap_part(rows: Sequence[ClassRow]) -> str:
+    """The check × student map, and the same as a table (folded: it may be long)."""
     known = [r for r in rows if r.graded and r.checks]
     if not known:
         return "<p>No check results are known (grade with --detail to keep them).</p>"
-    return _picture(heatmap(known), "checks by students: green passed, red failed, grey not run")
+    layout = check_map(known)
+    columns, students, cells = layout
+    failed = sum(row.count(FAILED) for row in cells)
+    text = (
+        f"Map of {len(columns)} checks (rows) by {len(students)} students (columns, lowest "
+        f"total first): {failed} failed results; {MAP_LEGEND}. The table below gives each cell"
+    )
+    head = "".join(f"<th scope='col'>{html.escape(c)}</th>" for c in columns)
+    body = "".join(
+        f"<tr><th scope='row'>{html.escape(student.id)}</th>"
+        + "".join(f"<td>{MAP_WORDS[row[j]]}</td>" for row in cells)
+        + "</tr>"
+        for j, student in enumerate(students)
+    )
+    return (
+        _picture(_draw_map(layout), text)
+        + "<details><summary>The map as a table: each student's result of each check"
+        + f"</summary><table><tr><th scope='col'>student</th>{head}</tr>{body}</table></details>"
+    )
 
 
 def _picture(figure: Figure, text: str) -> str:
@@ -364,12 +415,12 @@ def histograms(columns: list[tuple[str, list[float]]], maximum: dict[str, str]) 
     return figure
 
 
-def heatmap(rows: Sequence[ClassRow]) -> Figure:
-    """Checks (rows, by task) × students (columns, lowest total first): passed, failed,
-    not run."""
-    from matplotlib.colors import ListedColormap
-    from matplotlib.figure import Figure
+MapLayout = tuple[list[str], list[ClassRow], list[list[int]]]
+"""The check × student map: its checks, its students, and cells[check][student]."""
 
+
+def check_map(rows: Sequence[ClassRow]) -> MapLayout:
+    """Checks (by task) × students (lowest total first): `PASSED`, `FAILED`, `NOT_RUN`."""
     seen = {c.column: c.task for r in rows for c in r.checks}  # in the reports' order
     columns = sorted(seen, key=seen.__getitem__)
     students = sorted(rows, key=lambda r: (r.total, r.id))
@@ -378,11 +429,31 @@ def heatmap(rows: Sequence[ClassRow]) -> Figure:
     for j, row in enumerate(students):
         for check in row.checks:
             cells[where[check.column]][j] = PASSED if check.passed else FAILED
+    return columns, students, cells
+
+
+def heatmap(rows: Sequence[ClassRow]) -> Figure:
+    """Checks (rows, by task) × students (columns, lowest total first): passed, failed
+    (marked ×), not run (marked –)."""
+    return _draw_map(check_map(rows))
+
+
+def _draw_map(layout: MapLayout) -> Figure:
+    from matplotlib.colors import ListedColormap
+    from matplotlib.figure import Figure
+
+    columns, students, cells = layout
     width = min(6 + 0.22 * len(students), 14)  # inches: the check names, then the students
     figure = Figure(figsize=(width, 1.5 + 0.18 * len(columns)), layout="constrained")
     ax = figure.subplots()
-    colours = ListedColormap(["#5cb85c", "#d9534f", "#dddddd"])
+    colours = ListedColormap([MAP_COLOURS[kind] for kind in (PASSED, FAILED, NOT_RUN)])
     ax.imshow(cells, cmap=colours, vmin=0, vmax=2, aspect="auto", interpolation="nearest")
+    for kind, marker in ((FAILED, "x"), (NOT_RUN, "_")):
+        where = [
+            (j, i) for i, row in enumerate(cells) for j, cell in enumerate(row) if cell == kind
+        ]
+        if where:
+            ax.scatter(*zip(*where), marker=marker, s=18, c="black", linewidths=0.8)
     ax.set_yticks(range(len(columns)), columns, fontsize=7, parse_math=False)
     if len(students) <= 60:
         ax.set_xticks(
@@ -395,5 +466,5 @@ def heatmap(rows: Sequence[ClassRow]) -> Figure:
     else:
         ax.set_xticks([])
     ax.set_xlabel(f"{len(students)} students, lowest total on the left", fontsize=9)
-    ax.set_title("green passed, red failed, grey not run", fontsize=9)
+    ax.set_title(MAP_LEGEND, fontsize=9)
     return figure

@@ -36,9 +36,9 @@ tr.flagged { background: #fde2e2; }
 .sides { display: grid; grid-template-columns: 1fr 1fr; gap: 1em; }
 .sides pre { border: 1px solid #ccc; padding: 0.5em; overflow-x: auto; font-size: 0.8em;
              line-height: 1.4; margin: 0; }
-a.passage { color: inherit; text-decoration: none; border-radius: 2px; }
+a.passage { color: inherit; text-decoration: underline dotted; border-radius: 2px; }
 a.passage:target { outline: 3px solid #222; }
-.folded { color: #777; font-style: italic; }
+.folded { color: #595959; font-style: italic; }
 h2 { margin-top: 2em; }
 """
 PALETTE = ("#f6c343", "#8fd3f4", "#b5e48c", "#f4a6c6", "#c7a6f4", "#f9a66c",
@@ -209,7 +209,7 @@ def _line(
     parts, done = [], 0
     for start, end, group in marks:
         start, end = max(start - offset, done), min(end - offset, len(line))
-        if end <= start:
+        if not line[start:end].strip():  # nothing to read as a link: left as it is
             continue
         here = (
             "" if group in named else f' id="{anchor}-{"ab"[side]}{group}" title="go to its twin"'
