@@ -106,9 +106,9 @@ def run(args: argparse.Namespace) -> int:
     spec = implementation_spec(args.impl)
     folder = implementation_folder(spec, Path.cwd())
     if args.hidden and not has_hidden_checks(checks):
-        print("msdlab check: --hidden has nothing to run here: the hidden checks are not in")
-        print("this copy of the course. They run when your work is graded; the last line of")
-        print("msdlab check says what they are worth.")
+        print("msdlab check: --hidden has nothing to run here:")
+        print("the hidden checks are not in this copy of the course. They run when your work")
+        print("is graded; the last line of msdlab check says what they are worth.")
         return 2
     scope = f"task {task}" if task else "all tasks"
     print(f"msdlab check: {scope} on {folder}")
