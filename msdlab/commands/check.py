@@ -7,9 +7,9 @@ call into your files may take --call-timeout seconds. The table shows each
 check, its points, pass or fail and what the check saw (a long message once,
 below it); the last line says what the hidden checks, which run only when your
 work is graded, are worth. The exit status is 0 only if every check passed.
-While they run, a line says which check is running. The checks of each task may
-take --task-timeout seconds of processor time, as when graded: code stopped by
-either limit is named by its file, line and function.
+While they run, a line says which check is running. Each function of your task
+files may take --task-timeout seconds of processor time in its task's checks, as
+when graded: code stopped by either limit is named by its file, line and function.
 """
 
 from __future__ import annotations
@@ -84,8 +84,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--task-timeout",
         type=float,
         default=TASK_TIMEOUT,
-        help="processor seconds the checks of one task may take, as when your work is graded "
-        "(%(default)s)",
+        help="processor seconds each function of your task files may take in its task's "
+        "checks, all its calls together, as when your work is graded (%(default)s)",
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="show pytest's own output too")
     parser.set_defaults(run=run)

@@ -12,8 +12,9 @@
 - ``--call-timeout=S``: each call into the task modules, and each task file's import, may
   take S seconds (`msdlab.course.call_limit`; default: no limit). A function that did not
   return is not called again in the later checks of its task (each says so, once).
-- ``--task-timeout=S``: the checks of each task may take S seconds of processor time, as
-  when graded (`msdlab.course.task_budget`; default: no limit).
+- ``--task-timeout=S``: each function of the task files may take S seconds of processor
+  time in its task's checks, as when graded (`msdlab.course.task_budget`; default: no
+  limit).
 - ``--msdlab-progress=FD``: write a line ``TASK NAME`` to the file descriptor FD as each
   graded check starts (``msdlab check`` shows it while the checks run).
 - ``--msdlab-points=PATH`` writes the points of every collected check, public and
@@ -95,8 +96,8 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         type=float,
         default=0.0,
         metavar="S",
-        help="processor seconds the checks of one task may take, as when graded (default 0: "
-        "no limit)",
+        help="processor seconds each function of the implementation may take in its task's "
+        "checks, all its calls together, as when graded (default 0: no limit)",
     )
     group.addoption(
         "--msdlab-progress",
@@ -256,8 +257,7 @@ def pytest_runtest_call(item: pytest.Item) -> Iterator[None]:
 def _start_check(item: pytest.Item) -> None:
     """Each task's checks start afresh: a function that timed out in an earlier task runs
     again (in the same task it does not: it fails at once, `_explain` says where it did).
-    The check's line goes to ``--msdlab-progress``; a task whose code was stopped by its
-    time budget runs none of its later checks."""
+    The check's line goes to ``--msdlab-progress``."""
     graded = item.stash.get(_GRADED, None)
     task = graded[0] if graded else 0
     if item.config.stash.get(_LAST_TASK, None) != task:
@@ -268,13 +268,11 @@ def _start_check(item: pytest.Item) -> None:
         line = f"{task} {item.name.removeprefix('test_')}\n"  # runner.run_checks reads it
         with contextlib.suppress(OSError):
             os.write(progress, line.encode())
-    budget = item.config.stash.get(_BUDGET, None)
-    if graded and budget is not None:
-        budget.refuse_if_stopped(task)
 
 
 def _charged(item: pytest.Item) -> contextlib.AbstractContextManager:
-    """The block charged to the task budget of ``item``'s task (nothing without one)."""
+    """The block whose student code is charged to its functions' budgets in ``item``'s task
+    (nothing without a budget)."""
     graded = item.stash.get(_GRADED, None)
     budget = item.config.stash.get(_BUDGET, None)
     if graded is None or budget is None:
@@ -363,6 +361,16 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo):
             result.message = _timed_out_once(result.message, item)
     elif report.when == "call":
         result.outcome = "passed"
+    _stop_not_lost(item, result, report.when)
+
+
+def _stop_not_lost(item: pytest.Item, result: CheckResult, when: str) -> None:
+    """A check whose student code was stopped by its budget fails with what the stop said,
+    even where something between the stop and pytest caught it."""
+    budget = item.config.stash.get(_BUDGET, None)
+    said = budget.said.get(item.name.removeprefix("test_")) if budget is not None else None
+    if said and when == "call" and result.exception != TaskStopped.__name__:
+        result.outcome, result.exception, result.message = "failed", TaskStopped.__name__, said
 
 
 def pytest_sessionfinish(session: pytest.Session) -> None:

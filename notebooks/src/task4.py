@@ -134,8 +134,10 @@ with course.attempt():
         springs, seconds = np.array(points).T
         ax.plot(springs, seconds * 1e3, "o-", label=f"neighbours {wanted}")
     for n, few, many in zip((6, 10, 14, 18), *costs.values()):
-        print(f"n = {n}: (1, 2, 3) has {many[0] / few[0]:.1f}× the springs of (1,), "
-              f"{many[1] / few[1]:.1f}× the time a step")
+        print(
+            f"n = {n}: (1, 2, 3) has {many[0] / few[0]:.1f}× the springs of (1,), "
+            f"{many[1] / few[1]:.1f}× the time a step"
+        )
     ax.set(xlabel="springs", ylabel="ms per step", title="Cost of a step")
     ax.legend()
     plt.show()
