@@ -10,7 +10,7 @@ from __future__ import annotations
 import importlib
 from types import ModuleType
 
-STUDENT_COMMANDS = ("demo", "scenes", "run", "check")
+STUDENT_COMMANDS = ("demo", "scenes", "run", "check", "handin")
 
 try:
     from ..instructor.commands import COMMANDS as INSTRUCTOR_COMMANDS

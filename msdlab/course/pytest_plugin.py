@@ -9,8 +9,14 @@
   load submissions another way.
 - Markers ``task1`` ... ``task5``, ``points(n)`` and ``hidden``. A graded check
   has exactly one task marker and its points; ``hidden`` checks are instructor-only.
-- ``--call-timeout=S``: each call into the task modules may take S seconds
-  (`msdlab.course.call_limit`; default: no limit).
+- ``--call-timeout=S``: each call into the task modules, and each task file's import, may
+  take S seconds (`msdlab.course.call_limit`; default: no limit). A function that did not
+  return is not called again in the later checks of its task (each says so, once).
+- ``--task-timeout=S``: each function of the task files may take S seconds of processor
+  time in its task's checks, as when graded (`msdlab.course.task_budget`; default: no
+  limit).
+- ``--msdlab-progress=FD``: write a line ``TASK NAME`` to the file descriptor FD as each
+  graded check starts (``msdlab check`` shows it while the checks run).
 - ``--msdlab-points=PATH`` writes the points of every collected check, public and
   hidden, per task (`msdlab.course.manifest`).
 - ``--msdlab-report=PATH`` writes the JSON `CheckReport` of the graded checks;
@@ -23,22 +29,28 @@
 
 from __future__ import annotations
 
+import contextlib
 import inspect
 import os
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import pytest
 
 from . import TASKS, call_limit, delegation, failure, loader, manifest, own_numbers
 from .report import CheckReport, CheckResult
+from .task_budget import TaskBudget, TaskStopped, stuck_at
 
 ENV_IMPL = loader.ENV_IMPL
 _REPORT = pytest.StashKey[CheckReport]()
 _STARTED = pytest.StashKey[float]()
 _GRADED = pytest.StashKey[tuple[int, int, bool]]()
+_BUDGET = pytest.StashKey[TaskBudget]()
+_TIMED_OUT = pytest.StashKey[dict[str, str]]()
+"""A timed-out call's message (without its check) -> the check it first timed out in."""
+_LAST_TASK = pytest.StashKey[int]()
 
 
 class Hooks:
@@ -76,7 +88,23 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         type=float,
         default=0.0,
         metavar="S",
-        help="seconds one call into the implementation may take (default 0: no limit)",
+        help="seconds one call into the implementation, or one task file's import, may take "
+        "(default 0: no limit)",
+    )
+    group.addoption(
+        "--task-timeout",
+        type=float,
+        default=0.0,
+        metavar="S",
+        help="processor seconds each function of the implementation may take in its task's "
+        "checks, all its calls together, as when graded (default 0: no limit)",
+    )
+    group.addoption(
+        "--msdlab-progress",
+        type=int,
+        default=None,
+        metavar="FD",
+        help="write a line to the file descriptor FD as each graded check starts",
     )
     group.addoption(
         "--student",
@@ -107,6 +135,11 @@ def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "hidden: instructor-only check, not in the student release")
     config.stash[_REPORT] = CheckReport(implementation=implementation_spec(config))
     config.stash[_STARTED] = time.perf_counter()
+    config.stash[_TIMED_OUT] = {}
+    seconds = config.getoption("task_timeout") or 0.0
+    if seconds > 0:
+        folder = loader.resolve(implementation_spec(config), loader.course_root(config.rootpath))
+        config.stash[_BUDGET] = TaskBudget(seconds, folder)
 
 
 def implementation_spec(config: pytest.Config) -> str:
@@ -155,7 +188,17 @@ def _task_fixture(number: int):
     @pytest.fixture(scope="session", name=f"task{number}")
     def task(implementation: loader.Implementation, pytestconfig: pytest.Config):
         pytestconfig.stash[_REPORT].implementation = implementation.label
-        return implementation.task(number)
+        seconds = pytestconfig.getoption("call_timeout") or 0.0
+        if seconds <= 0:
+            return implementation.task(number)
+        folder = getattr(implementation, "folder", None)
+        try:
+            with call_limit.time_limit(seconds, lambda: _import_stopped(number, seconds, folder)):
+                return implementation.task(number)
+        except loader.SubmissionError as error:  # the stop says what and where by itself
+            if isinstance(error.__cause__, TaskStopped):
+                raise error.__cause__ from None
+            raise
 
     task.__doc__ = f"The module of task {number} of the implementation under test."
     return task
@@ -166,6 +209,17 @@ task2 = _task_fixture(2)
 task3 = _task_fixture(3)
 task4 = _task_fixture(4)
 task5 = _task_fixture(5)
+
+
+def _import_stopped(number: int, seconds: float, folder: Path | None) -> NoReturn:
+    """Stop the import of task ``number``'s file, saying where it was (called by the time
+    limit's signal handler, whose caller is the interrupted code)."""
+    where = stuck_at(inspect.currentframe(), folder)
+    raise TaskStopped(
+        f"task{number}.py was still being imported after {seconds:g} s and was stopped"
+        + (f" in {where}" if where else "")
+        + "\nan endless loop at the top level of the file? (--call-timeout S allows more)"
+    )
 
 
 def check_arguments(
@@ -185,9 +239,45 @@ def check_arguments(
     return {name: given[name] for name in taken}
 
 
-def pytest_runtest_setup(item: pytest.Item) -> None:
-    """Each check starts afresh: a function that timed out in an earlier check runs again."""
-    call_limit.forgive()
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_setup(item: pytest.Item) -> Iterator[None]:
+    """Set a check up (its fixtures import the task files) charged to its task's budget."""
+    _start_check(item)
+    with _charged(item):
+        return (yield)
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_call(item: pytest.Item) -> Iterator[None]:
+    """Run a check charged to its task's budget."""
+    with _charged(item):
+        return (yield)
+
+
+def _start_check(item: pytest.Item) -> None:
+    """Each task's checks start afresh: a function that timed out in an earlier task runs
+    again (in the same task it does not: it fails at once, `_explain` says where it did).
+    The check's line goes to ``--msdlab-progress``."""
+    graded = item.stash.get(_GRADED, None)
+    task = graded[0] if graded else 0
+    if item.config.stash.get(_LAST_TASK, None) != task:
+        item.config.stash[_LAST_TASK] = task
+        call_limit.forgive()
+    progress = item.config.getoption("msdlab_progress")
+    if graded and progress is not None:
+        line = f"{task} {item.name.removeprefix('test_')}\n"  # runner.run_checks reads it
+        with contextlib.suppress(OSError):
+            os.write(progress, line.encode())
+
+
+def _charged(item: pytest.Item) -> contextlib.AbstractContextManager:
+    """The block whose student code is charged to its functions' budgets in ``item``'s task
+    (nothing without a budget)."""
+    graded = item.stash.get(_GRADED, None)
+    budget = item.config.stash.get(_BUDGET, None)
+    if graded is None or budget is None:
+        return contextlib.nullcontext()
+    return budget.charged(graded[0], item.name.removeprefix("test_"))
 
 
 @pytest.hookimpl(tryfirst=True)  # before -m deselects: --msdlab-points counts every check
@@ -267,8 +357,20 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo):
     elif report.failed:
         result.outcome = "failed" if report.when == "call" else "error"
         result.exception, result.message, result.mistake = _describe(call, _task_folder(item))
+        if call.excinfo is not None and isinstance(call.excinfo.value, call_limit.CallTimedOut):
+            result.message = _timed_out_once(result.message, item)
     elif report.when == "call":
         result.outcome = "passed"
+    _stop_not_lost(item, result, report.when)
+
+
+def _stop_not_lost(item: pytest.Item, result: CheckResult, when: str) -> None:
+    """A check whose student code was stopped by its budget fails with what the stop said,
+    even where something between the stop and pytest caught it."""
+    budget = item.config.stash.get(_BUDGET, None)
+    said = budget.said.get(item.name.removeprefix("test_")) if budget is not None else None
+    if said and when == "call" and result.exception != TaskStopped.__name__:
+        result.outcome, result.exception, result.message = "failed", TaskStopped.__name__, said
 
 
 def pytest_sessionfinish(session: pytest.Session) -> None:
@@ -309,6 +411,8 @@ def _describe(call: pytest.CallInfo, folder: Path | None) -> tuple[str | None, s
         return None, "", ""
     error = call.excinfo.value
     errors = getattr(error, "exceptions", None)  # an exception group (Python 3.10: a backport)
+    if isinstance(errors, tuple) and len(errors) == 1:
+        error, errors = errors[0], None
     if not isinstance(errors, tuple) or not errors:
         return type(error).__name__, _explain(error, folder), getattr(error, "mistake", "")
     kinds = {type(e).__name__ for e in errors}
@@ -328,10 +432,22 @@ def _explain(error: BaseException, folder: Path | None) -> str:
     lines = [str(error).strip()]
     if isinstance(error, NotImplementedError):
         lines.append(failure.raised_in(error, folder, code=False))  # the function to write
-    elif not isinstance(error, call_limit.CallTimedOut):
+    elif isinstance(error, call_limit.CallTimedOut):
+        lines.append(failure.raised_in(error, folder).replace("in your code:", "stopped in"))
+    elif not isinstance(error, TaskStopped):  # a stop says where it was
         lines.append(failure.raised_in(error, folder))
         lines += [failure.failing_inputs(str(note)) for note in getattr(error, "__notes__", ())]
     return "\n".join(line for line in lines if line)
+
+
+def _timed_out_once(message: str, item: pytest.Item) -> str:
+    """A timed-out call's ``message`` the first time in its task (with where the code was);
+    in a later check, where the function was not called again, a line that points there."""
+    stem, _, rest = message.partition(" (check ")
+    first = item.config.stash[_TIMED_OUT].setdefault(stem, item.name.removeprefix("test_"))
+    if first == item.name.removeprefix("test_") or not rest:
+        return message
+    return f"{stem} in check {first} and was not called again (see there)"
 
 
 def _task_folder(item: pytest.Item) -> Path | None:

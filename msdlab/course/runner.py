@@ -12,17 +12,20 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import select
 import shlex
 import shutil
 import subprocess
 import sys
 import tempfile
-from collections.abc import Mapping
+import time
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 from . import PROJECT_ROOT, TASKS, loader
 from .report import CheckReport
+from .task_budget import TASK_TIMEOUT
 
 CHECKS = Path("tests") / "tasks"
 PLUGINS = ("msdlab.course.pytest_plugin", "_hypothesis_pytestplugin", "pytest_timeout")
@@ -67,6 +70,8 @@ class CheckRun:
     plugins: tuple[str, ...] = PLUGINS
     options: tuple[str, ...] = ()
     workspace: Path | None = None
+    task_timeout: float | None = None
+    progress: int | None = None
 
     def arguments(self) -> list[str]:
         """pytest's arguments: only the files of `task` where it is given (collecting the
@@ -90,8 +95,12 @@ class CheckRun:
         ]  # fmt: skip
         if self.call_timeout is not None:
             arguments.append(f"--call-timeout={self.call_timeout:g}")
+        if self.task_timeout is not None:
+            arguments.append(f"--task-timeout={self.task_timeout:g}")
         if self.points is not None:
             arguments.append(f"--msdlab-points={self.points}")
+        if self.progress is not None:
+            arguments.append(f"--msdlab-progress={self.progress}")
         if self.workspace is not None:
             arguments += ["--no-header", "--confcutdir", str(self.checks)]
             arguments += ["--rootdir", str(self.workspace), "-o", "addopts="]
@@ -133,6 +142,10 @@ def compile_msdlab() -> None:
     compileall.compile_dir(PROJECT_ROOT / "msdlab", quiet=2, workers=1)
 
 
+Progress = Callable[[str | None], None]
+"""Told ``'task 2: name'`` as each check starts, and None about once a second meanwhile."""
+
+
 def run_checks(
     checks: Path,
     folder: Path,
@@ -143,7 +156,9 @@ def run_checks(
     timeout: float = 900.0,
     save: Path | None = None,
     call_timeout: float = CALL_TIMEOUT,
+    task_timeout: float = TASK_TIMEOUT,
     points: Path | None = None,
+    progress: Progress | None = None,
 ) -> tuple[CheckReport, str]:
     """Run the checks of ``task`` (None: all tasks) on the task files in ``folder`` (a
     `CheckRun` standing in ``checks``).
@@ -151,34 +166,67 @@ def run_checks(
     Returns the report and pytest's output; ``save`` keeps a copy of the JSON report,
     ``points`` gets the points manifest of every check found (`manifest`). Hidden checks
     run only with ``hidden``. Each call into a task file may take ``call_timeout``
-    seconds, the whole run ``timeout``.
+    seconds, the checks of each task ``task_timeout`` seconds of processor time (as when
+    graded), the whole run ``timeout``; ``progress`` hears of each check as it starts.
     """
     compile_msdlab()
     with tempfile.TemporaryDirectory(prefix="msdlab-check-") as scratch:
         report_path = Path(scratch) / "report.json"
-        run = CheckRun(checks, folder, report_path, task, hidden, call_timeout, points, verbose)
+        read_end, write_end = os.pipe()
+        run = CheckRun(
+            checks, folder, report_path, task, hidden, call_timeout, points, verbose,
+            task_timeout=task_timeout, progress=write_end,
+        )  # fmt: skip
         try:
-            process = subprocess.run(
+            process = subprocess.Popen(
                 run.command(),
                 cwd=checks,
                 env=environment(),
-                capture_output=True,
-                text=True,
-                timeout=timeout,
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.STDOUT,
+                pass_fds=(write_end,),
             )
-        except subprocess.TimeoutExpired:
+        finally:
+            os.close(write_end)
+        with os.fdopen(read_end, "rb") as lines:
+            returncode, output = _watch(process, lines, timeout, progress or (lambda _: None))
+        if not report_path.exists() or returncode not in (0, 1):
             raise ChecksDidNotRun(
-                f"the checks did not finish within {timeout:g} s: is there an endless loop at "
-                "the top level of a task file, or one the per-call limit cannot interrupt?"
-            ) from None
-        output = process.stdout + process.stderr
-        if not report_path.exists() or process.returncode not in (0, 1):
-            raise ChecksDidNotRun(
-                f"the checks could not run (pytest exit status {process.returncode})", output
+                f"the checks could not run (pytest exit status {returncode})", output
             )
         if save is not None:
             shutil.copyfile(report_path, save)
         return CheckReport.read(report_path), output
+
+
+def _watch(process: subprocess.Popen, lines, timeout: float, progress: Progress) -> tuple[int, str]:
+    """Wait for the checks' ``process``, telling ``progress`` of each check it starts (read
+    from ``lines``); its exit status and output. After ``timeout`` seconds it is ended."""
+    deadline, output, last, buffer = time.monotonic() + timeout, bytearray(), "", b""
+    streams = [process.stdout, lines]
+    while process.stdout in streams:
+        if time.monotonic() > deadline:
+            process.kill()
+            process.wait()
+            raise ChecksDidNotRun(
+                f"the checks did not finish within {timeout:g} s"
+                + (f" (the last one started: {last})" if last else "")
+            )
+        for stream in select.select(streams, [], [], 1.0)[0]:
+            data = os.read(stream.fileno(), 65536)
+            if not data:
+                streams.remove(stream)
+            elif stream is process.stdout:
+                output += data
+            else:
+                *complete, buffer = (buffer + data).split(b"\n")
+                for line in complete:
+                    task, _, name = line.decode(errors="replace").partition(" ")
+                    last = f"task {task}: {name}"
+                    progress(last)
+        progress(None)
+    return process.wait(), output.decode(errors="replace")
 
 
 def missing_test_tools() -> list[str]:

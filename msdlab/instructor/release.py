@@ -74,6 +74,29 @@ pip install -e ".[notebooks]" && jupyter lab notebooks
 ```
 
 They open on the environment's Python kernel ("Python 3 (ipykernel)").
+
+## Handing in
+
+The grader reads your task files `assignments/task1.py` ... `task5.py` and nothing
+else. In this folder:
+
+```bash
+msdlab handin
+```
+
+writes `handin.zip` (a few kB) holding exactly those files, lists them, and warns about a
+task file that is missing or still has parts of its template to write. Hand in the way
+your course asks:
+
+- **a zip file** (a learning platform, e-mail): upload `handin.zip`. Do not zip this
+  whole folder: with its `.venv/` that is hundreds of MB, and the grader reads only the
+  task files;
+- **Gradescope**: upload `handin.zip` (or the five task files) to the assignment;
+- **a folder** (a shared drive): hand in your `assignments/` folder;
+- **git** (a course repository, e.g. GitHub Classroom): this folder is not a repository;
+  clone the one your course gives you, copy your task files into its `assignments/`,
+  then `git add assignments/task*.py`, `git commit` and `git push`. What is graded is
+  the last commit pushed before the deadline.
 {docs}"""
 
 STUDENT_DOCS = """
@@ -93,6 +116,7 @@ venv/
 env/
 # what msdlab writes
 msdlab-output/
+handin.zip
 *.gif
 *.mp4
 # caches and build by-products

@@ -2,7 +2,9 @@
 
 The release holds no built site: `write` copies the student pages (``docs/student/*.md``)
 into the release's ``docs/``, readable in any Markdown viewer (a forge's file view, an
-editor): the site's table of contents goes, a MyST role becomes its code text, a picture
+editor): the site's table of contents goes, so does what a page marks as the course's only
+(between ``<!-- course only -->`` and ``<!-- end course only -->``: how a clone of the
+course works, which the release is not), a MyST role becomes its code text, a picture
 of the site's comes along, a link stays where its target is in the release (the
 notebooks, another student page) and becomes its plain text where it is not (the
 engine's pages, the gallery).
@@ -25,6 +27,8 @@ PICTURES = "pictures"
 """The folder of the release's ``docs/`` that the pages' pictures go to."""
 
 _TOCTREE = re.compile(r"^```\{toctree\}.*?^```\n?", re.M | re.S)
+COURSE_ONLY = re.compile(r"^<!-- course only -->\n.*?^<!-- end course only -->\n?", re.M | re.S)
+"""A part of a student page about a clone of the course, left out of the release."""
 _ROLE = re.compile(r"\{[a-z]+(?::[a-z]+)*\}(`[^`]+`)")
 _LINK = re.compile(r"(!?)\[([^\]]*)\]\(([^)\s]+)\)")
 
@@ -41,7 +45,7 @@ def write(course: Path, release: Path) -> list[Path]:
     names = {page.name for page in pages}
     written = []
     for page in pages:
-        text = _TOCTREE.sub("", page.read_text(encoding="utf-8"))
+        text = _TOCTREE.sub("", COURSE_ONLY.sub("", page.read_text(encoding="utf-8")))
         text = _ROLE.sub(r"\1", text)
         text = _LINK.sub(partial(_link, page=page, out=out, names=names, written=written), text)
         target = out / page.name

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import argparse
 import importlib.util
 import re
 import shutil
 import sys
+import textwrap
+import time
 from pathlib import Path
 
 import pytest
@@ -92,10 +95,82 @@ def test_an_endless_loop_is_stopped_and_named(capsys, tmp_path):
     shutil.copy(SOLUTIONS / "task1.py", tmp_path / "task1.py")
     with (tmp_path / "task1.py").open("a") as handle:
         handle.write("\ndef particle_count(n=N):\n    while True:\n        pass\n")
+    line = len((tmp_path / "task1.py").read_text().splitlines()) - 1
     assert main(["check", "1", "--impl", str(tmp_path), "--call-timeout", "0.5"]) == 1
     out = " ".join(capsys.readouterr().out.split())  # as wrapped to any terminal's width
     assert "task1.py: particle_count did not return within 0.5 s (check particle_count)" in out
+    assert f"stopped in {tmp_path.name}/task1.py, line {line}, in particle_count" in out
     assert "total: 8/9 points" in out  # the other checks do not wait for it
+
+
+def endless(tmp_path: Path, where: str) -> Path:
+    """Task 2's answer with an endless loop at the top level of the file, or at the start of
+    ``where`` (a function every check of task 2 calls); its line is the file's 'while'."""
+    text = (SOLUTIONS / "task2.py").read_text()
+    loop = "while len(str(N)) > 0:\n    N = N + 0\n"
+    if where == "<module>":
+        text = text.replace("\nDT = ", f"\n{loop}DT = ", 1)
+    else:
+        head = text.index(f"def {where}(")
+        body = text.index('"""\n', text.index('"""', head) + 3) + 4
+        text = (
+            text[:body]
+            + "    n = 1\n"
+            + textwrap.indent(loop.replace("N", "n"), "    ")
+            + text[body:]
+        )
+    (tmp_path / "task2.py").write_text(text)
+    return tmp_path / "task2.py"
+
+
+@pytest.mark.parametrize(
+    ("where", "said"), [("<module>", "at the top level of the file"),
+                        ("spring_acceleration", "in spring_acceleration")]
+)  # fmt: skip
+def test_a_loop_every_check_meets_is_stopped_once_where_it_was(capsys, tmp_path, where, said):
+    """A loop at the top level of a task file, or in a function every check calls, costs one
+    time limit, not one a check, and is named once, by its file, line and function."""
+    path = endless(tmp_path, where)
+    line = (
+        path.read_text()
+        .splitlines()
+        .index(next(x for x in path.read_text().splitlines() if "while len(str(" in x))
+        + 1
+    )
+    started = time.monotonic()
+    assert main(["check", "2", "--impl", str(tmp_path), "--call-timeout", "1"]) == 1
+    assert time.monotonic() - started < 30  # six checks, one limit: not 6 x 1 s of waiting
+    out = " ".join(capsys.readouterr().out.split())
+    assert out.count(f"{tmp_path.name}/task2.py, line {line}, {said}") == 1
+    assert out.count("while len(str(") == 1
+    assert out.count("did not return within") + out.count("was still being imported") == (
+        1 if where == "<module>" else 2  # the message, then once for the later checks
+    )
+
+
+def test_the_processor_budget_stops_a_function_that_is_only_slow(capsys, tmp_path):
+    """Calls each within the per-call limit that add up to more than a function's processor
+    time in its task's checks: the check running then fails naming where the code was, its
+    later calls are stopped at once, and another task's checks are not charged for them."""
+    path = endless(tmp_path, "spring_acceleration")
+    path.write_text(path.read_text().replace("while len(str(n)) > 0:", "while n < 2_000_000:"))
+    path.write_text(path.read_text().replace("n = n + 0", "n = n + 1"))
+    shutil.copy(SOLUTIONS / "task1.py", tmp_path / "task1.py")
+    code = main(["check", "--impl", str(tmp_path), "--task-timeout", "0.2", "--call-timeout", "9"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert code == 1 and "task1 steps_to_floor_as_template 2/2 pass" in out  # not charged
+    used_up = "task2.py: spring_acceleration used up the 0.2 s of processor time it may take"
+    assert out.count(used_up) == 1
+    assert f"{tmp_path.name}/task2.py, line " in out and ", in spring_acceleration" in out
+    assert "had used up its processor time in task 2's checks in check " in out
+
+
+def test_the_checks_say_what_runs_while_they_run(capsys):
+    """Never silent: a line as each task's checks start (on a terminal, one line names each
+    check as it runs)."""
+    assert main(["check", "1", "--impl", str(SOLUTIONS)]) == 0
+    out = capsys.readouterr().out
+    assert out.index("  task 1...") < out.index("total: 9/9 points")
 
 
 def test_a_syntax_error_is_reported_once(capsys, tmp_path):
@@ -113,16 +188,30 @@ def test_missing_test_tools_name_the_install_command(capsys, monkeypatch):
     assert "[grade]" in out
 
 
-def test_without_hidden_files_hidden_says_so_and_the_manifest_counts_them(capsys, tmp_path):
+def test_without_hidden_files_hidden_is_refused_and_the_manifest_counts_them(capsys, tmp_path):
+    """A release has no hidden checks: --hidden would do nothing there, so it is refused
+    with why; the last line still says what the hidden checks are worth."""
     checks = tmp_path / "checks"
     checks.mkdir()
     for name in ("conftest.py", "test_task1.py"):
         shutil.copy(CHECKS / name, checks)
     manifest.write(checks / manifest.FILE_NAME, [(1, 9, False), (1, 5, True), (2, 7, True)])
-    assert main(["check", "1", "--hidden", "--checks", str(checks), "--impl", "solutions"]) == 0
-    out = capsys.readouterr().out
-    assert "The hidden checks are not in this copy of the course" in out
-    assert "public 9 of 9 points; hidden checks worth 5 more run when graded" in out
+    assert main(["check", "1", "--hidden", "--checks", str(checks), "--impl", "solutions"]) == 2
+    assert "the hidden checks are not in this copy of the course" in capsys.readouterr().out
+    assert main(["check", "1", "--checks", str(checks), "--impl", "solutions"]) == 0
+    assert "public 9 of 9 points; hidden checks worth 5 more run when graded" in (
+        capsys.readouterr().out
+    )
+
+
+def test_a_release_does_not_offer_hidden(monkeypatch):
+    """Where msdlab's checks folder holds no hidden checks (a student's release), ``msdlab
+    check --help`` does not list --hidden."""
+    monkeypatch.setattr(check, "has_hidden_checks", lambda folder: False)
+    parser = argparse.ArgumentParser(prog="msdlab")
+    check.register(parser.add_subparsers())
+    helped = parser._subparsers._group_actions[0].choices["check"].format_help()
+    assert "--task-timeout" in helped and "--hidden" not in helped
 
 
 def test_default_is_the_students_assignments_folder(capsys, tmp_path, monkeypatch):

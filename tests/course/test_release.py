@@ -9,6 +9,7 @@ import shutil
 import site
 import subprocess
 import sys
+import zipfile
 from pathlib import Path
 
 import pytest
@@ -117,10 +118,19 @@ def test_the_bundles_quick_start_works(bundle, tmp_path):
     hidden = subprocess.run(
         [scripts / "msdlab", "check", "1", "--hidden"], cwd=bundle, capture_output=True, text=True
     )
-    assert "hidden checks are not in this copy" in hidden.stdout and "(hidden)" not in hidden.stdout
+    assert hidden.returncode == 2 and "hidden checks are not in this copy" in hidden.stdout
+    helped = subprocess.run([scripts / "msdlab", "check", "--help"], capture_output=True, text=True)
+    assert "--task-timeout" in helped.stdout and "--hidden" not in helped.stdout
     usage = subprocess.run([scripts / "msdlab", "--help"], capture_output=True, text=True)
     listed = re.findall(r"^    (\w+)", usage.stdout, flags=re.MULTILINE)
-    assert listed == ["demo", "scenes", "run", "check"], usage.stdout
+    assert listed == ["demo", "scenes", "run", "check", "handin"], usage.stdout
+    handin = subprocess.run(
+        [scripts / "msdlab", "handin"], cwd=bundle, capture_output=True, text=True
+    )
+    assert handin.returncode == 0 and "parts still the template's" in handin.stdout, handin.stderr
+    with zipfile.ZipFile(bundle / "handin.zip") as archive:
+        assert sorted(archive.namelist()) == [f"assignments/task{n}.py" for n in range(1, 6)]
+    (bundle / "handin.zip").unlink()
 
 
 def test_bundle_readme_and_gitignore(bundle):
@@ -150,3 +160,60 @@ def test_the_bundle_carries_the_brief_and_the_student_pages_linked_from_its_read
             if path and not re.match(r"[a-z]+:", path):
                 assert (page.parent / path).is_file(), f"{page.name} links to {target}"
     assert "docs/brief.md" in readme and "docs/index.md" in readme
+
+
+PLACEHOLDERS = {"N": "2", "DIR": "assignments", "S": "10", "SCENE": "jelly-cube", "NAME": "*"}
+"""What a page's placeholder stands for, to try its command or find its path."""
+MADE_LATER = {
+    "msdlab-output/": "msdlab demo writes it",
+    ".venv/": "the quick start's first line makes it",
+    "assignments/student.json": "a release with its own numbers holds it",
+}
+"""Paths a release page names that the student's own commands make, not the release."""
+CODE = re.compile(r"(?<!`)`([^`\n]+)`(?!`)")
+BLOCK = re.compile(r"^```(?:bash|console|sh|shell)\n(.*?)^```", re.M | re.S)
+PATH = re.compile(r"^[\w.-]+/[\w./*-]*$")
+
+
+def named_in(text: str) -> list[str]:
+    """The inline code and the shell lines of a page, placeholders filled in."""
+    lines = [line.split(" # ")[0].strip() for block in BLOCK.findall(text)
+             for line in block.splitlines()]  # fmt: skip
+    named = [*CODE.findall(text), *(line for line in lines if line)]
+    return [" ".join(PLACEHOLDERS.get(word, word) for word in item.split()) for item in named]
+
+
+def not_in_release(command: str, bundle: Path, parser) -> str:
+    """Why ``command`` (or path) named by a release page does not work there; '' if it does."""
+    words = command.split()
+    if words[0] == "msdlab":
+        try:
+            parser.parse_args(words[1:])
+        except SystemExit as done:  # --help exits 0
+            return f"msdlab does not take `{command}`" if done.code else ""
+    elif words[0] in ("python", "python3") and words[1].endswith(".py"):
+        return "" if (bundle / words[1]).is_file() else f"`{command}`: no {words[1]} there"
+    elif PATH.match(command) and command not in MADE_LATER:
+        return "" if list(bundle.glob(command.rstrip("/"))) else f"`{command}` is not there"
+    return ""
+
+
+def test_every_command_and_path_a_release_page_names_is_in_the_release(bundle):
+    """The release's README and pages name only what the release has: each msdlab command
+    is one its msdlab takes (--hidden, which has nothing to run there, is not offered),
+    each script and path is a file of the release, from the folder the pages say to stand
+    in (the release's)."""
+    from msdlab.cli import build_parser
+    from msdlab.commands import STUDENT_COMMANDS
+
+    parser = build_parser(STUDENT_COMMANDS)
+    wrong = []
+    for page in [bundle / "README.md", *sorted((bundle / "docs").glob("*.md"))]:
+        text = page.read_text(encoding="utf-8")
+        if "--hidden" in text or "notebooks/src" in text or "build.py" in text:
+            wrong.append(f"{page.name}: names what only a clone of the course has")
+        commands = [command for item in named_in(text) for command in item.split(" && ")]
+        wrong += [
+            f"{page.name}: {why}" for c in commands if (why := not_in_release(c, bundle, parser))
+        ]
+    assert not wrong, "\n".join(wrong)
