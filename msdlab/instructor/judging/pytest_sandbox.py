@@ -43,8 +43,9 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         type=float,
         default=None,
         metavar="S",
-        help="with --sandbox: seconds the implementation may take for one task, all the calls "
-        "of its checks together; once used up, its further calls fail at once (default: none)",
+        help="with --sandbox: processor seconds each function of the implementation may take "
+        "in one task's checks, all its calls together; once used up, its further calls there "
+        "fail at once (default: none)",
     )
     group.addoption(
         "--sandbox-memory",

@@ -304,7 +304,7 @@ class SandboxProcess:
             raise ValueError(f"isolation must be one of {ISOLATION_LEVELS}, not {isolation!r}")
         self.folder = Path(folder).resolve()
         self.timeout = timeout
-        self.task_timeout = task_timeout  # seconds for all calls of one task's checks
+        self.task_timeout = task_timeout  # processor seconds of a function in one task's checks
         self.task: int | None = None  # the task of the check running now
         self.spent: dict[tuple[int, str], float] = {}  # processor seconds by task and function
         self.used = 0.0  # processor seconds of the processes closed so far
