@@ -204,26 +204,6 @@ def test_a_sandbox_killed_from_outside_is_graded_again_and_not_blamed(tmp_path, 
     assert "15 of 15 points" in text and "killed" not in text and "crash" not in text
 
 
-def test_a_submission_that_kills_its_own_process_is_graded_once_and_told(tmp_path, checks):
-    """SIGKILL raised by the submission's own code looks like an outside kill of its process,
-    but it is the submission's doing: a row with its points, graded once, feedback written."""
-    kills = student(tmp_path / "class", "kills", extra="""
-        import signal
-
-        def particle_count(n: int = N) -> int:
-            signal.raise_signal(signal.SIGKILL)
-    """)  # fmt: skip
-    out, notes = tmp_path / "grades.csv", tmp_path / "feedback"
-    status = main(["grade", str(kills), "--out", str(out), "--checks", str(checks),
-                   "--feedback", str(notes), "--jobs", "1"])  # fmt: skip
-    assert status == 0
-    row = rows_of(out)["kills"]
-    assert 0 < int(row["total"]) < 15 and "grader" not in row["notes"]
-    (record,) = gradebook_db.read_class(out)
-    assert record.attempts == 1 and record.status == "graded"
-    assert "ended by the signal SIGKILL" in (notes / "students" / "kills.md").read_text()
-
-
 def test_sigterm_ends_the_run_as_ctrl_c_does(tmp_path, checks):
     """Every judge and sandbox ended, no temporary folder left, the run closed in the
     gradebook, exit status 143."""

@@ -14,9 +14,13 @@ submission's task files, the Python environment read-only, its own ``/proc``
 and a private, size-limited ``/tmp``; as root it runs as a reserved user id
 without capabilities. Everything it starts dies with it. ``process`` is the
 weaker level an instructor must ask for: a plain child process as the
-grader's user. Both add resource limits (CPU time, memory, processes, file
-size), a per-call time limit after which the process is killed and restarted,
-and an audit hook whose only job is friendly messages, not the boundary.
+grader's user. Both add resource limits (CPU time, memory, file size, and no
+process or thread started once the engine has loaded), a processor-time budget
+per function of a task and a per-call limit of the call's own time (`CallClock`)
+after which the process is killed and restarted, and an audit hook whose only
+job is friendly messages, not the boundary. Whatever the submission's process
+does to itself is the submission's outcome; only evidence it cannot produce
+(`INFRASTRUCTURE_FAILURES`) is the grader's.
 """
 
 from __future__ import annotations
