@@ -15,7 +15,7 @@ import pytest
 
 from msdlab.cli import main
 from msdlab.course import PROJECT_ROOT
-from msdlab.instructor.judging import grading, sandbox
+from msdlab.instructor.judging import grading, processes, sandbox
 from msdlab.instructor.judging.judges import ForkedJudges
 from msdlab.instructor.points import gradebook_db
 
@@ -244,10 +244,13 @@ def test_grade_command_writes_rows_feedback_and_exit_status(tmp_path, capsys):
     assert "[1/1]" in output.err and "graded 1 of 2" in output.out
 
 
-@pytest.mark.parametrize("busy", [False, True], ids=["quiet machine", "overloaded machine"])
-def test_a_submission_that_outlasts_its_time_limit_still_gets_a_row(tmp_path, monkeypatch, busy):
-    """On a quiet machine the student's; on an overloaded one the grader's, graded again."""
-    monkeypatch.setattr(grading, "overloaded", lambda: busy)
+@pytest.mark.parametrize("starved", [False, True], ids=["given a processor", "starved"])
+def test_a_submission_that_outlasts_its_time_limit_still_gets_a_row(tmp_path, monkeypatch, starved):
+    """The student's where its processes were given a processor; the grader's, graded again,
+    where they waited for one at least half the time (the judge's scheduling figures)."""
+    waited = processes.waited_for_processor
+    monkeypatch.setattr(processes, "waited_for_processor", lambda pids: 60.0 if starved else
+                        waited(pids))  # fmt: skip
     slow = submission(tmp_path, "slow", task1="import time\ntime.sleep(60)\n")
     checks = tmp_path / "checks"
     checks.mkdir()
@@ -256,10 +259,11 @@ def test_a_submission_that_outlasts_its_time_limit_still_gets_a_row(tmp_path, mo
     status = main(["grade", str(slow), "--out", str(out), "--checks", str(checks), "--timeout", "8",
                    "--call-timeout", "30", "--retries", "1"])  # fmt: skip
     row = {row["id"]: row for row in csv.DictReader(out.open())}["slow"]
-    assert row["total"] == "0" and "timed out after 8 s" in row["notes"]
-    assert status == (2 if busy else 1)
-    assert ("grader error" in row["notes"]) == busy
-    assert gradebook_db.read_class(out)[0].attempts == (2 if busy else 1)
+    assert row["total"] == "0"
+    assert status == (2 if starved else 1)
+    assert ("grader error" in row["notes"]) == starved
+    assert ("timed out after 8 s" if not starved else "waited for a processor") in row["notes"]
+    assert gradebook_db.read_class(out)[0].attempts == (2 if starved else 1)
 
 
 @pytest.mark.skipif(os.geteuid() != 0, reason="sandbox user ids are used only when grading as root")

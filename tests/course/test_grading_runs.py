@@ -8,6 +8,7 @@ import csv
 import os
 import shutil
 import signal
+import sqlite3
 import subprocess
 import sys
 import textwrap
@@ -166,7 +167,16 @@ def _command_line(pid: int) -> str:
         return ""
 
 
+def _parent(pid: int) -> int:
+    try:
+        return int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
+    except (OSError, ValueError, IndexError):
+        return 0
+
+
 def test_a_sandbox_killed_from_outside_is_graded_again_and_not_blamed(tmp_path, checks):
+    """bubblewrap itself, outside the submission's namespaces, killed: evidence the
+    submission cannot produce (it can end its own process, which is its crash)."""
     heidi = student(tmp_path / "class", "heidi")
     out, notes = tmp_path / "grades.csv", tmp_path / "feedback"
     killed = threading.Event()
@@ -175,7 +185,8 @@ def test_a_sandbox_killed_from_outside_is_graded_again_and_not_blamed(tmp_path, 
         while not killed.is_set():
             for pid in processes.descendants(os.getpid()):
                 line = _command_line(pid)
-                if "sandbox_child.py" in line and "bwrap" not in line:
+                outer = not _command_line(_parent(pid)).startswith("bwrap")
+                if "sandbox_child.py" in line and line.startswith("bwrap") and outer:
                     os.kill(pid, signal.SIGKILL)  # as another run or the OOM killer would
                     killed.set()
             time.sleep(0.05)
@@ -191,3 +202,32 @@ def test_a_sandbox_killed_from_outside_is_graded_again_and_not_blamed(tmp_path, 
     assert record.attempts == 2 and record.status == "graded"
     text = (notes / "students" / "heidi.md").read_text()
     assert "15 of 15 points" in text and "killed" not in text and "crash" not in text
+
+
+def test_sigterm_ends_the_run_as_ctrl_c_does(tmp_path, checks):
+    """Every judge and sandbox ended, no temporary folder left, the run closed in the
+    gradebook, exit status 143."""
+    student(tmp_path / "class", "loop", extra=ENDLESS)
+    student(tmp_path / "class", "heidi")
+    out = tmp_path / "out" / "grades.csv"
+    (tmp_path / "tmp").mkdir()
+    environment = dict(os.environ, TMPDIR=str(tmp_path / "tmp"))
+    folders = [str(tmp_path / "class" / name) for name in ("loop", "heidi")]
+    command = [*grade_command(out, checks, *folders), "--task-timeout", "600"]
+    process = subprocess.Popen(command, env=environment, text=True, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, start_new_session=True)  # fmt: skip
+    try:
+        deadline = time.monotonic() + 300
+        while graded_count(out) == 0 and process.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.5)
+        os.kill(process.pid, signal.SIGTERM)  # to the run alone, as a scheduler sends it
+        _, errors = process.communicate(timeout=120)
+    finally:
+        if process.poll() is None:
+            processes.kill_tree(process.pid)
+    assert process.returncode == 143, errors
+    assert "interrupted: 1 of 2 submissions" in errors and "Traceback" not in errors
+    assert not any(str(tmp_path) in _command_line(p) for p in processes.descendants(1)[1:])
+    assert [path for path in (tmp_path / "tmp").iterdir() if path.is_dir()] == []
+    with sqlite3.connect(gradebook_db.beside(out)) as connection:
+        assert connection.execute("SELECT outcome FROM runs").fetchall() == [("interrupted",)]

@@ -59,20 +59,22 @@ def judge(server: ForkedJudges, folder: Path, timeout: float = 120.0, **settings
 def test_every_judge_starts_from_the_servers_state(server, tmp_path):
     for name in ("first", "second"):
         (tmp_path / name).mkdir()
-        status, errors = judge(server, tmp_path / name)
-        assert status == 0, errors
+        judged = judge(server, tmp_path / name)
+        assert judged.status == 0, judged.printed
 
 
 def test_a_judge_over_its_time_limit_is_killed_and_the_next_one_runs(server, tmp_path):
     (tmp_path / "slow").mkdir()
-    assert judge(server, tmp_path / "slow", timeout=3.0, SLEEP="1")[0] is None
+    slow = judge(server, tmp_path / "slow", timeout=3.0, SLEEP="1")
+    assert slow.status is None and slow.remains is not None
+    assert slow.remains.judge > 0 and 0 <= slow.remains.waited < 60  # read before its end
     (tmp_path / "next").mkdir()
-    assert judge(server, tmp_path / "next")[0] == 0
+    assert judge(server, tmp_path / "next").status == 0
 
 
 def test_a_dead_server_is_started_again(server, tmp_path):
     (tmp_path / "first").mkdir()
-    assert judge(server, tmp_path / "first")[0] == 0
+    assert judge(server, tmp_path / "first").status == 0
     pid = forkserver._forkserver._forkserver_pid
     os.kill(pid, signal.SIGKILL)
     deadline = time.monotonic() + 30
@@ -80,7 +82,7 @@ def test_a_dead_server_is_started_again(server, tmp_path):
         assert time.monotonic() < deadline
         time.sleep(0.05)
     (tmp_path / "second").mkdir()
-    assert judge(server, tmp_path / "second")[0] == 0
+    assert judge(server, tmp_path / "second").status == 0
 
 
 FORKED_UNDER_A_DEEP_TMPDIR = """
@@ -94,8 +96,8 @@ if __name__ == "__main__":
     folder = Path(sys.argv[1])
     assert len(tempfile.gettempdir()) > 80, tempfile.gettempdir()
     arguments = ["-q", "-p", "no:cacheprovider", "--rootdir", str(folder), str(folder)]
-    status, printed = ForkedJudges().run(arguments, folder, runner.environment(), 120.0)
-    assert status == 0, printed
+    judged = ForkedJudges().run(arguments, folder, runner.environment(), 120.0)
+    assert judged.status == 0, judged.printed
     print(forkserver._forkserver._forkserver_pid)
 """
 
@@ -123,7 +125,7 @@ def test_without_a_server_each_judge_starts_afresh_and_the_grader_says_so_once(t
     arguments = ["-q", "-p", "no:cacheprovider", "--rootdir", str(tmp_path), str(tmp_path)]
     server = NoServer()
     for _ in range(2):
-        status, _ = grading._judge(arguments, tmp_path, runner.environment(), 120.0, server)
+        status = grading._judge(arguments, tmp_path, runner.environment(), 120.0, server).status
         assert status == 0
     said = capsys.readouterr().err.splitlines()
     assert said == [

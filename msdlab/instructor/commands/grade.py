@@ -13,7 +13,7 @@ set gets. Every submission is graded in
 its own workspace by a fresh process running the instructor's checks (hidden
 ones included); the submission's code runs in a sandbox and can only answer
 with data, under a time and memory limit (--task-timeout: processor seconds per
-task, all its calls together). Each result is committed to the gradebook
+function of a task, all its calls together). Each result is committed to the gradebook
 GRADES.db beside the CSV as soon as it is graded; the CSV (id, source, task1 ...
 task5, points, the late work columns, total, notes; per check with --detail; the
 first row holds the maximum points), the feedback (--feedback DIR: DIR/students/ID.md
@@ -26,14 +26,17 @@ beside the CSV
 options and files are checked whole before anything is graded: every mistake is
 named with its line and the fix. A submission graded again
 gets its row replaced; --resume grades only those not yet graded with the same checks
-and files, and those the grader failed on. Ctrl-C stops the run at once, keeping what
-was graded. A failure of the grader or the machine (a sandbox killed from outside, a
-call out of time on an overloaded machine) is graded again (--retries), never blamed
-on the student. Exit status 0 if every submission was graded, 1 if some could not be
-(their notes say why), 2 if the grader itself failed (named in the notes: no student
-feedback file is written for those submissions; run again with --resume), 130 if
-interrupted. With --cluster ADDRESS the submissions are graded by a Dask
-scheduler's workers (msdlab[cluster]).
+and files, and those the grader failed on. Ctrl-C or SIGTERM stops the run at once,
+keeping what was graded. A failure of the grader or the machine, on evidence the
+submission cannot produce (a sandbox ended from outside its namespaces, a sandbox or
+judge kept waiting for a processor), is graded again (--retries), never blamed on the
+student; whatever the submission's own process does (exits, ends itself by a signal,
+sleeps, loops) is its own outcome. The summary gives the run's processor time (grader,
+judges, sandboxes) and the rows graded more than once. Exit status 0 if every submission
+was graded, 1 if some could not be (their notes say why), 2 if the grader itself failed
+(named in the notes: no student feedback file is written for those submissions; run
+again with --resume), 130 if interrupted (143 by SIGTERM). With --cluster ADDRESS the
+submissions are graded by a Dask scheduler's workers (msdlab[cluster]).
 """
 
 from __future__ import annotations
@@ -99,15 +102,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--task-timeout",
         type=float,
         default=60.0,
-        help="processor seconds a submission's code may take for one task, all its calls "
-        "together: an endless loop costs this once, however busy the machine (%(default)s)",
+        help="processor seconds a submission's code may take for each function in one task's "
+        "checks, all its calls together: an endless loop costs this once, however busy the "
+        "machine, and the task's other functions keep their own (%(default)s)",
     )
     parser.add_argument(
         "--call-timeout",
         type=float,
         default=300.0,
-        help="wall-clock seconds one call into it may take; reached on an overloaded machine, "
-        "the grader's failure, graded again (%(default)s)",
+        help="seconds of its own one call into it may take: wall-clock time, less the time its "
+        "sandbox waited for a processor or for the judge; the same at any load (%(default)s)",
     )
     parser.add_argument(
         "--retries",
@@ -173,19 +177,31 @@ def run(args: argparse.Namespace) -> int:
     if args.similarity:
         similarity.require_copydetect()
     connection = open_gradebook(args.out)
+    before = signal.signal(signal.SIGTERM, _terminate)
     try:
         session = Session(args, connection, checked_terms(args, connection))
         run_number = gradebook_db.start_run(connection, ["msdlab", *sys.argv[1:]])
         try:
             return session.grade(run_number)
-        except KeyboardInterrupt:
-            signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second Ctrl-C: the views get out
+        except KeyboardInterrupt as stop:
+            for number in (signal.SIGINT, signal.SIGTERM):  # a second one: the views get out
+                signal.signal(number, signal.SIG_IGN)
             gradebook_db.end_run(connection, run_number, "interrupted")
             session.render()
             print(session.interrupted(), file=sys.stderr)
-            return 130
+            return 128 + (signal.SIGTERM if isinstance(stop, Terminated) else signal.SIGINT)
     finally:
+        signal.signal(signal.SIGTERM, before)
         connection.close()
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM arrived: the run ends as at Ctrl-C (every judge and sandbox ended, the
+    temporary folders removed, the run closed in the gradebook), with exit status 143."""
+
+
+def _terminate(signum: int, frame: object) -> None:
+    raise Terminated
 
 
 def checked_terms(args: argparse.Namespace, connection: sqlite3.Connection) -> final_points.Terms:
@@ -364,8 +380,9 @@ class Session:
             result = f"{grade.total}/{grade.report.points} points"
         else:
             result = "NOT GRADED: " + "; ".join(grade.notes)
+        attempts = f", {grade.attempts} attempts" if grade.attempts > 1 else ""
         tqdm.write(f"[{done:>{len(str(count))}}/{count}] {grade.submission:<{width}}  "
-                   f"{result}  ({grade.seconds:.1f} s)", file=sys.stderr)  # fmt: skip
+                   f"{result}  ({grade.seconds:.1f} s{attempts})", file=sys.stderr)  # fmt: skip
 
     def _hint(self, grade: grading.Grade) -> str | None:
         """With own numbers, for the instructor only: whose task 1 constants a graded
@@ -420,7 +437,7 @@ class Session:
         args = self.args
         known = gradebook_db.statuses(self.connection)
         term_options.report(self.terms, args.out)
-        print(grading.summary(grades, seconds))
+        print(grading.summary(grades, seconds, grading.grader_seconds()))
         if args.isolation != "namespace":
             print(f"isolation: {args.isolation} (weaker than namespace; submissions were not "
                   "isolated by the operating system)")  # fmt: skip

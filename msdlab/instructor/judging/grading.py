@@ -14,8 +14,10 @@ import collections
 import contextlib
 import fcntl
 import itertools
+import json
 import os
 import queue
+import resource
 import shutil
 import signal
 import stat
@@ -33,9 +35,9 @@ from ...course import TASKS, reference_cache, runner
 from ...course.report import CheckReport
 from ...course.runner import CheckRun
 from ..intake import MAX_FILE_BYTES
-from . import processes
-from .judges import ForkedJudges
-from .sandbox import INFRASTRUCTURE_FAILURES, overloaded
+from . import judges, processes
+from .judges import TIMES, ForkedJudges
+from .sandbox import INFRASTRUCTURE_FAILURES
 
 FIRST_UID = 61000  # as root, sandboxes run as reserved user ids from here on
 RETRY_PAUSE = 2.0  # seconds before grading again after the grader's failure, times the attempt
@@ -58,8 +60,10 @@ class Grade:
     submission: str
     report: CheckReport | None
     notes: list[str] = field(default_factory=list)
-    seconds: float = 0.0
+    seconds: float = 0.0  # wall-clock seconds, every attempt's
     attempts: int = 1
+    processor: dict[str, float] = field(default_factory=dict)
+    """Processor seconds by part ("judges", "sandboxes"), every attempt's."""
 
     @property
     def graded(self) -> bool:
@@ -168,29 +172,53 @@ def grade(
             environment["MSDLAB_SANDBOX_UID"] = str(uid)
         if references is not None:
             environment[reference_cache.ENV] = str(references)
-        status, printed = _judge(run.arguments(), workspace, environment, timeout, server)
+        environment[TIMES] = str(workspace / "judge-times.json")
+        judged = _judge(run.arguments(), workspace, environment, timeout, server)
         if uid is not None:
             _kill_user(uid)
-        report = _read_report(report_path) if status in (0, 1) else None
-        failure = _infrastructure_failure(report)
-        if failure is not None:  # the machine's failure, not the submission's
-            report = None
-            notes.append(GRADER_ERROR + failure)
-        elif report is not None:
-            notes += _problems(report)
-        elif status is None and overloaded():
-            notes.append(f"{GRADER_ERROR}grading timed out after {timeout:g} s on an overloaded "
-                         "machine")  # fmt: skip
-        elif status is None:
-            notes.append(f"grading timed out after {timeout:g} s")
-        else:
-            notes.append(GRADER_ERROR + _judge_failure(status, printed))
-        return Grade(submission.name, report, notes, time.monotonic() - started)
+        report = _read_report(report_path) if judged.status in (0, 1) else None
+        notes += _outcome_notes(report, judged, timeout)
+        if any(note.startswith(GRADER_ERROR) for note in notes):
+            report = None  # the machine's failure, not the submission's
+        return Grade(submission.name, report, notes, time.monotonic() - started,
+                     processor=_processor_times(workspace, judged))  # fmt: skip
     except Exception as error:  # never lose a row: the reason goes to its notes
         note = f"{GRADER_ERROR}{type(error).__name__}: {error}"
         return Grade(submission.name, None, [note], time.monotonic() - started)
     finally:
         shutil.rmtree(workspace, ignore_errors=True)
+
+
+def _outcome_notes(
+    report: CheckReport | None, judged: processes.Judged, timeout: float
+) -> list[str]:
+    """The notes of a judge's outcome: the report's problems; or why there is none, blamed on
+    the grader only on evidence the submission cannot produce (a sandbox ended from outside
+    or kept from a processor, a judge that failed or was kept from a processor)."""
+    failure = _infrastructure_failure(report)
+    if failure is not None:
+        return [GRADER_ERROR + failure]
+    if report is not None:
+        return _problems(report)
+    left = judged.remains
+    if left is not None and left.waited >= timeout / 2:
+        return [f"{GRADER_ERROR}grading ran out of its {timeout:g} s, for {left.waited:.0f} s "
+                "of which its processes were ready to run and waited for a processor"]  # fmt: skip
+    if judged.status is None:
+        return [f"grading timed out after {timeout:g} s"]
+    return [GRADER_ERROR + _judge_failure(judged.status, judged.printed)]
+
+
+def _processor_times(workspace: Path, judged: processes.Judged) -> dict[str, float]:
+    """Processor seconds of the judge and its sandboxes: as the judge wrote them at its end,
+    or as read before it was ended after its time ({} if neither)."""
+    if judged.remains is not None:
+        return {"judges": judged.remains.judge, "sandboxes": judged.remains.sandboxes}
+    try:
+        times = json.loads((workspace / "judge-times.json").read_text())
+        return {"judges": float(times["judge"]), "sandboxes": float(times["sandboxes"])}
+    except (OSError, ValueError, KeyError, TypeError):
+        return {}
 
 
 def grade_all(
@@ -218,15 +246,18 @@ def grade_all(
 
     def one(submission: Submission) -> Grade:
         uid = slots.get()
+        started, processor = time.monotonic(), collections.Counter()
         try:
             for attempt in range(1, retries + 2):
                 outcome = grade(submission, checks, uid=uid, isolation=isolation,
                                 allow_delegation=allow_delegation, references=references,
                                 server=server, **limits)  # fmt: skip
-                outcome.attempts = attempt
+                processor.update(outcome.processor)
                 if not outcome.grader_failed or running.stopped:
                     break
                 time.sleep(RETRY_PAUSE * attempt)  # let a passing overload pass
+            outcome.attempts, outcome.processor = attempt, dict(processor)
+            outcome.seconds = time.monotonic() - started  # every attempt's
             return outcome
         finally:
             slots.put(uid)
@@ -352,8 +383,30 @@ def _lock_all(paths: list[Path]) -> list[int] | None:
     return handles
 
 
-def summary(grades: Sequence[Grade], seconds: float) -> str:
-    """Count, mean points per task, and failures by reason."""
+def grader_seconds() -> float:
+    """Processor seconds of this process (the grader) and of its judges' server itself."""
+    used = resource.getrusage(resource.RUSAGE_SELF)
+    return used.ru_utime + used.ru_stime + judges.server_seconds()
+
+
+def machine_time(grades: Sequence[Grade], grader: float) -> list[str]:
+    """The run's processor time by part and the rows graded more than once."""
+    parts = collections.Counter({"grader": grader})
+    for grade in grades:
+        parts.update(grade.processor)
+    shares = ", ".join(f"{part} {parts[part]:.1f} s" for part in ("grader", "judges", "sandboxes"))
+    lines = [f"machine time: {sum(parts.values()):.1f} s of processor time ({shares})"]
+    again = [grade for grade in grades if grade.attempts > 1]
+    if again:
+        attempts = sum(grade.attempts for grade in again)
+        lines.append(f"graded more than once: {len(again)} row{'s' * (len(again) > 1)} "
+                     f"({attempts} attempts)")  # fmt: skip
+    return lines
+
+
+def summary(grades: Sequence[Grade], seconds: float, grader: float | None = None) -> str:
+    """Count, mean points per task, failures by reason, and (given the ``grader``'s processor
+    seconds) the run's machine time."""
     graded = [g for g in grades if g.graded]
     plural = "" if len(grades) == 1 else "s"
     lines = [f"graded {len(graded)} of {len(grades)} submission{plural} in {seconds:.0f} s"]
@@ -368,6 +421,8 @@ def summary(grades: Sequence[Grade], seconds: float) -> str:
     reasons = collections.Counter(r for g in grades for r in {_reason(n) for n in g.notes})
     if reasons:
         lines.append("problems: " + ", ".join(f"{r} ×{n}" for r, n in reasons.most_common()))
+    if grader is not None:
+        lines += machine_time(grades, grader)
     return "\n".join(lines)
 
 
@@ -395,9 +450,9 @@ def _judge(
     environment: dict,
     timeout: float,
     server: ForkedJudges | None,
-) -> tuple[int | None, str]:
+) -> processes.Judged:
     """Run the judge, forked from ``server`` or else afresh: its exit status (None: timed
-    out) and what it printed."""
+    out), what it printed, and what it had used if it was ended after its time."""
     if server is not None:
         try:
             return server.run(arguments, workspace, environment, timeout)
@@ -408,9 +463,9 @@ def _judge(
 
 def _run_judge(
     arguments: list[str], workspace: Path, environment: dict, timeout: float
-) -> tuple[int | None, str]:
-    """Run a fresh judge: its exit status (None: timed out) and what it printed. The judge
-    and every process below it are killed at the end."""
+) -> processes.Judged:
+    """Run a fresh judge (see `_judge`). The judge and every process below it are killed at
+    the end."""
     process = subprocess.Popen(
         [sys.executable, "-m", "pytest", *arguments],
         cwd=workspace,
@@ -424,12 +479,13 @@ def _run_judge(
         try:
             printed, _ = process.communicate(timeout=timeout)
         except subprocess.TimeoutExpired:
+            left = processes.remains(process.pid)
             processes.kill_tree(process.pid)
             process.communicate()
-            return None, ""
+            return processes.Judged(None, "", left)
         finally:
             processes.kill_tree(process.pid)  # and anything left behind
-    return process.returncode, printed.decode(errors="replace")
+    return processes.Judged(process.returncode, printed.decode(errors="replace"))
 
 
 def _judge_failure(status: int, printed: str) -> str:
@@ -475,6 +531,7 @@ def _read_report(path: Path) -> CheckReport | None:
 
 _KNOWN = {
     "SubmissionTimeout": "a call timed out (endless loop?)",
+    "SubmissionWaited": "a call timed out, waiting (sleeping or blocked)",
     "SubmissionCrashed": "the submission's process died",
     "MemoryError": "ran out of memory",
     "SyntaxError": "syntax error",

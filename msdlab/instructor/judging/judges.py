@@ -39,6 +39,8 @@ SAFE_PATH = sys.version_info >= (3, 11)  # PYTHONSAFEPATH: no working folder on 
 SOCKET_PATH_BYTES = 107  # a socket file's path, less its closing NUL (Linux's sun_path)
 SOCKET_NAME_BYTES = len("/pymp-12345678/listener-12345678")  # multiprocessing's names in it
 _STARTING = threading.Lock()
+TIMES = "MSDLAB_JUDGE_TIMES"
+"""The environment variable naming the file a judge writes its processor time to."""
 
 
 class ForkedJudges:
@@ -59,8 +61,8 @@ class ForkedJudges:
 
     def run(
         self, arguments: list[str], cwd: Path, environment: dict[str, str], timeout: float
-    ) -> tuple[int | None, str]:
-        """Run pytest with ``arguments`` in a forked judge; its exit status (None if it was
+    ) -> processes.Judged:
+        """Run pytest with ``arguments`` in a forked judge: its exit status (None if it was
         killed after ``timeout`` seconds) and what it printed (stdout and stderr). OSError where no
         server can start whose imports are safe from the working folder."""
         _start_server()
@@ -72,13 +74,21 @@ class ForkedJudges:
         with processes.RUNNING.judge(judge.pid):
             judge.join(timeout)
             status = judge.exitcode
+            left = processes.remains(judge.pid) if status is None else None
             processes.kill_tree(judge.pid)  # over time, and anything left behind
         judge.join()
         judge.close()
         try:
-            return status, output.read_text(errors="replace")
+            return processes.Judged(status, output.read_text(errors="replace"), left)
         except OSError:
-            return status, ""
+            return processes.Judged(status, "", left)
+
+
+def server_seconds() -> float:
+    """Processor seconds the judges' server of this process has used itself (0 if none runs;
+    its judges are counted by each judge)."""
+    pid = getattr(forkserver._forkserver, "_forkserver_pid", None)
+    return processes.cpu_of([pid]) if pid else 0.0
 
 
 def _start_server() -> None:

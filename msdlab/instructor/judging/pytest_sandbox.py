@@ -8,12 +8,15 @@ sandboxed submission returns.
 
 from __future__ import annotations
 
+import json
 import os
+import resource
 from pathlib import Path
 
 import pytest
 
 from ...course import TASKS, loader
+from .judges import TIMES
 from .sandbox import RemoteImplementation
 
 _REMOTE = pytest.StashKey[RemoteImplementation]()
@@ -40,8 +43,9 @@ def pytest_addoption(parser: pytest.Parser) -> None:
         type=float,
         default=None,
         metavar="S",
-        help="with --sandbox: seconds the implementation may take for one task, all the calls "
-        "of its checks together; once used up, its further calls fail at once (default: none)",
+        help="with --sandbox: processor seconds each function of the implementation may take "
+        "in one task's checks, all its calls together; once used up, its further calls there "
+        "fail at once (default: none)",
     )
     group.addoption(
         "--sandbox-memory",
@@ -82,3 +86,18 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
     remote = item.config.stash.get(_REMOTE, None)
     if remote is not None:
         remote.begin_check(task)
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    """Write the processor seconds of this judge and of its sandboxes (all closed by now) to
+    the file the environment's `TIMES` names, if it names one."""
+    path = os.environ.get(TIMES)
+    if not path:
+        return
+    remote = config.stash.get(_REMOTE, None)
+    used = resource.getrusage(resource.RUSAGE_SELF)
+    times = {
+        "judge": used.ru_utime + used.ru_stime,
+        "sandboxes": remote.sandbox.used if remote is not None else 0.0,
+    }
+    Path(path).write_text(json.dumps(times))

@@ -14,9 +14,13 @@ submission's task files, the Python environment read-only, its own ``/proc``
 and a private, size-limited ``/tmp``; as root it runs as a reserved user id
 without capabilities. Everything it starts dies with it. ``process`` is the
 weaker level an instructor must ask for: a plain child process as the
-grader's user. Both add resource limits (CPU time, memory, processes, file
-size), a per-call time limit after which the process is killed and restarted,
-and an audit hook whose only job is friendly messages, not the boundary.
+grader's user. Both add resource limits (CPU time, memory, file size, and no
+process or thread started once the engine has loaded), a processor-time budget
+per function of a task and a per-call limit of the call's own time (`CallClock`)
+after which the process is killed and restarted, and an audit hook whose only
+job is friendly messages, not the boundary. Whatever the submission's process
+does to itself is the submission's outcome; only evidence it cannot produce
+(`INFRASTRUCTURE_FAILURES`) is the grader's.
 """
 
 from __future__ import annotations
@@ -56,8 +60,10 @@ SCRATCH_BYTES = 64 * 2**20  # the private /tmp of one sandbox
 INSIDE_LIBRARY = "/sandbox/lib"  # where the msdlab package is seen inside the sandbox
 INSIDE_FOLDER = "/submission"  # where the submission's task files are seen
 INSIDE_SCRATCH = "/tmp"
-KILLED = (-signal.SIGKILL, 128 + signal.SIGKILL)
-"""The child's exit status when SIGKILL ended it (bubblewrap reports 128 + the signal)."""
+KILLED = -signal.SIGKILL
+"""The exit status of bubblewrap itself killed by SIGKILL: outside the submission's
+namespaces, only something outside the sandbox can send it that (a submission's process
+that ends itself ends bubblewrap with 128 + the signal)."""
 ENABLE_HINT = (
     "install bubblewrap (Debian/Ubuntu: apt-get install bubblewrap) and, when not root, "
     "allow unprivileged user namespaces (sysctl kernel.unprivileged_userns_clone=1 and "
@@ -175,16 +181,28 @@ class SubmissionTimeout(SandboxError):
 
 
 class SandboxLost(SandboxError):
-    """The submission's process was killed from outside (SIGKILL, not by its time limit):
-    the machine's failure, not the submission's."""
+    """The sandbox was ended from outside, on evidence its own code cannot produce (bubblewrap,
+    outside the submission's namespaces, killed): the machine's failure, not the
+    submission's."""
+
+
+class SandboxUnavailable(SandboxError):
+    """The sandbox could not start (before any of the submission's code ran): the grader's
+    failure."""
 
 
 class MachineBusy(SubmissionTimeout):
-    """A call ran out of wall-clock time, short of its processor time, while the machine was
-    overloaded: the machine's failure, not the submission's."""
+    """A call ran long because its sandbox was ready to run and was not given a processor
+    (its own scheduling figures say so): the machine's failure, not the submission's."""
 
 
-INFRASTRUCTURE_FAILURES = frozenset({SandboxLost.__name__, MachineBusy.__name__})
+class SubmissionWaited(SubmissionTimeout):
+    """A call took longer than the time limit while the submission slept or was blocked."""
+
+
+INFRASTRUCTURE_FAILURES = frozenset(
+    {SandboxLost.__name__, SandboxUnavailable.__name__, MachineBusy.__name__}
+)
 """The exceptions a check may end with that are no fault of the submission."""
 
 
@@ -196,32 +214,81 @@ class SubmissionRaised(Exception):
     """The submission raised an exception that is not a Python built-in one."""
 
 
-def overloaded() -> bool:
-    """True if the machine's load average is above its number of processors."""
-    return os.getloadavg()[0] > (os.cpu_count() or 1)
+STARVED_FACTOR = 10.0
+"""A call that has run this many times its time limit, without having had the limit's time
+of its own, is the machine's failure (`MachineBusy`)."""
 
 
 class CallClock:
-    """The processor time one call into the submission is charged against its task's budget
-    (the time the submission's processes use: a busy machine does not eat a student's
-    time, and an endless loop costs the budget however loaded the machine is)."""
+    """The time of one call into the submission, as it is charged.
+
+    Its processor time is charged against the function's budget (the time the submission's
+    processes use: a busy machine does not eat a student's time, and an endless loop costs
+    the budget however loaded the machine is). Its time limit is measured in its own time:
+    the wall-clock time of the call less the time its sandbox was ready to run and waited
+    for a processor (the kernel's scheduling figures, `processes.scheduled`), and less the
+    time it waited for the judge to serve its callbacks (`served`: the judge's wait for a
+    processor once woken by the callback, and its time serving it). A sleeping or blocked
+    sandbox spends its own time; a starved one does not."""
 
     POLL_SECONDS = 1.0  # how often the charge is looked at while waiting
 
-    def __init__(self, processor: Callable[[], float], budget: float | None) -> None:
-        self.processor, self.budget = processor, budget
-        self._start = self._seen = processor() if budget is not None else 0.0
+    def __init__(
+        self,
+        processor: Callable[[], float],
+        budget: float | None,
+        waits: Callable[[], float] = lambda: 0.0,
+    ) -> None:
+        self.processor, self.budget, self.waits = processor, budget, waits
+        self._start = self._seen = processor()
+        self._started, self._waited = time.monotonic(), waits()
+        self.served = 0.0  # seconds the sandbox waited for the judge to serve its callbacks
+        self.woken = 0.0  # seconds the judge waited for a processor since it last served
 
     def charged(self) -> float:
-        """Processor seconds charged so far (what ended processes used stays charged; none
-        without a budget)."""
-        if self.budget is not None:
-            self._seen = max(self._seen, self.processor())
+        """Processor seconds used so far (what ended processes used stays charged)."""
+        self._seen = max(self._seen, self.processor())
         return self._seen - self._start
 
     def over_budget(self) -> bool:
         """True once the call has been charged its budget."""
         return self.budget is not None and self.charged() >= self.budget
+
+    def elapsed(self) -> float:
+        """Wall-clock seconds since the call started."""
+        return time.monotonic() - self._started
+
+    def own(self) -> float:
+        """The call's own seconds so far: wall-clock time less the waits of `waits` and the
+        time it waited for its callbacks."""
+        return self.elapsed() - (self.waits() - self._waited) - self.served
+
+    def served_since(self, started: float) -> None:
+        """The judge has served a callback since ``started`` (`time.monotonic`): the sandbox
+        waited for it that long, and for the judge to be given a processor before."""
+        self.served += self.woken + time.monotonic() - started
+        self.woken = 0.0
+
+    def timed_out(self, limit: float) -> SubmissionTimeout:
+        """The error of a call that ran ``limit`` seconds of its own: an endless loop's where
+        it computed most of them, a sleeper's where it slept or blocked."""
+        if self.charged() >= 0.5 * self.own():
+            return SubmissionTimeout(
+                f"the submission did not answer within {limit:g} s, computing all along "
+                "(an endless loop, or far too much work?)"
+            )
+        return SubmissionWaited(
+            f"the submission did not answer within {limit:g} s: it was waiting (sleeping or "
+            "blocked), not computing, most of that time"
+        )
+
+    def starved(self, limit: float) -> MachineBusy:
+        """The error of a call whose sandbox was kept from a processor."""
+        return MachineBusy(
+            f"no answer within {self.elapsed():.0f} s, of which the call had only "
+            f"{max(self.own(), 0.0):.0f} s of its own (limit {limit:g} s): its sandbox was "
+            "ready to run and waited for a processor the rest of the time"
+        )
 
 
 class SandboxProcess:
@@ -241,9 +308,10 @@ class SandboxProcess:
             raise ValueError(f"isolation must be one of {ISOLATION_LEVELS}, not {isolation!r}")
         self.folder = Path(folder).resolve()
         self.timeout = timeout
-        self.task_timeout = task_timeout  # seconds for all calls of one task's checks
+        self.task_timeout = task_timeout  # processor seconds of a function in one task's checks
         self.task: int | None = None  # the task of the check running now
-        self.spent: dict[int, float] = {}  # seconds the calls of each task took
+        self.spent: dict[tuple[int, str], float] = {}  # processor seconds by task and function
+        self.used = 0.0  # processor seconds of the processes closed so far
         self.memory_bytes = memory_bytes
         self.uid = uid if uid is not None else 65534
         self.strong = isolation == "namespace"
@@ -259,6 +327,9 @@ class SandboxProcess:
         self._deadline, self._limit = 0.0, timeout  # of the answer being waited for
         self._clock = CallClock(lambda: 0.0, None)  # the time the current call is charged
         self._clock_of_child: processes.ProcessorClock | None = None  # found at first need
+        self._judge_schedule = processes.held_schedule()  # this thread's: it serves the calls
+        self._key: tuple[int, str] | None = None  # the budget the current call is charged to
+        self._answered = False  # whether the child started now has answered
 
     @property
     def isolation(self) -> str:
@@ -273,11 +344,12 @@ class SandboxProcess:
         self._launch()
         try:
             self.request({"op": "ping"}, timeout=STARTUP_SECONDS)
-        except SandboxLost:
+            self._answered = True
+        except (SandboxLost, MachineBusy):
             raise
-        except SandboxError as error:
+        except SandboxError as error:  # no code of the submission has run yet
             reason = f"cannot start the grading sandbox ({error}): {self.log_tail()}"
-            raise SandboxError(reason) from None
+            raise SandboxUnavailable(reason) from None
 
     def log_tail(self, limit: int = 2000) -> str:
         """The end of what the submission printed (its stdout and stderr)."""
@@ -288,6 +360,7 @@ class SandboxProcess:
 
     def _launch(self) -> None:
         self.close()
+        self._answered = False  # the processes' clock is found once the child answers
         to_child, self._send_fd = os.pipe()
         self._recv_fd, from_child = os.pipe()
         self._reader = wire.Reader(self._recv_fd, self._wait_for_answer)  # nothing left over
@@ -343,6 +416,7 @@ class SandboxProcess:
         """Kill the child (and anything it started) and close the pipes; its objects are gone."""
         if self.process is not None:
             self.generation += 1
+            self.used += self._processor_time()  # read before it is ended
             with contextlib.suppress(ProcessLookupError, PermissionError):
                 os.killpg(self.process.pid, signal.SIGKILL)
             self.process.wait()
@@ -357,6 +431,9 @@ class SandboxProcess:
     def cleanup(self) -> None:
         """Close the child and delete its scratch folder."""
         self.close()
+        for handle in self._judge_schedule:
+            os.close(handle)
+        self._judge_schedule = []
         shutil.rmtree(self.scratch, ignore_errors=True)
 
     # ------------------------------------------------------------ requests
@@ -369,11 +446,19 @@ class SandboxProcess:
         self.forgive()
         self.task = task
 
-    def _time_left(self) -> float | None:
-        """Seconds the calls of the current task may still take (None: no task budget)."""
+    def _budget_key(self, name: str) -> tuple[int, str] | None:
+        """What a call of ``name`` is charged to: its function (``task2.spring_force()`` and
+        ``task5.Verlet().step()`` are ``task2.spring_force`` and ``task5.Verlet.step``) in
+        the current task's checks; None without a task budget."""
         if self.task_timeout is None or self.task is None:
             return None
-        return self.task_timeout - self.spent.get(self.task, 0.0)
+        return self.task, name.replace("()", "")
+
+    def _time_left(self, key: tuple[int, str] | None) -> float | None:
+        """Processor seconds the calls charged to ``key`` may still take (None: no budget)."""
+        if key is None:
+            return None
+        return self.task_timeout - self.spent.get(key, 0.0)
 
     def request(
         self,
@@ -392,6 +477,9 @@ class SandboxProcess:
         call of ``name`` that timed out or killed the process is not run again until
         `forgive`: it fails at once the same way, so one endless or crashing function
         costs one time limit or one restart per check, however often the check calls it.
+        Its processor time is charged to its function's budget in the current task
+        (`_budget_key`), so an endless loop in one function costs that function's checks,
+        not the rest of its task's.
         """
         if name in self.broken:
             error = self.broken[name]
@@ -400,35 +488,49 @@ class SandboxProcess:
             raise SubmissionCrashed(
                 "this object was lost when the submission's process was restarted after a failure"
             )
-        left = self._time_left() if timeout is None else None
+        key = self._budget_key(name or "the import of its task files") if timeout is None else None
+        left = self._time_left(key)
         if left is not None and left <= 0:
-            raise SubmissionTimeout(f"not run: {self._used_up()}")
+            raise SubmissionTimeout(f"not run: {self._used_up(key)}")
         if self.process is None:
             self.start()
         limit = self.timeout if timeout is None else timeout
-        self._clock = CallClock(self._processor_time, left)
+        self._clock = CallClock(self._processor_time, left, self._waits)
+        self._key = key
         try:
             return self._exchange(message, name, arguments, limit, time.monotonic() + limit)
         finally:
-            if left is not None:
-                self.spent[self.task] = self.spent.get(self.task, 0.0) + self._clock.charged()
+            if key is not None:
+                self.spent[key] = self.spent.get(key, 0.0) + self._clock.charged()
+
+    def _child_clock(self) -> processes.ProcessorClock | None:
+        """The clock of the child's processes, found once they have answered (all of them
+        run by then: bubblewrap's and the child's)."""
+        if self.process is None or not self._answered:
+            return None
+        if self._clock_of_child is None:
+            pids = processes.descendants(self.process.pid)
+            self._clock_of_child = processes.ProcessorClock(pids)
+        return self._clock_of_child
 
     def _processor_time(self) -> float:
-        """Processor seconds the child's processes have used (found once per start)."""
-        if self.process is None:
-            return 0.0
-        clock = self._clock_of_child
-        if clock is None or (len(clock.pids) == 1 and self.strong):  # bubblewrap's child too
-            if clock is not None:
-                clock.close()
-            clock = processes.ProcessorClock(processes.descendants(self.process.pid))
-            self._clock_of_child = clock
-        return clock.seconds()
+        """Processor seconds the child's processes have used."""
+        clock = self._child_clock()
+        return 0.0 if clock is None else clock.seconds()
 
-    def _used_up(self) -> str:
+    def _waits(self) -> float:
+        """Seconds the sandbox's processes have waited, ready to run, for a processor; 0
+        where the kernel keeps no scheduling figures."""
+        clock = self._child_clock()
+        figures = None if clock is None else clock.scheduled()
+        return figures[1] if figures else 0.0
+
+    def _used_up(self, key: tuple[int, str] | None) -> str:
+        task, function = key if key is not None else (self.task, "")
         return (
-            f"the submission's code used up the {self.task_timeout:g} s of processor time it may "
-            f"take for task {self.task} (an endless loop, or far too much work?)"
+            f"the submission's code used up the {self.task_timeout:g} s of processor time "
+            f"{function} may take in task {task}'s checks (an endless loop, or far too much "
+            "work?)"
         )
 
     def _exchange(
@@ -442,7 +544,9 @@ class SandboxProcess:
             while True:
                 reply = self._receive(deadline, limit)
                 if isinstance(reply, dict) and "op" in reply:
+                    started = time.monotonic()
                     wire.write_all(self._send_fd, self._serve(reply))
+                    self._clock.served_since(started)
                     continue
                 break
         except SubmissionTimeout as error:
@@ -451,9 +555,9 @@ class SandboxProcess:
             raise
         except (EOFError, BrokenPipeError, wire.WireError, ValueError, KeyError) as error:
             reason = self._death_reason() or f"the channel broke ({error})"
-            killed = self.process is not None and self.process.returncode in KILLED
+            lost = self.strong and self.process is not None and self.process.returncode == KILLED
             self.close()
-            if killed:
+            if lost:
                 raise SandboxLost(f"the sandbox was killed from outside ({reason})") from None
             crash = SubmissionCrashed(f"the submission's process {reason}")
             self._remember(name, crash)
@@ -480,21 +584,22 @@ class SandboxProcess:
         while True:
             remaining = self._deadline - time.monotonic()
             wait = max(min(remaining, CallClock.POLL_SECONDS), 0)
+            before = processes.scheduled(self._judge_schedule)
             if select.select([self._recv_fd], [], [], wait)[0]:
+                after = processes.scheduled(self._judge_schedule)
+                if before and after:  # what the judge waited for a processor once woken
+                    self._clock.woken += after[1] - before[1]
                 return
             if self._clock.over_budget():
-                raise SubmissionTimeout(self._used_up())
+                raise SubmissionTimeout(self._used_up(self._key))
             if time.monotonic() < self._deadline:
                 continue
-            if overloaded():
-                raise MachineBusy(
-                    f"no answer within {self._limit:g} s while the machine was overloaded "
-                    f"(load {os.getloadavg()[0]:.1f} on {os.cpu_count()} processors)"
-                )
-            raise SubmissionTimeout(
-                f"the submission did not answer within {self._limit:g} s "
-                "(an endless loop, or far too much work?)"
-            )
+            own = self._clock.own()
+            if own >= self._limit:
+                raise self._clock.timed_out(self._limit)
+            if self._clock.elapsed() >= STARVED_FACTOR * self._limit:
+                raise self._clock.starved(self._limit)
+            self._deadline = time.monotonic() + self._limit - own  # the rest of its own time
 
     def _death_reason(self) -> str:
         if self.process is None:
@@ -503,10 +608,10 @@ class SandboxProcess:
             code = self.process.wait(timeout=1.0)
         except subprocess.TimeoutExpired:
             return ""
-        if code < 0:
-            name = signal.Signals(-code).name
-            hint = " (memory limit?)" if -code in (signal.SIGKILL, signal.SIGSEGV) else ""
-            return f"was killed by {name}{hint}"
+        number = -code if code < 0 else code - 128 if self.strong and code > 128 else 0
+        if number:  # bubblewrap exits with 128 + the signal that ended its child
+            name = signal.Signals(number).name if number in set(signal.Signals) else number
+            return f"was ended by the signal {name}"
         return f"exited with status {code}"
 
     def _export(self, value: Any) -> wire.Ref:

@@ -40,6 +40,7 @@ def main(config: dict[str, Any]) -> None:
     _load_engine()
     delegation.install()  # before the submission is imported: see msdlab.course.delegation
 
+    _refuse_new_processes()
     _install_guard(config["read_roots"], config["scratch"])
     os.chdir(config["scratch"])
     Server(config["folder"], config["in_fd"], config["out_fd"], wire, importlib.util).serve()
@@ -113,6 +114,17 @@ def _limit_resources(memory_bytes: int, cpu_seconds: int) -> None:
         (resource.RLIMIT_CORE, 0),
     ):
         resource.setrlimit(limit, (value, value))
+
+
+def _refuse_new_processes() -> None:
+    """From now on this process can start no process and no thread (``RLIMIT_NPROC`` 0: the
+    kernel refuses every fork, clone and spawn, however it is asked for): whatever the
+    submission runs runs here, in the one process whose processor time its budget is
+    charged. Ignored only by a process with root's capabilities (the ``process`` isolation
+    run as root)."""
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_NPROC, (0, 0))
 
 
 _BLOCKED = {
