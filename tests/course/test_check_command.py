@@ -72,7 +72,11 @@ def test_the_checks_leave_no_bytecode_in_the_course_and_msdlab_compiled(monkeypa
     tasks, checks = tmp_path / "tasks", tmp_path / "checks"
     shutil.copytree(SOLUTIONS, tasks, ignore=shutil.ignore_patterns("__pycache__"))
     shutil.copytree(CHECKS, checks, ignore=shutil.ignore_patterns("__pycache__", "*hidden*"))
-    compiled = Path(importlib.util.cache_from_source(str(Path(msdlab.__file__).parent / "body.py")))
+    compiled = Path(
+        importlib.util.cache_from_source(
+            str(Path(msdlab.__file__).parent / "engine" / "model" / "body.py")
+        )
+    )
     compiled.unlink(missing_ok=True)
     report, output = runner.run_checks(checks, tasks, 1)
     assert report.all_passed, output

@@ -234,6 +234,7 @@ def test_grade_command_writes_rows_feedback_and_exit_status(tmp_path, capsys):
         "late_penalty",
         "adjustment",
         "total",
+        "status",
         "notes",
         "fingerprint",
     ]
@@ -259,7 +260,8 @@ def test_a_submission_that_outlasts_its_time_limit_still_gets_a_row(tmp_path, mo
     status = main(["grade", str(slow), "--out", str(out), "--checks", str(checks), "--timeout", "8",
                    "--call-timeout", "30", "--retries", "1"])  # fmt: skip
     row = {row["id"]: row for row in csv.DictReader(out.open())}["slow"]
-    assert row["total"] == "0"
+    assert row["total"] == ("" if starved else "0")  # the grader's failure has no points
+    assert row["status"] == ("grader failed" if starved else "graded")
     assert status == (2 if starved else 1)
     assert ("grader error" in row["notes"]) == starved
     assert ("timed out after 8 s" if not starved else "waited for a processor") in row["notes"]
