@@ -13,9 +13,8 @@ KERNELS = ("numba", "numpy")
 
 
 def default_kernel() -> str:
-    """The spring kernel to use: ``MSDLAB_KERNEL`` if set; else "numpy" while a debugger
-    traces the program (`sys.gettrace`), so its breakpoints in `msdlab.engine.equations` and in
-    an integrator's update stop; else "numba".
+    """The spring kernel to use: ``MSDLAB_KERNEL`` if set, else "numba" (while a debugger
+    traces the program, a step runs on "numpy" all the same: `stepping_backend`).
 
     "numba" is the compiled loop of `msdlab.engine.backends.numba`; "numpy" is the readable
     array version of `msdlab.engine.backends.numpy`. Both apply the same `msdlab.engine.equations`.
@@ -23,13 +22,21 @@ def default_kernel() -> str:
     name = os.environ.get("MSDLAB_KERNEL", "").strip().lower()
     if name:
         return checked_kernel_name(name, "MSDLAB_KERNEL")
-    return "numpy" if sys.gettrace() is not None else "numba"
+    return "numba"
 
 
 def kernel_left_to_msdlab(name: str | None) -> bool:
     """Whether a simulation asked for no kernel (``kernel=None`` and no ``MSDLAB_KERNEL``):
     then each step runs on the numpy kernel while a debugger traces the program."""
     return name is None and not os.environ.get("MSDLAB_KERNEL", "").strip()
+
+
+def stepping_backend(chosen: SpringKernel, readable: SpringKernel) -> SpringKernel:
+    """The backend of the next step of a simulation that asked for no kernel: the readable
+    one while a debugger traces the program (`sys.gettrace`), so that its breakpoints in
+    `msdlab.engine.equations` and in an integrator's update stop; else the ``chosen`` one.
+    The one place a debugger changes what runs."""
+    return readable if sys.gettrace() is not None else chosen
 
 
 def checked_kernel_name(name: str, what: str) -> str:

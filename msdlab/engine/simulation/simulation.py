@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import sys
 from collections import defaultdict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -128,97 +127,40 @@ class Simulation:
     def step(self) -> None:
         """Advance the body by one step of ``dt``.
 
-        Integrate, apply the constraints, book the energy each mechanism took out,
-        check for divergence, and store the new state in the body: read
-        ``body.positions`` and ``body.velocities`` again after a step, as arrays
-        read before may still hold the old state. Edits of the body's state made
-        before the call are where the step starts.
+        Integrate, apply the constraints, book the energy each mechanism took out, check for
+        divergence, and make the new state the body's: read ``body.positions`` and
+        ``body.velocities`` again after a step, as arrays read before hold the old state.
+        Edits of the body's state made before the call are where the step starts.
+
+        The ledger books the dashpots and the dissipative forces at their power at the
+        step's first pass over the springs, where it starts (`Step.powers`), the
+        integrator's damping (`Integrator.dissipated_energy`, summed by the backend), and
+        what each constraint returns.
         """
-        self._load()
-        self._step()
-        self._store()
-
-    def _load(self) -> None:
-        """Hand the body's state to the backend: where a public call starts stepping."""
-        self.dynamics.springs.load(self.body.positions, self.body.velocities)
-
-    def _store(self) -> None:
-        """Make the backend's state the body's (a CPU backend's arrays, uncopied)."""
-        x, v = self.dynamics.springs.state()
-        if x is not self.body.positions or v is not self.body.velocities:
-            self.body.store_state(x, v)
-
-    def _step(self) -> None:
-        """One step of the backend's state, kept there (`step` without loading and storing)."""
         body, dt, dynamics = self.body, self._dt, self.dynamics
-        if dynamics.readable is not None:  # a debugger attached since reaches the equations
-            dynamics.choose(dynamics.readable if sys.gettrace() else dynamics.chosen)
-        kernel = dynamics.springs
-        x, v = kernel.state()
-        dynamics.opening, dynamics.advanced = None, (None, None)  # the integrator's step fills in
-        x_new, v_new = self._integrate(x, v)
+        x, v = body.positions, body.velocities
+        step = dynamics.step(self.integrator, x, v, dt)
+        x_new, v_new = step.x, step.v
         energy_of = partial(self._energy, x_new, v_new) if self.ledger else _unbooked
-        state = StepState(body, x, v, x_new, v_new, self.time + dt, dt, energy_of, kernel)
+        state = StepState(body, x, v, x_new, v_new, self.time + dt, dt, energy_of, dynamics.springs)
         removed = []
         for constraint in self.constraints:
             removed.append((constraint.ledger_name, constraint.apply(state)))
         if self.ledger:  # after the constraints: the integrator's damping works at the final v
-            self._book(v, v_new, removed)
-        stretched = self.max_stretch is not None and dynamics.max_stretch > self.max_stretch
-        if stretched or not kernel.finite(x_new, v_new):
+            powers = dynamics.powers(x, v) if step.powers is None else step.powers
+            for name, power in powers.items():
+                self.dissipated[name] += power * dt
+            self.dissipated["integrator"] += self.integrator.dissipated_energy(
+                v, body.masses, v_new, kernel=dynamics.springs
+            )
+            for name, energy in removed:
+                self.dissipated[name] += energy
+        stretched = self.max_stretch is not None and step.stretch > self.max_stretch
+        if stretched or not dynamics.springs.finite(x_new, v_new):
             raise self._divergence(x, x_new, v_new)
-        kernel.load(x_new, v_new)
+        body.store_state(x_new, v_new)
         self.time += dt
         self.step_count += 1
-
-    def _integrate(self, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The integrator's step from (x, v) as new float arrays of the body's shape, with
-        the fixed particles kept where they are, at rest.
-
-        The arrays become the state the backend steps next, so they must be no one else's:
-        those the backend's `advance` made in this step are kept, any other (an integrator's
-        own buffers, its arithmetic on arrays) is copied, as storing it in the body did."""
-        result = self.integrator.step(x, v, self._dt, self.dynamics)
-        try:
-            x_new, v_new = result
-        except (TypeError, ValueError):
-            raise TypeError(
-                f"{self.integrator!r}.step must return (x_new, v_new), got {type(result).__name__}"
-            ) from None
-        arrays = []
-        for name, array, made in zip(("x_new", "v_new"), (x_new, v_new), self.dynamics.advanced):
-            array = np.asarray(array, dtype=float)
-            if array.shape != x.shape:
-                raise ValueError(
-                    f"{self.integrator!r}.step returned {name} of shape {array.shape}; "
-                    f"it must have the shape of the positions, {x.shape}"
-                )
-            arrays.append(
-                array if array is made and made is not x and made is not v else array.copy()
-            )
-        x_new, v_new = arrays
-        fixed = self.body.fixed
-        if np.count_nonzero(fixed):  # faster than fixed.any() on a few rows
-            pinned = np.flatnonzero(fixed)  # indices: a mask costs 68 µs on 16 384 rows
-            x_new[pinned] = x[pinned]
-            v_new[pinned] = 0.0
-        return x_new, v_new
-
-    def _book(self, v: np.ndarray, v_new: np.ndarray, removed: list[tuple[str, float]]) -> None:
-        """Add to `dissipated` the energy (J) each mechanism took out in the step from the
-        body's state, velocities ``v``, to velocities ``v_new``: the dashpots and the
-        dissipative forces at the power of the step's pass there (`Dynamics.opening`), the
-        integrator's damping (`Integrator.dissipated_energy`, summed by the backend), and
-        the constraints (``removed``: (ledger name, energy) of each)."""
-        dynamics, dt = self.dynamics, self._dt
-        powers = dynamics.opening or dynamics.powers_now()  # the integrator's pass, if it took one
-        for name, power in powers.items():
-            self.dissipated[name] += power * dt
-        self.dissipated["integrator"] += self.integrator.dissipated_energy(
-            v, self.body.masses, v_new, kernel=dynamics.springs
-        )
-        for name, energy in removed:
-            self.dissipated[name] += energy
 
     def run(
         self,
@@ -231,9 +173,8 @@ class Simulation:
         """Run ``steps`` steps (or ``duration`` seconds) and return the recorded frames.
 
         A frame is recorded at the start, every ``record_every`` steps and at the
-        end. ``callback(sim)`` is called after every step (e.g. a progress bar). The body
-        holds the state at each frame, in each callback (which may edit it) and at the end,
-        also when the run diverges; in between, the backend holds it.
+        end. ``callback(sim)`` is called after every step (e.g. a progress bar); it may edit
+        the body. The body holds the state after every step, also when the run diverges.
         """
         steps = self._count_steps(steps, duration)
         if isinstance(record_every, bool) or not isinstance(record_every, int) or record_every < 1:
@@ -241,22 +182,17 @@ class Simulation:
         ledger = EnergyLedger()
         frames: list[tuple[int, float, np.ndarray, np.ndarray | None]] = []
         record = partial(self._record, frames, ledger, dict(self.dissipated), record_velocities)
-        self._load()
         record()
         try:
             for i in range(1, steps + 1):
-                self._step()
+                self.step()
                 if i % record_every == 0 or i == steps:
                     record()
                 if callback is not None:  # it sees the body's state, and may edit it
-                    self._store()
                     callback(self)
-                    self._load()
         except SimulationDiverged as error:
             error.trajectory = self._trajectory(frames, ledger)
             raise
-        finally:
-            self._store()
         return self._trajectory(frames, ledger)
 
     def _record(
@@ -266,10 +202,9 @@ class Simulation:
         start: dict[str, float],
         with_velocities: bool,
     ) -> None:
-        """Store the backend's state in the body and add it as a frame to ``frames`` (the
-        velocities too if ``with_velocities``) and ``ledger`` (the energy taken out since
-        ``start``, the dissipated energies by mechanism when the run started)."""
-        self._store()
+        """Add the body's state as a frame to ``frames`` (the velocities too if
+        ``with_velocities``) and ``ledger`` (the energy taken out since ``start``, the
+        dissipated energies by mechanism when the run started)."""
         x, v = self.body.positions, self.body.velocities
         frames.append((self.step_count, self.time, x.copy(), v.copy() if with_velocities else None))
         if self.step_count > 0:  # before the first step v is the user's v(t0)
