@@ -19,13 +19,12 @@ simulation hands back at the next step), and sets nothing for another class to r
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING, NamedTuple, Protocol
+from typing import NamedTuple, Protocol
 
 import numpy as np
 import scipy.sparse as sp
 
-if TYPE_CHECKING:
-    from .layout import Layout
+from .layout import Layout
 
 
 class SpringSums(NamedTuple):
