@@ -7,6 +7,7 @@ from collections import defaultdict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import partial
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -20,6 +21,9 @@ from ..model.forces import Force
 from ..model.units import SI, Units
 from .energy import EnergyLedger, kinetic_energy
 from .stability import describe_blowup
+
+if TYPE_CHECKING:
+    from ..backends.contract import SpringKernel
 
 
 @dataclass
@@ -137,6 +141,8 @@ class Simulation:
         integrator's damping (`Integrator.dissipated_energy`, summed by the backend), and
         what each constraint returns.
         """
+        if hasattr(self.dynamics.springs, "step") and self._device_steps(1, "step"):
+            return  # a device backend's whole step
         body, dt, dynamics = self.body, self._dt, self.dynamics
         x, v = body.positions, body.velocities
         step = dynamics.step(self.integrator, x, v, dt)
@@ -169,24 +175,33 @@ class Simulation:
         record_every: int = 1,
         record_velocities: bool = False,
         callback: Callable[[Simulation], None] | None = None,
+        sync: str = "step",
     ) -> Trajectory:
         """Run ``steps`` steps (or ``duration`` seconds) and return the recorded frames.
 
         A frame is recorded at the start, every ``record_every`` steps and at the
         end. ``callback(sim)`` is called after every step (e.g. a progress bar); it may edit
-        the body. The body holds the state after every step, also when the run diverges.
+        the body. The body holds the state after every step, also when the run diverges;
+        on a backend that runs whole steps on a device (Warp), at every frame and at the
+        end (the state stays on the device in between). There, ``sync="frame"`` runs the
+        steps between two frames as one captured frame (a CUDA graph on a GPU) whose ledger
+        numbers come back once, not once a step (`_device_steps`).
         """
         steps = self._count_steps(steps, duration)
         if isinstance(record_every, bool) or not isinstance(record_every, int) or record_every < 1:
             raise ValueError(f"record_every must be an integer >= 1, got {shown(record_every)}")
+        if sync not in ("step", "frame"):
+            raise ValueError(f'sync must be "step" or "frame", got {shown(sync)}')
+        batch = 1 if callback is not None else record_every  # steps a device may take at once
         ledger = EnergyLedger()
         frames: list[tuple[int, float, np.ndarray, np.ndarray | None]] = []
         record = partial(self._record, frames, ledger, dict(self.dissipated), record_velocities)
         record()
         try:
-            for i in range(1, steps + 1):
-                self.step()
-                if i % record_every == 0 or i == steps:
+            done = 0
+            while done < steps:
+                done += self._steps(min(batch - done % batch, steps - done), sync)
+                if done % record_every == 0 or done == steps:
                     record()
                 if callback is not None:  # it sees the body's state, and may edit it
                     callback(self)
@@ -194,6 +209,88 @@ class Simulation:
             error.trajectory = self._trajectory(frames, ledger)
             raise
         return self._trajectory(frames, ledger)
+
+    def _steps(self, count: int, sync: str) -> int:
+        """``count`` steps on a device backend where they run whole there
+        (`_device_steps`), else one `step`; the number of steps taken."""
+        if hasattr(self.dynamics.springs, "step") and self._device_steps(count, sync):
+            return count
+        self.step()
+        return 1
+
+    def _device_steps(self, count: int, sync: str) -> bool:
+        """``count`` whole steps on the backend's device (`WarpKernel.step`, or one captured
+        frame of them with ``sync="frame"``, `WarpKernel.frame`), from the body's state, which
+        then adopts the device's: an update integrator (`Integrator.update_step`), uniform
+        fields as forces, at most a ground plane as constraint. False, with nothing done, for
+        any other step, or an update Warp cannot compile (the host steps it)."""
+        kernel, plan = self.dynamics.springs, self._device_plan()
+        if plan is None:
+            return False
+        kernel.load(self.body.positions, self.body.velocities)
+        if sync == "frame" and count > 1:
+            rows = kernel.frame(count, *plan)
+            if rows is None:
+                return False
+            limit = np.inf if self.max_stretch is None else self.max_stretch
+            if rows[:, 4].any() or (rows[:, 0] > limit).any():
+                kernel.undo_frame()  # again from the frame's start, to stop where it blew up
+                self._device_each(kernel, plan, count)
+            else:
+                for stretch, power, damping, ground, _ in rows.tolist():
+                    self._book_device(stretch, power, damping, ground)
+        elif not self._device_each(kernel, plan, count):
+            return False
+        self.body.store_state(*kernel.state())
+        return True
+
+    def _device_each(self, kernel: SpringKernel, plan: tuple, count: int) -> bool:
+        """``count`` device steps, their sums read and booked after each; at a blow-up the body
+        gets the state before it and `SimulationDiverged` is raised. False if not compiled."""
+        for _ in range(count):
+            sums = kernel.step(*plan)
+            if sums is None:  # an update Warp cannot compile: the host's step (it said why)
+                return False
+            if (self.max_stretch is not None and sums.stretch > self.max_stretch) or not (
+                sums.finite
+            ):
+                self._book_device(sums.stretch, sums.power, sums.damping, sums.ground)
+                x, x_new, v_new = kernel.undo_step()
+                self.body.store_state(*kernel.state())
+                raise self._divergence(x, x_new, v_new)
+            self._book_device(sums.stretch, sums.power, sums.damping, sums.ground)
+        return True
+
+    def _book_device(self, stretch: float, power: float, damping: float, ground: float) -> None:
+        """A device step's sums: the dashpots' power (W) at its start, the integrator's
+        damping work and the ground's energy (J), booked as `step` books them; the step's
+        time."""
+        if self.ledger:
+            self.dissipated["dashpot"] += power * self._dt
+            self.dissipated["integrator"] += damping
+            for constraint in self.constraints:
+                self.dissipated[constraint.ledger_name] += ground
+        self.time += self._dt
+        self.step_count += 1
+
+    def _device_plan(self) -> tuple | None:
+        """The arguments of the backend's whole ``step`` (see `_device_steps`), or None."""
+        integrator, body = self.integrator, self.body
+        found = integrator.update_step()
+        booked = type(integrator).dissipated_energy is Integrator.dissipated_energy
+        if found is None or not booked or len(self.constraints) > 1:
+            return None
+        field = np.zeros(body.dim)
+        for force in self.dynamics.forces:
+            g = force.uniform_acceleration(body)
+            if g is None:
+                return None
+            field += g
+        ground = self.constraints[0].plane(body) if self.constraints else None
+        if self.constraints and ground is None:
+            return None
+        factor = integrator.velocity_factor if self.ledger else 1.0
+        return found[0], self.dynamics.layout, field, self._dt, found[1], factor, ground
 
     def _record(
         self,
