@@ -60,8 +60,7 @@ def grid_simulation(n: int, kernel: WarpKernel | str) -> msd.Simulation:
 def on(kernel: WarpKernel | str, sim: msd.Simulation) -> msd.Simulation:
     """``sim`` stepping on ``kernel``: a WarpKernel of a chosen device and precision."""
     if not isinstance(kernel, str):
-        sim.dynamics.choose(kernel)
-        sim.dynamics.chosen = kernel
+        sim.dynamics.chosen = sim.dynamics.springs = kernel
     return sim
 
 
