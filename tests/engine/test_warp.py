@@ -266,3 +266,17 @@ def test_what_warp_cannot_compile_is_named(update: object, reason: str) -> None:
 
     with pytest.raises(NotCompiled, match=reason):
         typed_source(update)
+
+
+def test_the_sums_of_a_gpu_add_up_in_bins_to_those_of_one() -> None:
+    """The step's sums added into bins, as on a GPU (particle i into bin i mod 7 here), then
+    reduced: the same trajectory and the same ledger, to rounding, as one bin."""
+    from msdlab.engine.backends.warp import WarpKernel
+
+    sims = [falling_cube("warp"), falling_cube("warp")]
+    sims[1].dynamics.chosen = sims[1].dynamics.springs = WarpKernel("cpu", bins=7)
+    for sim in sims:
+        sim.run(steps=200, record_every=100)
+    np.testing.assert_array_equal(sims[0].body.positions, sims[1].body.positions)
+    for name, energy in sims[0].dissipated.items():
+        assert sims[1].dissipated[name] == pytest.approx(energy, rel=1e-12), name

@@ -72,11 +72,14 @@ def default_device() -> str:
 
 class WarpKernel:
     """The Warp backend: the state on ``device`` ("cuda", "cpu"; default `default_device`) in
-    ``precision`` ("float64", the default, or "float32")."""
+    ``precision`` ("float64", the default, or "float32"), the step's sums added in ``bins``
+    (default: 1 on the CPU device, `GPU_BINS` on a GPU)."""
 
     name = "warp"
 
-    def __init__(self, device: str | None = None, precision: str = "float64") -> None:
+    def __init__(
+        self, device: str | None = None, precision: str = "float64", bins: int | None = None
+    ) -> None:
         if precision not in PRECISIONS:
             raise ValueError(f"precision must be float64 or float32, got {precision!r}")
         self.device = wp.get_device(default_device() if device is None else device)
@@ -85,7 +88,7 @@ class WarpKernel:
         self._state: list[wp.array] = []  # x and v of state_0, then of state_1
         self._host: tuple[np.ndarray, np.ndarray] | None = None  # what `state` handed out
         self._sums = wp.zeros(len(SUMS), dtype=self.kernels.scalar, device=self.device)
-        bins = 1 if self.device.is_cpu else GPU_BINS
+        bins = bins or (1 if self.device.is_cpu else GPU_BINS)
         self._bins = wp.zeros((bins, len(SUMS)), dtype=self.kernels.scalar, device=self.device)
         self._scratch: dict[str, wp.array] = {}
         self._topology: tuple[object, tuple] = (None, ())
