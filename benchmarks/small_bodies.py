@@ -55,7 +55,8 @@ def ground_alone(sim):
 
     body, ground = sim.body, sim.constraints[0]
     x, v = body.positions, body.velocities
-    x_new, v_new = sim._integrate(x, v)
+    step = sim.dynamics.step(sim.integrator, x, v, sim.dt)
+    x_new, v_new = step.x, step.v
     arrays = (x, v, x_new.copy(), v_new.copy())
     state = StepState(body, *arrays, sim.time, sim.dt, lambda p: 0.0, sim.dynamics.springs)
 

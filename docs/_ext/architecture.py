@@ -1,7 +1,7 @@
 """Draws the architecture picture of the engine page at build time (matplotlib, offline).
 
-The layers are those `tests/architecture/test_imports.py` enforces: a module imports only
-its own layer and the layers below it.
+The layers are those `tests/architecture/test_imports.py` reads from the folders: a module
+imports only its own layer and the layers below it.
 """
 
 from __future__ import annotations
@@ -11,16 +11,17 @@ from pathlib import Path
 # (layer, what it holds), lowest first
 LAYERS = [
     (
-        "engine core",
-        "equations · particle, spring · body, lattice · spring kernel: numpy | compiled (numba)\n"
-        "forces, constraint · dynamics, integrators · simulation, energy, stability",
+        "engine",
+        "equations · model (body, springs, forces) · backends: contract, layout, numpy | numba\n"
+        "dynamics · integrators · simulation: stepping, the energy ledger, stability",
     ),
     ("analysis · interaction", "measured stable dt, convergence · ground, walls, grab"),
-    ("msdlab", "the package: re-exports the two layers below (import msdlab as msd)"),
+    ("msdlab", "the package: the public names of the layers below (import msdlab as msd)"),
     ("scenes · course", "ready simulations · task loading, checks' feedback, pytest plugin"),
-    ("viz · jupyter_extension", "pictures, animations, the live view · Jupyter server side"),
+    ("viz", "pictures, animations, the live view"),
     ("instructor", "templates, release, grading, sandbox, Gradescope, validate"),
-    ("commands · cli", "msdlab demo, scenes, run, check, grade, ..."),
+    ("commands", "msdlab demo, scenes, run, check, grade, ..."),
+    ("cli · jupyter_extension", "the ways in: the msdlab command, the Jupyter server's side"),
 ]
 
 
@@ -58,7 +59,8 @@ def draw(path: Path) -> None:
         ax.text(0.25, y + height - 0.28, name, fontsize=12, weight="bold", va="center")
         ax.text(0.25, y + 0.15, holds, fontsize=9, va="bottom", color="#222222", linespacing=1.4)
         y += height + gap
-    ax.text(9.55, 0.6 + line * 2 + gap / 2, "imports", fontsize=8, va="center", color="#1f4e79")
+    first = 0.6 + line * (LAYERS[0][1].count("\n") + 1)  # the lowest box's height
+    ax.text(9.55, first + gap / 2, "imports", fontsize=8, va="center", color="#1f4e79")
     top = y
     ax.set_xlim(-0.1, 10.1)
     ax.set_ylim(-0.1, top - gap + 0.1)

@@ -20,20 +20,22 @@ def spring_force(
     rest: float,
     damping: float,
     d: tuple[float, float, float],
-    w: tuple[float, float, float],
-) -> tuple[float, float, float]:
-    """Force (N) on end ``a`` of a spring from end ``b``: eq. (1.2) plus the dashpot, a vector.
+    w: tuple[float, float, float] | None,
+) -> tuple[tuple[float, float, float], float, float]:
+    """Force (N) on end ``a`` of a spring from end ``b``: eq. (1.2) plus the dashpot, a vector;
+    with the length |d| (m) and the lengthening rate ṡ (m/s) it was computed from.
 
     ``d`` = x_a - x_b (m) and ``w`` = v_a - v_b (m/s), three coordinates each (0 for
-    the third in 2-D; ``w`` may be 0 where there is no dashpot)::
+    the third in 2-D; ``w`` may be None where there is no dashpot)::
 
         n = d / |d|,   ṡ = w·n,   f_a = [k (l - |d|) - c ṡ] n,   f_b = -f_a
 
     ṡ is how fast the spring lengthens. Coincident ends (d = 0) have no
-    direction and get no force. The terms are `spring_state`'s.
+    direction and get no force. The terms are `spring_state`'s; the derivative is
+    `spring_jacobian`.
     """
-    scale = spring_state(stiffness, rest, damping, d, w)[3]  # |f_a| / |d|
-    return scale * d[0], scale * d[1], scale * d[2]
+    length, _, rate, scale = spring_state(stiffness, rest, damping, d, w)  # scale: |f_a|/|d|
+    return (scale * d[0], scale * d[1], scale * d[2]), length, rate
 
 
 def spring_state(
@@ -57,6 +59,19 @@ def spring_state(
     rate = 0.0 if w is None else (w[0] * d[0] + w[1] * d[1] + w[2] * d[2]) / safe
     tension = stiffness * (rest - length) - damping * rate  # positive: pushes the ends apart
     return length, safe, rate, tension / safe
+
+
+def spring_jacobian(
+    stiffness: float, transverse: float, damping: float, n_i: float, n_j: float, same: float
+) -> tuple[float, float]:
+    """Entry (i, j) of the derivative of `spring_force`: -∂f_a/∂x_a, the stiffness block
+    B = k n nᵀ + k_t (I - n nᵀ) (N/m), and -∂f_a/∂v_a, the dashpot block C = c n nᵀ
+    (N·s/m), for the direction n = d/|d| (``n_i``, ``n_j`` its coordinates; ``same`` 1
+    where i = j, else 0) and k_t = `transverse_stiffness`. A spring adds -B and -C on its
+    (a, a) and (b, b) blocks of ∂F/∂x and ∂F/∂v, +B and +C on (a, b) and (b, a).
+    """
+    along = n_i * n_j
+    return (stiffness - transverse) * along + transverse * same, damping * along
 
 
 def spring_energy(stiffness: float, rest: float, length: float) -> float:

@@ -30,7 +30,7 @@ from .dynamics import Dynamics
 from .equations import damping_work, kinetic_energy
 
 if TYPE_CHECKING:
-    from .backends.contract import SpringKernel
+    from .backends.contract import SpringKernel, Update
 
 State = tuple[np.ndarray, np.ndarray]
 
@@ -75,6 +75,12 @@ class Integrator(ABC):
         work = damping_work if kernel is None else kernel.damping_work
         return work(masses, v, v_new, factor)
 
+    def update_step(self) -> tuple[Update, tuple[float, ...]] | None:
+        """``(update, coefficients)`` if `step` is ``dynamics.advance(update, x, v, dt,
+        *coefficients)`` and nothing else, so a device backend may run whole steps itself
+        (`Simulation`); None here (a step the backend cannot see into)."""
+        return None
+
     def velocity_at_positions(self, v: np.ndarray, a: np.ndarray, dt: float) -> np.ndarray:
         """The velocity at the time of the positions, for energy measurements; ``v`` here.
 
@@ -102,6 +108,10 @@ class ExplicitEuler(Integrator):
         """`update` with a = F(x, v)/m (`Dynamics.advance`)."""
         return dynamics.advance(self.update, x, v, dt)
 
+    def update_step(self) -> tuple[Update, tuple[float, ...]] | None:
+        """`update` with no coefficients, unless a subclass steps its own way."""
+        return (self.update, ()) if type(self).step is ExplicitEuler.step else None
+
 
 class SymplecticEuler(Integrator):
     """Semi-implicit Euler: v += dt·a(x), then x += dt·v with the new v. Order 1.
@@ -118,6 +128,10 @@ class SymplecticEuler(Integrator):
     def step(self, x: np.ndarray, v: np.ndarray, dt: float, dynamics: Dynamics) -> State:
         """`update` with a = F(x, v)/m (`Dynamics.advance`)."""
         return dynamics.advance(self.update, x, v, dt)
+
+    def update_step(self) -> tuple[Update, tuple[float, ...]] | None:
+        """`update` with no coefficients, unless a subclass steps its own way."""
+        return (self.update, ()) if type(self).step is SymplecticEuler.step else None
 
 
 class Verlet(Integrator):
@@ -159,6 +173,10 @@ class Verlet(Integrator):
         """x(t + dt) and v by eq. (1.4), `update`, with a(t) = F(x, v)/m: `Dynamics.advance`
         computes a and applies the equation (on the numba kernel, in one compiled loop)."""
         return dynamics.advance(self.update, x, v, dt, self.damping)
+
+    def update_step(self) -> tuple[Update, tuple[float, ...]] | None:
+        """`update` with the damping λ, unless a subclass steps its own way."""
+        return (self.update, (self.damping,)) if type(self).step is Verlet.step else None
 
     def velocity_at_positions(self, v: np.ndarray, a: np.ndarray, dt: float) -> np.ndarray:
         """v(t) ≈ v(t - dt/2) + ½ a(t) dt: the stored velocity is half a step behind x."""

@@ -95,6 +95,13 @@ class Ground(Constraint):
                 f"ground normal has {len(self.normal)} components but the body is {body.dim}-D"
             )
 
+    def plane(self, body: Body) -> tuple[np.ndarray, float, float] | None:
+        """The floor's normal for ``body``, its height and friction, for a device backend's
+        own step; None for a subclass with its own `apply`, which must run as written."""
+        if type(self).apply is not Ground.apply:
+            return None
+        return np.asarray(self.normal_of(body)), self.height, self.friction
+
     def apply(self, state: StepState) -> float:
         """The backend's `ground_clamp` (`backends.numpy.ground_clamp` on arrays) on the step."""
         body = state.body

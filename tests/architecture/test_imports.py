@@ -35,7 +35,7 @@ FOLDERS = [
 ENGINE = ["equations", "model", "backends", "dynamics", "integrators", "simulation"]
 # The one import made inside a function in the engine: a compiled backend, when chosen.
 LOADS_BACKENDS = "msdlab.engine.backends.choice"
-COMPILED = ("msdlab.engine.backends.numba",)
+COMPILED = ("msdlab.engine.backends.numba", "msdlab.engine.backends.warp")
 
 
 def module_name(path: Path) -> str:

@@ -8,7 +8,9 @@ import pytest
 import msdlab as msd
 from msdlab.engine.backends import contract
 from msdlab.engine.backends import numpy as numpy_backend
+from msdlab.engine.backends.layout import Layout
 from msdlab.engine.backends.numba import NumbaKernel
+from msdlab.engine.backends.numba.kernel import sorted_edges
 
 RTOL = 1e-12
 
@@ -36,9 +38,16 @@ def shuffled_body(seed: int = 0) -> msd.Body:
     return body
 
 
-def forces_by(kernel: contract.SpringKernel, body: msd.Body, springs=None) -> tuple:
+def forces_by(
+    kernel: contract.SpringKernel, body: msd.Body, springs=None, layout: Layout | None = None
+) -> tuple:
+    """The spring forces, largest stretch and dashpot power by ``kernel``, given ``layout``
+    (a fresh one of ``body`` if None)."""
+    layout = Layout(body) if layout is None else layout
     out = np.zeros_like(body.positions)
-    stretch, power = kernel.spring_forces(body, body.positions, body.velocities, out, springs)
+    stretch, power = kernel.spring_forces(
+        Layout(body), body.positions, body.velocities, out, springs
+    )
     return out, stretch, power
 
 
@@ -60,7 +69,7 @@ def assert_close_to_numpy(body: msd.Body, kernel: NumbaKernel, springs=None) -> 
 def test_sorted_springs_keep_each_springs_values() -> None:
     body = shuffled_body()
     body.set_springs(slice(None, None, 4), damping=0.3)
-    a, b, k, rest, c = NumbaKernel()._sorted_edges(body)
+    a, b, k, rest, c = sorted_edges(body.edges(), len(body))
     assert np.all(np.diff(a.astype(np.int64)) >= 0)  # sorted by the first end
     order = np.lexsort((body.edges().b, body.edges().a))
     np.testing.assert_array_equal(b, body.edges().b[order])
@@ -82,24 +91,24 @@ def sorted_body() -> msd.Body:
 def test_springs_in_order_are_read_from_the_body() -> None:
     """Springs already sorted: the loop reads the body's own arrays, no copies."""
     body = sorted_body()
-    kernel = NumbaKernel()
-    _, _, k, _, _ = kernel._sorted_edges(body)
+    _, _, k, _, _ = sorted_edges(body.edges(), len(body))
     assert np.shares_memory(k, body.edges().values()[0])
     body.set_springs([4], stiffness=7.0)
-    assert_close_to_numpy(body, kernel)
+    assert_close_to_numpy(body, NumbaKernel())
 
 
-def test_reading_the_values_keeps_the_sorted_springs_and_editing_counts() -> None:
-    """Reading a spring array, or holding it, is no edit: the sorted springs are kept. The
-    arrays are read-only; an edit goes through `Body.set_springs` (or a whole array) and
-    counts."""
+def test_reading_the_values_keeps_the_layout_and_editing_counts() -> None:
+    """Reading a spring array, or holding it, is no edit: the layout (and the kernel's sorted
+    springs) is kept. The arrays are read-only; an edit goes through `Body.set_springs` (or a
+    whole array) and counts."""
     body = shuffled_body(3)
-    kernel = NumbaKernel()
-    before = forces_by(kernel, body)
-    kept = kernel._sorted_edges(body)[2]
+    dynamics = msd.Dynamics(body, kernel="numba")
+    kernel = dynamics.springs
+    kept = dynamics.layout
+    before = forces_by(kernel, body, layout=kept)
     held = body.edges().rest_lengths
-    assert kernel._sorted_edges(body)[2] is kept
-    assert_same(forces_by(kernel, body), before)
+    assert dynamics.layout is kept
+    assert_same(forces_by(kernel, body, layout=dynamics.layout), before)
     with pytest.raises(ValueError, match="read-only"):
         held[6] = 1.0
     for edit in (
@@ -111,9 +120,9 @@ def test_reading_the_values_keeps_the_sorted_springs_and_editing_counts() -> Non
         version = body.version
         edit()
         assert body.version == version + 1
-        assert kernel._sorted_edges(body)[2] is not kept
-        kept = kernel._sorted_edges(body)[2]
-        assert_close_to_numpy(body, kernel)
+        assert dynamics.layout is not kept
+        kept = dynamics.layout
+        assert_same(forces_by(kernel, body, layout=kept), forces_by(NumbaKernel(), body))
     version = body.version
     _ = (
         body.edges().stiffness * 2.0,
@@ -137,11 +146,13 @@ def test_springs_edited_between_steps(threaded: bool, monkeypatch: pytest.Monkey
         body.set_springs([step], stiffness=90.0 + step)
         body.set_springs([5 * step], rest_lengths=body.edges().rest_lengths[5 * step] * 1.25)
         body.set_springs([7 * step], damping=0.2)
-        fresh = NumbaKernel()
-        assert_same(forces_by(sim.dynamics.springs, body), forces_by(fresh, body))
-        assert_close_to_numpy(body, sim.dynamics.springs)
+        laid = sim.dynamics.layout
+        assert_same(
+            forces_by(sim.dynamics.springs, body, layout=laid), forces_by(NumbaKernel(), body)
+        )
     body.springs[9].stiffness = 3.0  # and through a Spring object
-    assert_same(forces_by(sim.dynamics.springs, body), forces_by(NumbaKernel(), body))
+    laid = sim.dynamics.layout
+    assert_same(forces_by(sim.dynamics.springs, body, layout=laid), forces_by(NumbaKernel(), body))
 
 
 def test_springs_subset_in_the_bodys_order() -> None:

@@ -10,6 +10,7 @@ import msdlab as msd
 import msdlab.engine.backends.numba.kernel as compiled_kernel
 from msdlab.engine.backends import numpy as numpy_backend
 from msdlab.engine.backends.contract import SpringKernel
+from msdlab.engine.backends.layout import Layout
 from msdlab.engine.backends.numba import NumbaKernel
 
 RTOL = 1e-12
@@ -52,7 +53,7 @@ def gathers(monkeypatch: pytest.MonkeyPatch) -> list[str]:
 
 def forces_by(kernel: SpringKernel, body: msd.Body) -> tuple[np.ndarray, float, float]:
     out = np.zeros_like(body.positions)
-    stretch, power = kernel.spring_forces(body, body.positions, body.velocities, out, None)
+    stretch, power = kernel.spring_forces(Layout(body), body.positions, body.velocities, out, None)
     return out, stretch, power
 
 
@@ -206,6 +207,6 @@ def test_shuffled_springs_sorted_for_the_edge_loop(
     body.set_springs([7], rest_lengths=body.edges().rest_lengths[7] * 1.5)
     assert_agree(body, kernel)
     touching = body.springs_touching(np.array([3, 8]))
-    assert kernel.elastic_energy(body, body.positions, touching) == pytest.approx(
+    assert kernel.elastic_energy(Layout(body), body.positions, touching) == pytest.approx(
         numpy_backend.elastic_energy(body, body.positions, touching), rel=RTOL
     )

@@ -11,6 +11,7 @@ import pytest
 
 import msdlab as msd
 from msdlab.engine.backends.choice import make_kernel
+from msdlab.engine.backends.layout import Layout
 from msdlab.engine.backends.numpy import NumpyKernel
 from msdlab.engine.model.lattice import LatticeSprings, grid_pairs, neighbour_offsets
 from msdlab.engine.model.springs import EdgeSprings
@@ -82,15 +83,15 @@ def test_the_lattice_gives_the_forces_of_its_springs(kernel: str) -> None:
         x, v = body.positions, body.velocities
         springs = make_kernel(kernel)
         forces = np.zeros_like(x)
-        stretch, power = springs.spring_forces(body, x, v, forces, None)
-        energy = springs.elastic_energy(body, x, None)
+        stretch, power = springs.spring_forces(Layout(body), x, v, forces, None)
+        energy = springs.elastic_energy(Layout(body), x, None)
         reference = NumpyKernel()
         expected = np.zeros_like(x)
         assert (stretch, power) == pytest.approx(
-            reference.spring_forces(twin, x, v, expected), rel=1e-12
+            reference.spring_forces(Layout(twin), x, v, expected), rel=1e-12
         )
         np.testing.assert_allclose(forces, expected, rtol=1e-12, atol=1e-12)
-        assert energy == pytest.approx(reference.elastic_energy(twin, x), rel=1e-12)
+        assert energy == pytest.approx(reference.elastic_energy(Layout(twin), x), rel=1e-12)
 
 
 @pytest.mark.parametrize("threads", [False, True])
@@ -150,8 +151,8 @@ def test_edits_of_a_lattice_are_for_all_its_springs_and_count(kernel: str) -> No
     assert edges.stiffness[5] == 900.0 and edges.stiffness[4] == 400.0
     x, v = body.positions, body.velocities
     forces, expected = np.zeros_like(x), np.zeros_like(x)
-    sim.dynamics.springs.spring_forces(body, x, v, forces, None)
-    NumpyKernel().spring_forces(body, x, v, expected)
+    sim.dynamics.springs.spring_forces(Layout(body), x, v, forces, None)
+    NumpyKernel().spring_forces(Layout(body), x, v, expected)
     np.testing.assert_allclose(forces, expected, rtol=1e-12, atol=1e-12)
     with pytest.raises(ValueError, match="damping"):
         body.set_springs(damping=-1.0)

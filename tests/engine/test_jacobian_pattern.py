@@ -8,8 +8,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 import msdlab as msd
-from msdlab.engine.backends import choice, jacobian
+from msdlab.engine.backends import choice
 from msdlab.engine.backends import numpy as numpy_backend
+from msdlab.engine.backends.layout import Layout
 from msdlab.engine.dynamics import Dynamics
 
 
@@ -75,15 +76,15 @@ def test_pattern_is_built_once_and_rebuilt_when_springs_change() -> None:
     body = shaken_grid(1)
     dynamics = Dynamics(body)
     first_x, first_v = dynamics.jacobians(body.positions, body.velocities)
-    pattern = dynamics._pattern
+    pattern = dynamics.layout.pattern
     body.positions[:] += 0.01
     second_x, _ = dynamics.jacobians(body.positions, body.velocities)
-    assert dynamics._pattern is pattern
+    assert dynamics.layout.pattern is pattern
     assert second_x.indptr is first_x.indptr is first_v.indptr  # same structure, new values
     assert not np.array_equal(second_x.data, first_x.data)
     body.add_springs([[0, len(body) - 1]], stiffness=5.0)
     third_x, _ = dynamics.jacobians(body.positions, body.velocities)
-    assert dynamics._pattern is not pattern
+    assert dynamics.layout.pattern is not pattern
     fresh_x, _ = fresh_jacobians(body, body.positions)
     np.testing.assert_allclose(third_x.toarray(), fresh_x.toarray(), rtol=1e-12, atol=1e-12)
 
@@ -110,8 +111,7 @@ def test_each_kernel_sums_the_blocks_a_fresh_assembly_sums(kernel: str, shape: t
         body.positions[:] += np.random.default_rng(3).normal(scale=0.03, size=(20, 2))
         body.springs_as_edges()  # values of their own per spring
         body.set_springs(slice(None, None, 2), damping=0.3)
-    pattern = jacobian.JacobianPattern(body)
-    jx, jv = choice.make_kernel(kernel).jacobians(body, body.positions, pattern)
+    jx, jv = choice.make_kernel(kernel).jacobians(Layout(body), body.positions)
     fresh_x, fresh_v = fresh_jacobians(body, body.positions)
     np.testing.assert_allclose(jx.toarray(), fresh_x.toarray(), rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(jv.toarray(), fresh_v.toarray(), rtol=1e-12, atol=1e-12)
@@ -122,8 +122,7 @@ def test_coincident_ends_give_an_isotropic_block(kernel: str) -> None:
     body = msd.Body.from_arrays([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]], [[0, 1]], stiffness=7.0)
     body.set_springs(damping=0.5)
     body.positions[1] = body.positions[0]
-    pattern = jacobian.JacobianPattern(body)
-    jx, jv = choice.make_kernel(kernel).jacobians(body, body.positions, pattern)
+    jx, jv = choice.make_kernel(kernel).jacobians(Layout(body), body.positions)
     block = 7.0 * np.eye(3)
     np.testing.assert_array_equal(jx.toarray(), np.block([[-block, block], [block, -block]]))
     np.testing.assert_array_equal(jv.toarray(), np.zeros((6, 6)))

@@ -11,6 +11,7 @@ import msdlab as msd
 from msdlab.engine import equations
 from msdlab.engine.backends import choice
 from msdlab.engine.backends import numpy as numpy_backend
+from msdlab.engine.backends.layout import Layout
 from msdlab.engine.dynamics import Dynamics
 
 RTOL = 1e-12
@@ -68,14 +69,14 @@ def test_kernel_matches_spring_objects(
     assert springs.name == kernel
     forces, energy, power = per_spring(body)
     out = np.ones_like(x)  # the kernel adds to what is there
-    stretch, fused_power = springs.spring_forces(body, x, v, out, None)
+    stretch, fused_power = springs.spring_forces(Layout(body), x, v, out, None)
     assert_close(out - 1.0, forces, np.abs(forces).max())
     assert stretch == pytest.approx(max(s.length() / s.rest_length for s in body.springs), RTOL)
     assert fused_power == pytest.approx(power, rel=RTOL) and power > 0
-    assert springs.elastic_energy(body, x, None) == pytest.approx(energy, rel=RTOL)
+    assert springs.elastic_energy(Layout(body), x, None) == pytest.approx(energy, rel=RTOL)
     some = body.springs_touching(np.array([1, 5, 6]))
     by_objects = sum(body.springs[int(s)].energy() for s in some)
-    assert springs.elastic_energy(body, x, some) == pytest.approx(by_objects, rel=RTOL)
+    assert springs.elastic_energy(Layout(body), x, some) == pytest.approx(by_objects, rel=RTOL)
 
 
 def test_public_numpy_functions_match_spring_objects() -> None:
@@ -84,7 +85,7 @@ def test_public_numpy_functions_match_spring_objects() -> None:
     forces, energy, power = per_spring(body)
     assert_close(numpy_backend.spring_forces(body, x, v)[0], forces, np.abs(forces).max())
     assert numpy_backend.elastic_energy(body, x) == pytest.approx(energy, rel=RTOL)
-    dashpots = numpy_backend.NumpyKernel().spring_forces(body, x, v, np.zeros_like(x)).power
+    dashpots = numpy_backend.NumpyKernel().spring_forces(Layout(body), x, v, np.zeros_like(x)).power
     assert dashpots == pytest.approx(power, rel=RTOL)
 
 

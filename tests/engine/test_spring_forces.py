@@ -7,6 +7,7 @@ from hypothesis.extra.numpy import arrays
 
 import msdlab as msd
 from msdlab.engine.backends import numpy as numpy_backend
+from msdlab.engine.backends.layout import Layout
 
 coordinates = st.floats(-3.0, 3.0, allow_nan=False, allow_infinity=False)
 
@@ -50,7 +51,9 @@ def dashpot_power(body: msd.Body) -> float:
     """The power (W) the dashpots take, from the numpy kernel's pass over the springs."""
     x = body.positions
     return (
-        numpy_backend.NumpyKernel().spring_forces(body, x, body.velocities, np.zeros_like(x)).power
+        numpy_backend.NumpyKernel()
+        .spring_forces(Layout(body), x, body.velocities, np.zeros_like(x))
+        .power
     )
 
 

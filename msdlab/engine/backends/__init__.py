@@ -5,6 +5,6 @@
   readable numpy one while a debugger traces the program);
 - `numpy`: the readable reference, the equations on whole arrays;
 - `numba`: the same equations compiled into loops (the default), loaded only when chosen;
-- `host`: the state and edge list both CPU backends keep; `jacobian`: the sparsity of the
-  springs' Jacobians, shared by every backend.
+- `layout`: the body as the arrays every backend reads, laid out once per edit; `jacobian`:
+  the sparsity of the springs' Jacobians, part of the layout.
 """

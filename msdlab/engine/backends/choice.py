@@ -9,13 +9,13 @@ import warnings
 from .contract import SpringKernel
 from .numpy import NumpyKernel
 
-KERNELS = ("numba", "numpy")
+KERNELS = ("numba", "numpy", "warp")
+CHOICES = (*KERNELS, "auto")  # "auto": warp on a GPU, numba elsewhere
 
 
 def default_kernel() -> str:
-    """The spring kernel to use: ``MSDLAB_KERNEL`` if set; else "numpy" while a debugger
-    traces the program (`sys.gettrace`), so its breakpoints in `msdlab.engine.equations` and in
-    an integrator's update stop; else "numba".
+    """The spring kernel to use: ``MSDLAB_KERNEL`` if set, else "numba" (while a debugger
+    traces the program, a step runs on "numpy" all the same: `stepping_backend`).
 
     "numba" is the compiled loop of `msdlab.engine.backends.numba`; "numpy" is the readable
     array version of `msdlab.engine.backends.numpy`. Both apply the same `msdlab.engine.equations`.
@@ -23,7 +23,7 @@ def default_kernel() -> str:
     name = os.environ.get("MSDLAB_KERNEL", "").strip().lower()
     if name:
         return checked_kernel_name(name, "MSDLAB_KERNEL")
-    return "numpy" if sys.gettrace() is not None else "numba"
+    return "numba"
 
 
 def kernel_left_to_msdlab(name: str | None) -> bool:
@@ -32,10 +32,18 @@ def kernel_left_to_msdlab(name: str | None) -> bool:
     return name is None and not os.environ.get("MSDLAB_KERNEL", "").strip()
 
 
+def stepping_backend(chosen: SpringKernel, readable: SpringKernel) -> SpringKernel:
+    """The backend of the next step of a simulation that asked for no kernel: the readable
+    one while a debugger traces the program (`sys.gettrace`), so that its breakpoints in
+    `msdlab.engine.equations` and in an integrator's update stop; else the ``chosen`` one.
+    The one place a debugger changes what runs."""
+    return readable if sys.gettrace() is not None else chosen
+
+
 def checked_kernel_name(name: str, what: str) -> str:
     """``name`` if it is a kernel's name, else a ValueError naming ``what`` and the choices."""
-    if name not in KERNELS:
-        raise ValueError(f"{what} must be one of {', '.join(KERNELS)}, got {name!r}")
+    if name not in CHOICES:
+        raise ValueError(f"{what} must be one of {', '.join(CHOICES)}, got {name!r}")
     return name
 
 
@@ -58,8 +66,12 @@ def make_kernel(name: str | None = None) -> SpringKernel:
     install), this warns and returns the numpy kernel, which computes the same.
     """
     name = default_kernel() if name is None else checked_kernel_name(name, "kernel")
+    if name == "auto":
+        name = "warp" if gpu_present() else "numba"
     if name == "numpy":
         return NumpyKernel()
+    if name == "warp":
+        return warp_kernel()
     try:
         from .numba import NumbaKernel  # the one optional, compiled backend
     except ImportError as error:
@@ -71,3 +83,28 @@ def make_kernel(name: str | None = None) -> SpringKernel:
         )
         return NumpyKernel()
     return NumbaKernel()
+
+
+def gpu_present() -> bool:
+    """Whether Warp is installed and sees a CUDA device (``kernel="auto"`` then picks it)."""
+    try:
+        import warp
+    except ImportError:
+        return False
+    return warp.get_cuda_device_count() > 0
+
+
+def warp_kernel() -> SpringKernel:
+    """The Warp backend (`msdlab.engine.backends.warp`) in the precision
+    ``MSDLAB_WARP_PRECISION`` names ("float64", the default, or "float32"), or an
+    ImportError saying how to install Warp."""
+    precision = os.environ.get("MSDLAB_WARP_PRECISION", "").strip().lower() or "float64"
+    if precision not in ("float64", "float32"):
+        raise ValueError(f"MSDLAB_WARP_PRECISION must be float64 or float32, got {precision!r}")
+    try:
+        from .warp import WarpKernel
+    except ImportError as error:
+        raise ImportError(
+            f'kernel="warp" needs NVIDIA Warp ({error}); install it with pip install "msdlab[warp]"'
+        ) from None
+    return WarpKernel(precision=precision)

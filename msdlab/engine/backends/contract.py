@@ -4,27 +4,27 @@ A backend computes, for all springs of a body at once, what `Spring.force` compu
 one (eq. 1.1-1.2 with the dashpot), their energy and Jacobians, and steps the particles
 with an integrator's update; it also checks the state, sums the work of an integrator's
 velocity factor and clamps particles to the ground, booking the energy that takes out.
-It holds the state it steps: the simulation loads the body's positions and velocities
-into it (`load`) and asks for them (`state`) where it needs arrays. `SpringKernel` is the
-whole contract, nine methods, none optional; nothing else asks a backend for more, and
-nothing asks which one runs: `numpy.NumpyKernel` (readable, whole arrays, the reference
-every backend is tested against) or `numba.NumbaKernel` (compiled loops, the default).
-Both apply the same `msdlab.engine.equations`, and both keep the host's arrays as the
-state (`host.HostState`: loading and asking copy nothing). What the methods return is
-named here too (`SpringSums`, `Jacobians`, `Advanced`); `choice` picks the backend.
+`SpringKernel` is the whole contract, seven methods, none optional; nothing else asks a
+backend for more, and nothing asks which one runs: `numpy.NumpyKernel` (readable, whole
+arrays, the reference every backend is tested against) or `numba.NumbaKernel` (compiled
+loops, the default). Both apply the same `msdlab.engine.equations`.
+
+A backend is given what it reads as values: the body laid out as arrays once per edit
+(`layout.Layout`), the state (x, v) at every call; it returns values (`SpringSums`,
+`Jacobians`, `Advanced`: the new state as arrays no one else holds, which the
+simulation hands back at the next step), and sets nothing for another class to read.
+`choice` picks the backend.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING, NamedTuple, Protocol
+from typing import NamedTuple, Protocol
 
 import numpy as np
 import scipy.sparse as sp
 
-if TYPE_CHECKING:
-    from ..model.body import Body
-    from .jacobian import JacobianPattern
+from .layout import Layout
 
 
 class SpringSums(NamedTuple):
@@ -58,30 +58,17 @@ Update = Callable[..., tuple[np.ndarray, np.ndarray]]
 class SpringKernel(Protocol):
     """What a backend provides; `NumpyKernel` and `NumbaKernel` have all of it.
 
-    ``body`` is a `Body` (its spring arrays ``spring_a``, ``spring_b``,
-    ``spring_values``; ``masses``, ``fixed``), ``x`` and ``v`` are positions (m) and
-    velocities (m/s), (N, d) float64 with d = 2 or 3. ``springs`` (indices) restricts
-    a method to some springs.
+    ``layout`` is the body's springs, masses and fixed particles as arrays (`Layout`, laid
+    out once per edit of the body: a backend never reads a `Body`), ``x`` and ``v`` are
+    positions (m) and velocities (m/s), (N, d) float64 with d = 2 or 3. ``springs``
+    (indices) restricts a method to some springs.
     """
 
     name: str
 
-    def load(self, x: np.ndarray, v: np.ndarray) -> None:
-        """Step from positions ``x`` (m) and velocities ``v`` (m/s), host arrays (N, d): the
-        body's state when a public call of the simulation starts, the step's end state after
-        each step. A CPU backend keeps the arrays; a GPU one would copy them to the device
-        unless they are the ones its `state` handed out."""
-
-    def state(self) -> tuple[np.ndarray, np.ndarray]:
-        """The positions (m) and velocities (m/s) being stepped, as host arrays (N, d), for
-        the integrator's step, the constraints, a recorded frame and the body at the end of
-        a public call. A CPU backend returns the arrays loaded; a GPU one would return its
-        arrays in managed memory, which the host reads without a copy (the architecture
-        page's GPU backend)."""
-
     def spring_forces(
         self,
-        body: Body,
+        layout: Layout,
         x: np.ndarray,
         v: np.ndarray,
         out: np.ndarray,
@@ -90,11 +77,14 @@ class SpringKernel(Protocol):
         """Add the spring and dashpot forces (N), eq. (1.1)-(1.2), to ``out`` (N, d); with the
         largest stretch and the dashpots' power (W) of the same pass."""
 
-    def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
+    def elastic_energy(
+        self, layout: Layout, x: np.ndarray, springs: np.ndarray | None = None
+    ) -> float:
         """Energy (J) stored in the springs, Σ ½ k (|x_a - x_b| - l)²."""
 
-    def jacobians(self, body: Body, x: np.ndarray, pattern: JacobianPattern) -> Jacobians:
-        """∂F/∂x and ∂F/∂v of the springs on ``pattern`` (see `backends.numpy.spring_jacobians`)."""
+    def jacobians(self, layout: Layout, x: np.ndarray) -> Jacobians:
+        """∂F/∂x and ∂F/∂v of the springs on the layout's pattern (`Layout.pattern`; see
+        `backends.numpy.spring_jacobians`)."""
 
     def finite(self, x: np.ndarray, v: np.ndarray) -> bool:
         """Whether every position and velocity (N, d) is a finite number."""
@@ -102,7 +92,7 @@ class SpringKernel(Protocol):
     def advance(
         self,
         update: Update,
-        body: Body,
+        layout: Layout,
         x: np.ndarray,
         v: np.ndarray,
         field: np.ndarray,

@@ -10,11 +10,12 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..model.body import Body
+from ..model.springs import EdgeSprings
 
 
 class JacobianPattern:
-    """Sparsity of the spring Jacobians (N·d × N·d, CSR), built once per topology.
+    """Sparsity of the spring Jacobians (N·d × N·d, CSR) of the springs ``edges`` between
+    ``n_particles`` particles in ``dim`` dimensions, built once per topology (`Layout.pattern`).
 
     Holds the rows and columns of every (a, a), (b, b), (a, b), (b, a) block and
     of the whole diagonal (``diagonal``: where each (i, i) is in the values),
@@ -23,22 +24,19 @@ class JacobianPattern:
     (a, a) and (b, b), +B on (a, b) and (b, a): refilling is one sparse product.
     """
 
-    def __init__(self, body: Body) -> None:
-        dim = body.dim or 3
-        n_dof = body.n_particles * dim
-        edges = body.edges()
+    def __init__(self, edges: EdgeSprings, n_particles: int, dim: int) -> None:
+        n_dof = n_particles * dim
         rows, cols = _block_indices(edges.a, edges.b, dim)
         diagonal = np.arange(n_dof, dtype=np.int64)
         keys = np.concatenate([rows * n_dof + cols, diagonal * (n_dof + 1)])
         unique, inverse = np.unique(keys, return_inverse=True)
-        self.version = body.version
         self.shape = (n_dof, n_dof)
         index = np.int32 if len(unique) < 2**31 else np.int64  # what scipy would convert to
         self.indices = (unique % max(n_dof, 1)).astype(index)
         self.indptr = np.zeros(n_dof + 1, dtype=index)
         np.cumsum(np.bincount(unique // max(n_dof, 1), minlength=n_dof), out=self.indptr[1:])
         self.diagonal = np.searchsorted(unique, diagonal * (n_dof + 1))  # where (i, i) is
-        block_entries = body.n_springs * dim * dim
+        block_entries = edges.count * dim * dim
         signs = np.repeat([-1.0, -1.0, 1.0, 1.0], block_entries)
         entry = np.tile(np.arange(block_entries), 4)
         self.assemble = sp.csr_matrix(

@@ -9,9 +9,9 @@ backend is tested against it, method by method. The numba backend
 spring or particle at a time in compiled loops.
 
 Every function reads a body's springs as an edge list (`springs.EdgeSprings`: ``a``,
-``b`` particle indices, stiffness, rest lengths, dashpots; `Body.edges`, which lays a
-lattice out) and computes, for all springs at once, what `Spring.force` computes for
-one. `NumpyKernel` keeps a lattice's edge list, laid out once per edit.
+``b`` particle indices, stiffness, rest lengths, dashpots; a lattice laid out) and
+computes, for all springs at once, what `Spring.force` computes for one. `NumpyKernel`
+reads them from the `layout.Layout` it is given, which lays a lattice out once per edit.
 """
 
 from __future__ import annotations
@@ -22,8 +22,8 @@ from .. import equations
 from ..model.body import Body
 from ..model.springs import EdgeSprings
 from .contract import Advanced, Jacobians, SpringSums, Update
-from .host import HostState, KeptEdges
 from .jacobian import JacobianPattern
+from .layout import Layout
 
 
 def spring_vectors(body: Body, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -58,7 +58,7 @@ def spring_forces(
     restricts the sum to some springs (indices).
     """
     out = np.zeros_like(x) if out is None else out
-    return out, NumpyKernel().spring_forces(body, x, v, out, springs).stretch
+    return out, NumpyKernel().spring_forces(Layout(body), x, v, out, springs).stretch
 
 
 def elastic_energy(body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
@@ -79,28 +79,27 @@ def spring_jacobians(
     body: Body, x: np.ndarray, pattern: JacobianPattern | None = None
 ) -> Jacobians:
     """∂F/∂x and ∂F/∂v (N·d × N·d, sparse) of the spring and dashpot forces (`jacobians`)."""
-    return jacobians(body.edges(), x, JacobianPattern(body) if pattern is None else pattern)
+    layout = Layout(body)
+    return jacobians(layout.edges, x, layout.pattern if pattern is None else pattern)
 
 
 def jacobians(edges: EdgeSprings, x: np.ndarray, pattern: JacobianPattern) -> Jacobians:
     """`spring_jacobians` of the springs ``edges``, on the sparsity ``pattern`` of an
     earlier call on the same springs.
 
-    Per spring with n = d/|d|, the stiffness block is B = k n nᵀ + k_t (I - n nᵀ),
-    k_t = `equations.transverse_stiffness`, and the dashpot block is C = c n nᵀ.
-    Both enter as -B on the (a, a) and (b, b) blocks and +B on (a, b) and (b, a).
+    Per spring with n = d/|d|, the stiffness block B = k n nᵀ + k_t (I - n nᵀ) and the
+    dashpot block C = c n nᵀ of `equations.spring_jacobian`, -B on the (a, a) and (b, b)
+    blocks and +B on (a, b) and (b, a).
     """
     dim = x.shape[1]
     d = x.take(edges.a, axis=0) - x.take(edges.b, axis=0)
     stiffness, rest, damping = edges.values()
     length, safe, _, _ = equations.spring_state(stiffness, rest, 0.0, three(d))
     n = d / safe[:, None]  # 0 for coincident ends: B = k I
-    outer = n[:, :, None] * n[:, None, :]
     across = equations.transverse_stiffness(stiffness, rest, length, safe)[:, None, None]
-    stiff = (stiffness[:, None, None] - across) * outer + across * np.eye(dim)
-    return Jacobians(
-        *pattern.jacobians(stiff, damping[:, None, None] * outer if damping.any() else None)
-    )
+    k, c = stiffness[:, None, None], damping[:, None, None]
+    stiff, damp = equations.spring_jacobian(k, across, c, n[:, :, None], n[:, None, :], np.eye(dim))
+    return Jacobians(*pattern.jacobians(stiff, damp if damping.any() else None))
 
 
 def finite(x: np.ndarray, v: np.ndarray) -> bool:
@@ -146,12 +145,11 @@ def ground_clamp(
     return float(np.sum(removed))
 
 
-class NumpyKernel(HostState, KeptEdges):
+class NumpyKernel:
     """The readable kernel (`contract.SpringKernel`): the equations on whole arrays.
 
-    It reads a body's springs as an edge list: an edge list's own arrays, or a
-    lattice laid out once per edit (``body.version``, `KeptEdges`). The state it steps
-    is the host's arrays (`HostState`).
+    It reads a body's springs as the edge list of the `Layout` it is given (a lattice laid
+    out once per edit).
     """
 
     name = "numpy"
@@ -161,7 +159,7 @@ class NumpyKernel(HostState, KeptEdges):
 
     def spring_forces(
         self,
-        body: Body,
+        layout: Layout,
         x: np.ndarray,
         v: np.ndarray,
         out: np.ndarray,
@@ -169,9 +167,7 @@ class NumpyKernel(HostState, KeptEdges):
     ) -> SpringSums:
         """Add `spring_forces` to ``out`` (N, d); with the largest stretch and the power (W)
         the dashpots take at (x, v), Σ c ((v_a - v_b)·n)²."""
-        kept = self._edges  # `edges`, its check written out: no call a step
-        same = kept[0] is body.spring_set and kept[1] == body.version
-        edges = kept[2] if same else self.edges(body)
+        edges = layout.edges
         a, b, stiffness, rest, damping = (
             edges.a, edges.b, edges.stiffness, edges.rest_lengths, edges.damping
         )  # fmt: skip
@@ -183,26 +179,27 @@ class NumpyKernel(HostState, KeptEdges):
         w = None  # v_a - v_b, needed only with dashpots
         if damping.any():
             w = (*(v.take(a, axis=0) - v.take(b, axis=0)).T, 0.0)[:3]
-        length, _, rate, _ = equations.spring_state(stiffness, rest, damping, d, w)
+        f, length, rate = equations.spring_force(stiffness, rest, damping, d, w)
         power = 0.0 if w is None else float(np.sum(equations.dashpot_power(damping, rate)))
-        f = equations.spring_force(stiffness, rest, damping, d, w)
         for q in range(x.shape[1]):  # eq. (1.1): f on each a, -f on each b
             out[:, q] += np.bincount(a, f[q], len(x)) - np.bincount(b, f[q], len(x))
         stretch = float((length / rest).max()) if len(length) else 0.0
         return SpringSums(stretch, power)
 
-    def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
+    def elastic_energy(
+        self, layout: Layout, x: np.ndarray, springs: np.ndarray | None = None
+    ) -> float:
         """`energy` of the body's springs (J)."""
-        return energy(self.edges(body), x, springs)
+        return energy(layout.edges, x, springs)
 
-    def jacobians(self, body: Body, x: np.ndarray, pattern: JacobianPattern) -> Jacobians:
-        """`jacobians` of the body's springs."""
-        return jacobians(self.edges(body), x, pattern)
+    def jacobians(self, layout: Layout, x: np.ndarray) -> Jacobians:
+        """`jacobians` of the body's springs, on the layout's pattern."""
+        return jacobians(layout.edges, x, layout.pattern)
 
     def advance(
         self,
         update: Update,
-        body: Body,
+        layout: Layout,
         x: np.ndarray,
         v: np.ndarray,
         field: np.ndarray,
@@ -213,10 +210,15 @@ class NumpyKernel(HostState, KeptEdges):
         """``update(x, v, a, dt, *coefficients)`` on whole arrays, a = (F + m·g)/m (0 if fixed):
         F the spring forces plus ``forces`` (N, d) if given, g = ``field`` (d,) in m/s²."""
         total = np.zeros_like(x)
-        sums = self.spring_forces(body, x, v, total)
+        sums = self.spring_forces(layout, x, v, total)
         total = total if forces is None else total + forces
-        masses = body.masses[:, None]
+        masses = layout.masses[:, None]
         if field.any():
             total += masses * field
-        a = equations.acceleration(total, masses, ~body.fixed[:, None])
-        return Advanced(*update(x, v, a, dt, *coefficients), *sums)
+        a = equations.acceleration(total, masses, ~layout.fixed[:, None])
+        x_new, v_new = update(x, v, a, dt, *coefficients)
+        if np.may_share_memory(x_new, x) or np.may_share_memory(x_new, v):
+            x_new = np.array(x_new)  # an update that returned x: new arrays all the same
+        if np.may_share_memory(v_new, v) or np.may_share_memory(v_new, x):
+            v_new = np.array(v_new)
+        return Advanced(x_new, v_new, *sums)

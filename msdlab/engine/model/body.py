@@ -140,20 +140,17 @@ class Body:
             self.spring_set = edges
         return edges
 
-    def new_state(self) -> tuple[np.ndarray, np.ndarray]:
-        """Empty arrays (N, d) for a step's new positions and velocities (`store_state`)."""
-        new = (np.empty_like(self.positions), np.empty_like(self.velocities))
-        vars(self).update(_new_state=new)  # every step: past `__setattr__`
-        return new
-
     def store_state(self, positions: np.ndarray, velocities: np.ndarray) -> None:
-        """Make ``positions`` (m) and ``velocities`` (m/s), (N, d), the body's state: those of
-        the last `new_state` uncopied (arrays read before keep the old state), others copied."""
-        new = vars(self).pop("_new_state", ())
-        if new and positions is new[0] and velocities is new[1] and len(positions) == len(self):
-            vars(self).update(positions=positions, velocities=velocities)  # past `__setattr__`
-        else:
-            self.positions[...], self.velocities[...] = positions, velocities
+        """Make ``positions`` (m) and ``velocities`` (m/s), float arrays (N, d), the body's
+        state, uncopied: the caller hands them over and writes them no more (a simulation's
+        new state after a step; arrays read before keep the old state)."""
+        for name, array in (("positions", positions), ("velocities", velocities)):
+            if array.shape != self.positions.shape or array.dtype != self.positions.dtype:
+                raise ValueError(
+                    f"a state of {array.dtype} {array.shape} cannot be the body's {name}: it "
+                    f"has {len(self)} particles in {self.positions.shape[1]}-D, float64"
+                )
+        vars(self).update(positions=positions, velocities=velocities)  # past `__setattr__`
 
     @classmethod
     def from_arrays(

@@ -45,6 +45,11 @@ class Constraint(ABC):
     def check(self, body: Body) -> None:
         """Raise ValueError if this constraint cannot act on ``body``."""
 
+    def plane(self, body: Body) -> tuple[np.ndarray, float, float] | None:
+        """(unit normal (d,), height in m, friction) if this constraint is a ground plane a
+        device backend clamps to in its own step (`Simulation`); None for any other."""
+        return None
+
     @abstractmethod
     def apply(self, state: StepState) -> float:
         """Edit ``state.x``/``state.v``; return the energy removed (J)."""

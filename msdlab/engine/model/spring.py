@@ -91,7 +91,7 @@ class Spring(Bound):
         x_a, x_b, v_a, v_b = self._ends()
         d, w = np.zeros(3), np.zeros(3)  # three coordinates, the third 0 in 2-D
         d[: len(x_a)], w[: len(x_a)] = x_a - x_b, v_a - v_b
-        f = equations.spring_force(self.stiffness, self.rest_length, self.damping, d, w)
+        f = equations.spring_force(self.stiffness, self.rest_length, self.damping, d, w)[0]
         return np.array(f[: len(x_a)])
 
     def energy(self) -> float:

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import math
-import sys
 from collections import defaultdict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import partial
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -21,6 +21,9 @@ from ..model.forces import Force
 from ..model.units import SI, Units
 from .energy import EnergyLedger, kinetic_energy
 from .stability import describe_blowup
+
+if TYPE_CHECKING:
+    from ..backends.contract import SpringKernel
 
 
 @dataclass
@@ -128,97 +131,42 @@ class Simulation:
     def step(self) -> None:
         """Advance the body by one step of ``dt``.
 
-        Integrate, apply the constraints, book the energy each mechanism took out,
-        check for divergence, and store the new state in the body: read
-        ``body.positions`` and ``body.velocities`` again after a step, as arrays
-        read before may still hold the old state. Edits of the body's state made
-        before the call are where the step starts.
+        Integrate, apply the constraints, book the energy each mechanism took out, check for
+        divergence, and make the new state the body's: read ``body.positions`` and
+        ``body.velocities`` again after a step, as arrays read before hold the old state.
+        Edits of the body's state made before the call are where the step starts.
+
+        The ledger books the dashpots and the dissipative forces at their power at the
+        step's first pass over the springs, where it starts (`Step.powers`), the
+        integrator's damping (`Integrator.dissipated_energy`, summed by the backend), and
+        what each constraint returns.
         """
-        self._load()
-        self._step()
-        self._store()
-
-    def _load(self) -> None:
-        """Hand the body's state to the backend: where a public call starts stepping."""
-        self.dynamics.springs.load(self.body.positions, self.body.velocities)
-
-    def _store(self) -> None:
-        """Make the backend's state the body's (a CPU backend's arrays, uncopied)."""
-        x, v = self.dynamics.springs.state()
-        if x is not self.body.positions or v is not self.body.velocities:
-            self.body.store_state(x, v)
-
-    def _step(self) -> None:
-        """One step of the backend's state, kept there (`step` without loading and storing)."""
+        if hasattr(self.dynamics.springs, "step") and self._device_steps(1, "step"):
+            return  # a device backend's whole step
         body, dt, dynamics = self.body, self._dt, self.dynamics
-        if dynamics.readable is not None:  # a debugger attached since reaches the equations
-            dynamics.choose(dynamics.readable if sys.gettrace() else dynamics.chosen)
-        kernel = dynamics.springs
-        x, v = kernel.state()
-        dynamics.opening, dynamics.advanced = None, (None, None)  # the integrator's step fills in
-        x_new, v_new = self._integrate(x, v)
+        x, v = body.positions, body.velocities
+        step = dynamics.step(self.integrator, x, v, dt)
+        x_new, v_new = step.x, step.v
         energy_of = partial(self._energy, x_new, v_new) if self.ledger else _unbooked
-        state = StepState(body, x, v, x_new, v_new, self.time + dt, dt, energy_of, kernel)
+        state = StepState(body, x, v, x_new, v_new, self.time + dt, dt, energy_of, dynamics.springs)
         removed = []
         for constraint in self.constraints:
             removed.append((constraint.ledger_name, constraint.apply(state)))
         if self.ledger:  # after the constraints: the integrator's damping works at the final v
-            self._book(v, v_new, removed)
-        stretched = self.max_stretch is not None and dynamics.max_stretch > self.max_stretch
-        if stretched or not kernel.finite(x_new, v_new):
+            powers = dynamics.powers(x, v) if step.powers is None else step.powers
+            for name, power in powers.items():
+                self.dissipated[name] += power * dt
+            self.dissipated["integrator"] += self.integrator.dissipated_energy(
+                v, body.masses, v_new, kernel=dynamics.springs
+            )
+            for name, energy in removed:
+                self.dissipated[name] += energy
+        stretched = self.max_stretch is not None and step.stretch > self.max_stretch
+        if stretched or not dynamics.springs.finite(x_new, v_new):
             raise self._divergence(x, x_new, v_new)
-        kernel.load(x_new, v_new)
+        body.store_state(x_new, v_new)
         self.time += dt
         self.step_count += 1
-
-    def _integrate(self, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The integrator's step from (x, v) as new float arrays of the body's shape, with
-        the fixed particles kept where they are, at rest.
-
-        The arrays become the state the backend steps next, so they must be no one else's:
-        those the backend's `advance` made in this step are kept, any other (an integrator's
-        own buffers, its arithmetic on arrays) is copied, as storing it in the body did."""
-        result = self.integrator.step(x, v, self._dt, self.dynamics)
-        try:
-            x_new, v_new = result
-        except (TypeError, ValueError):
-            raise TypeError(
-                f"{self.integrator!r}.step must return (x_new, v_new), got {type(result).__name__}"
-            ) from None
-        arrays = []
-        for name, array, made in zip(("x_new", "v_new"), (x_new, v_new), self.dynamics.advanced):
-            array = np.asarray(array, dtype=float)
-            if array.shape != x.shape:
-                raise ValueError(
-                    f"{self.integrator!r}.step returned {name} of shape {array.shape}; "
-                    f"it must have the shape of the positions, {x.shape}"
-                )
-            arrays.append(
-                array if array is made and made is not x and made is not v else array.copy()
-            )
-        x_new, v_new = arrays
-        fixed = self.body.fixed
-        if np.count_nonzero(fixed):  # faster than fixed.any() on a few rows
-            pinned = np.flatnonzero(fixed)  # indices: a mask costs 68 µs on 16 384 rows
-            x_new[pinned] = x[pinned]
-            v_new[pinned] = 0.0
-        return x_new, v_new
-
-    def _book(self, v: np.ndarray, v_new: np.ndarray, removed: list[tuple[str, float]]) -> None:
-        """Add to `dissipated` the energy (J) each mechanism took out in the step from the
-        body's state, velocities ``v``, to velocities ``v_new``: the dashpots and the
-        dissipative forces at the power of the step's pass there (`Dynamics.opening`), the
-        integrator's damping (`Integrator.dissipated_energy`, summed by the backend), and
-        the constraints (``removed``: (ledger name, energy) of each)."""
-        dynamics, dt = self.dynamics, self._dt
-        powers = dynamics.opening or dynamics.powers_now()  # the integrator's pass, if it took one
-        for name, power in powers.items():
-            self.dissipated[name] += power * dt
-        self.dissipated["integrator"] += self.integrator.dissipated_energy(
-            v, self.body.masses, v_new, kernel=dynamics.springs
-        )
-        for name, energy in removed:
-            self.dissipated[name] += energy
 
     def run(
         self,
@@ -227,37 +175,122 @@ class Simulation:
         record_every: int = 1,
         record_velocities: bool = False,
         callback: Callable[[Simulation], None] | None = None,
+        sync: str = "step",
     ) -> Trajectory:
         """Run ``steps`` steps (or ``duration`` seconds) and return the recorded frames.
 
         A frame is recorded at the start, every ``record_every`` steps and at the
-        end. ``callback(sim)`` is called after every step (e.g. a progress bar). The body
-        holds the state at each frame, in each callback (which may edit it) and at the end,
-        also when the run diverges; in between, the backend holds it.
+        end. ``callback(sim)`` is called after every step (e.g. a progress bar); it may edit
+        the body. The body holds the state after every step, also when the run diverges;
+        on a backend that runs whole steps on a device (Warp), at every frame and at the
+        end (the state stays on the device in between). There, ``sync="frame"`` runs the
+        steps between two frames as one captured frame (a CUDA graph on a GPU) whose ledger
+        numbers come back once, not once a step (`_device_steps`).
         """
         steps = self._count_steps(steps, duration)
         if isinstance(record_every, bool) or not isinstance(record_every, int) or record_every < 1:
             raise ValueError(f"record_every must be an integer >= 1, got {shown(record_every)}")
+        if sync not in ("step", "frame"):
+            raise ValueError(f'sync must be "step" or "frame", got {shown(sync)}')
+        batch = 1 if callback is not None else record_every  # steps a device may take at once
         ledger = EnergyLedger()
         frames: list[tuple[int, float, np.ndarray, np.ndarray | None]] = []
         record = partial(self._record, frames, ledger, dict(self.dissipated), record_velocities)
-        self._load()
         record()
         try:
-            for i in range(1, steps + 1):
-                self._step()
-                if i % record_every == 0 or i == steps:
+            done = 0
+            while done < steps:
+                done += self._steps(min(batch - done % batch, steps - done), sync)
+                if done % record_every == 0 or done == steps:
                     record()
                 if callback is not None:  # it sees the body's state, and may edit it
-                    self._store()
                     callback(self)
-                    self._load()
         except SimulationDiverged as error:
             error.trajectory = self._trajectory(frames, ledger)
             raise
-        finally:
-            self._store()
         return self._trajectory(frames, ledger)
+
+    def _steps(self, count: int, sync: str) -> int:
+        """``count`` steps on a device backend where they run whole there
+        (`_device_steps`), else one `step`; the number of steps taken."""
+        if hasattr(self.dynamics.springs, "step") and self._device_steps(count, sync):
+            return count
+        self.step()
+        return 1
+
+    def _device_steps(self, count: int, sync: str) -> bool:
+        """``count`` whole steps on the backend's device (`WarpKernel.step`, or one captured
+        frame of them with ``sync="frame"``, `WarpKernel.frame`), from the body's state, which
+        then adopts the device's: an update integrator (`Integrator.update_step`), uniform
+        fields as forces, at most a ground plane as constraint. False, with nothing done, for
+        any other step, or an update Warp cannot compile (the host steps it)."""
+        kernel, plan = self.dynamics.springs, self._device_plan()
+        if plan is None:
+            return False
+        kernel.load(self.body.positions, self.body.velocities)
+        if sync == "frame" and count > 1:
+            rows = kernel.frame(count, *plan)
+            if rows is None:
+                return False
+            limit = np.inf if self.max_stretch is None else self.max_stretch
+            if rows[:, 4].any() or (rows[:, 0] > limit).any():
+                kernel.undo_frame()  # again from the frame's start, to stop where it blew up
+                self._device_each(kernel, plan, count)
+            else:
+                for stretch, power, damping, ground, _ in rows.tolist():
+                    self._book_device(stretch, power, damping, ground)
+        elif not self._device_each(kernel, plan, count):
+            return False
+        self.body.store_state(*kernel.state())
+        return True
+
+    def _device_each(self, kernel: SpringKernel, plan: tuple, count: int) -> bool:
+        """``count`` device steps, their sums read and booked after each; at a blow-up the body
+        gets the state before it and `SimulationDiverged` is raised. False if not compiled."""
+        for _ in range(count):
+            sums = kernel.step(*plan)
+            if sums is None:  # an update Warp cannot compile: the host's step (it said why)
+                return False
+            if (self.max_stretch is not None and sums.stretch > self.max_stretch) or not (
+                sums.finite
+            ):
+                self._book_device(sums.stretch, sums.power, sums.damping, sums.ground)
+                x, x_new, v_new = kernel.undo_step()
+                self.body.store_state(*kernel.state())
+                raise self._divergence(x, x_new, v_new)
+            self._book_device(sums.stretch, sums.power, sums.damping, sums.ground)
+        return True
+
+    def _book_device(self, stretch: float, power: float, damping: float, ground: float) -> None:
+        """A device step's sums: the dashpots' power (W) at its start, the integrator's
+        damping work and the ground's energy (J), booked as `step` books them; the step's
+        time."""
+        if self.ledger:
+            self.dissipated["dashpot"] += power * self._dt
+            self.dissipated["integrator"] += damping
+            for constraint in self.constraints:
+                self.dissipated[constraint.ledger_name] += ground
+        self.time += self._dt
+        self.step_count += 1
+
+    def _device_plan(self) -> tuple | None:
+        """The arguments of the backend's whole ``step`` (see `_device_steps`), or None."""
+        integrator, body = self.integrator, self.body
+        found = integrator.update_step()
+        booked = type(integrator).dissipated_energy is Integrator.dissipated_energy
+        if found is None or not booked or len(self.constraints) > 1:
+            return None
+        field = np.zeros(body.dim)
+        for force in self.dynamics.forces:
+            g = force.uniform_acceleration(body)
+            if g is None:
+                return None
+            field += g
+        ground = self.constraints[0].plane(body) if self.constraints else None
+        if self.constraints and ground is None:
+            return None
+        factor = integrator.velocity_factor if self.ledger else 1.0
+        return found[0], self.dynamics.layout, field, self._dt, found[1], factor, ground
 
     def _record(
         self,
@@ -266,10 +299,9 @@ class Simulation:
         start: dict[str, float],
         with_velocities: bool,
     ) -> None:
-        """Store the backend's state in the body and add it as a frame to ``frames`` (the
-        velocities too if ``with_velocities``) and ``ledger`` (the energy taken out since
-        ``start``, the dissipated energies by mechanism when the run started)."""
-        self._store()
+        """Add the body's state as a frame to ``frames`` (the velocities too if
+        ``with_velocities``) and ``ledger`` (the energy taken out since ``start``, the
+        dissipated energies by mechanism when the run started)."""
         x, v = self.body.positions, self.body.velocities
         frames.append((self.step_count, self.time, x.copy(), v.copy() if with_velocities else None))
         if self.step_count > 0:  # before the first step v is the user's v(t0)

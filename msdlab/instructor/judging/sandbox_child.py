@@ -61,11 +61,11 @@ def _die_with_parent() -> None:
 
 NOT_ENGINE = frozenset({
     "instructor", "course", "viz", "scenes", "commands", "cli", "__main__",
-    "jupyter_extension", "engine.backends.numba",
+    "jupyter_extension", "engine.backends.numba", "engine.backends.warp",
 })  # fmt: skip
 """The parts of msdlab a submission's calls do not need (dotted names below ``msdlab``): the
-grader's and the course's tools, the pictures, and the numba backend (the sandbox runs the
-numpy backend)."""
+grader's and the course's tools, the pictures, and the numba and Warp backends (the sandbox
+runs the numpy backend)."""
 
 
 def _load_engine() -> None:

@@ -18,17 +18,15 @@ from __future__ import annotations
 import types
 import warnings
 from collections.abc import Callable
-from typing import TYPE_CHECKING
 
 import numba
 import numpy as np
 from numba.extending import register_jitable
 
 from ... import equations
-from ...model.body import Body
-from ...model.lattice import LatticeSprings
+from ...model.springs import EdgeSprings
 from ..contract import Advanced, Jacobians, SpringSums
-from ..host import HostState, KeptEdges
+from ..layout import Layout
 from .equations import (
     acceleration,
     dashpot_power,
@@ -36,6 +34,7 @@ from .equations import (
     kick_work,
     separation,
     spring_energy,
+    spring_jacobian,
     spring_state,
     transverse_stiffness,
 )
@@ -48,9 +47,6 @@ from .lattice import (
     padded_shape,
     plan,
 )
-
-if TYPE_CHECKING:
-    from ..jacobian import JacobianPattern
 
 # Below this many springs (particles for the update, `PARALLEL_MIN_PARTICLES`) one thread is
 # faster than waking the others.
@@ -199,9 +195,8 @@ elastic_energy_serial, elastic_energy_parallel = _compile_energy(False), _compil
 
 @numba.njit(cache=True)
 def jacobian_blocks(x, a, b, k, rest, c, stiff, damp):
-    """Each spring's blocks (E, d, d) of `backends.numpy.spring_jacobians`:
-    B = (k - k_t) n nᵀ + k_t I
-    into ``stiff`` and, if it is not empty, C = c n nᵀ into ``damp``."""
+    """Each spring's blocks (E, d, d) of `equations.spring_jacobian`, B into ``stiff`` and, if
+    it is not empty, C into ``damp``."""
     dim = x.shape[1]
     for s in range(len(a)):
         d = separation(x, a[s], b[s])
@@ -210,9 +205,10 @@ def jacobian_blocks(x, a, b, k, rest, c, stiff, damp):
         across = transverse_stiffness(k[s], rest[s], length, safe)
         for i in range(dim):
             for j in range(dim):
-                stiff[s, i, j] = (k[s] - across) * n[i] * n[j] + (across if i == j else 0.0)
+                same = 1.0 if i == j else 0.0
+                stiff[s, i, j], damping = spring_jacobian(k[s], across, c[s], n[i], n[j], same)
                 if len(damp):
-                    damp[s, i, j] = c[s] * n[i] * n[j]
+                    damp[s, i, j] = damping
 
 
 # Sums over the state at the end of a step: one pass each, no temporary arrays, the same
@@ -381,7 +377,7 @@ def _copy(update: Callable) -> Callable:
 
 def advance_particles(
     update: Callable,
-    body: Body,
+    layout: Layout,
     x: np.ndarray,
     v: np.ndarray,
     forces: np.ndarray,
@@ -400,8 +396,8 @@ def advance_particles(
             warnings.warn(_not_compiled(update), RuntimeWarning, stacklevel=5)
     loop = _LOOPS[update, threads]
     if loop is not None:
-        x_new, v_new = body.new_state()
-        arrays = (x, v, forces, partial, field, body.masses, body.fixed)
+        x_new, v_new = np.empty_like(x), np.empty_like(v)
+        arrays = (x, v, forces, partial, field, layout.masses, layout.fixed)
         try:
             loop(*arrays, dt, coefficients, x_new, v_new)
             return x_new, v_new
@@ -415,7 +411,7 @@ def advance_particles(
             )
     for part in partial:  # on arrays, in the order of the compiled loop
         forces = forces + part
-    masses, free = body.masses[:, None], ~body.fixed[:, None]
+    masses, free = layout.masses[:, None], ~layout.fixed[:, None]
     return update(
         x, v, equations.acceleration(forces + masses * field, masses, free), dt, *coefficients
     )
@@ -436,15 +432,15 @@ def _not_compiled(update: Callable) -> str:
     )
 
 
-class NumbaKernel(HostState, KeptEdges):
-    """The numba backend (`contract.SpringKernel`), with what a body needs kept between
-    calls, made again when its springs are edited (``body.version``).
+class NumbaKernel:
+    """The numba backend (`contract.SpringKernel`), with what it derives from a body's
+    `Layout` kept until it is given a new one (the body was edited).
 
-    A lattice (`lattice.LatticeSprings`, the springs of `Body.grid`) is gathered by
-    offset (`lattice.gather`, laid out by `lattice.plan`); an edge list goes through the edge loop,
-    over the springs sorted by their ends (`_sorted_edges`), with one force buffer per
-    extra thread. ``springs`` (indices) restricts a computation to some springs, on one
-    thread, in the body's order.
+    A lattice (`lattice.LatticeSprings`, the springs of `Body.grid`) is gathered by offset
+    (`lattice.gather`, laid out by `lattice.plan`); an edge list goes through the edge
+    loop, over the springs sorted by their ends (`sorted_edges`), with one force buffer
+    per extra thread. ``springs`` (indices) restricts a computation to some springs, on
+    one thread, in the body's order.
     """
 
     name = "numba"
@@ -453,15 +449,16 @@ class NumbaKernel(HostState, KeptEdges):
     ground_clamp = staticmethod(ground_clamp)
 
     def __init__(self) -> None:
-        self._sorted: tuple[object, int, tuple[np.ndarray, ...]] = (None, -1, ())
-        self._gather = NO_PLAN  # see `lattice.plan`
+        self._layout: Layout | None = None  # the layout the next two were derived from
+        self._sorted: tuple[np.ndarray, ...] = ()  # an edge list's springs, `sorted_edges`
+        self._gather = NO_PLAN  # a lattice's, see `lattice.plan`
         self._forces = np.zeros((0, 0))  # the spring forces of `advance`
         self._partial = np.zeros((0, 0, 0))  # the edge loop's extra threads' forces
         self._none = np.zeros((0, 0, 0))  # no threads' forces
 
     def spring_forces(
         self,
-        body: Body,
+        layout: Layout,
         x: np.ndarray,
         v: np.ndarray,
         out: np.ndarray,
@@ -470,19 +467,21 @@ class NumbaKernel(HostState, KeptEdges):
         """Add the spring and dashpot forces (N) to ``out`` (N, d); the largest stretch
         |d|/l and the power (W) the dashpots take come from the same loop."""
         if springs is not None:
-            a, b, k, rest, c = (array[springs] for array in self.edges(body).arrays())
+            a, b, k, rest, c = (array[springs] for array in layout.edges.arrays())
             return SpringSums(*spring_forces_serial(x, v, a, b, k, rest, c, out))
-        return SpringSums(*self._pass(body, x, v, out, fused=False)[:2])
+        return SpringSums(*self._pass(layout, x, v, out, fused=False)[:2])
 
-    def elastic_energy(self, body: Body, x: np.ndarray, springs: np.ndarray | None = None) -> float:
+    def elastic_energy(
+        self, layout: Layout, x: np.ndarray, springs: np.ndarray | None = None
+    ) -> float:
         """Energy (J) stored in the springs (or in the given ones) at positions x; a
         lattice's summed by offset (`lattice.grid_sum`)."""
-        lattice = body.spring_set
-        if springs is None and isinstance(lattice, LatticeSprings):
+        lattice = layout.lattice
+        if springs is None and lattice is not None:
             parallel = lattice.count >= PARALLEL_MIN_SPRINGS and numba.get_num_threads() > 1
             grid_sum = grid_sum_parallel if parallel else grid_sum_serial
             return grid_sum(x, *padded_shape(lattice), lattice.stiffness, lattice.rest_lengths)
-        edges = self.edges(body)
+        edges = layout.edges
         arrays = (edges.a, edges.b, edges.stiffness, edges.rest_lengths)
         if springs is not None:
             return elastic_energy_serial(x, *(array[springs] for array in arrays), 1)
@@ -490,20 +489,20 @@ class NumbaKernel(HostState, KeptEdges):
         energy = elastic_energy_parallel if blocks > 1 else elastic_energy_serial
         return energy(x, *arrays, blocks)
 
-    def jacobians(self, body: Body, x: np.ndarray, pattern: JacobianPattern) -> Jacobians:
-        """∂F/∂x and ∂F/∂v of the springs on ``pattern``, as `backends.numpy.jacobians`, with the
-        blocks computed spring by spring."""
-        edges = self.edges(body)
+    def jacobians(self, layout: Layout, x: np.ndarray) -> Jacobians:
+        """∂F/∂x and ∂F/∂v of the springs on the layout's pattern, as `backends.numpy.jacobians`,
+        with the blocks computed spring by spring."""
+        edges = layout.edges
         dim = x.shape[1]
         stiff = np.empty((edges.count, dim, dim))
         damp = np.empty((edges.count if edges.damping.any() else 0, dim, dim))
         jacobian_blocks(x, *edges.arrays(), stiff, damp)
-        return Jacobians(*pattern.jacobians(stiff, damp if len(damp) else None))
+        return Jacobians(*layout.pattern.jacobians(stiff, damp if len(damp) else None))
 
     def advance(
         self,
         update: Callable,
-        body: Body,
+        layout: Layout,
         x: np.ndarray,
         v: np.ndarray,
         field: np.ndarray,
@@ -522,17 +521,17 @@ class NumbaKernel(HostState, KeptEdges):
         if self._forces.shape != x.shape:
             self._forces = np.empty_like(x)
         if forces is None:
-            stretch, power, total, partial = self._pass(body, x, v, self._forces, fused=True)
+            stretch, power, total, partial = self._pass(layout, x, v, self._forces, fused=True)
         else:
             self._forces.fill(0.0)
-            stretch, power, _, _ = self._pass(body, x, v, self._forces, fused=False)
+            stretch, power, _, _ = self._pass(layout, x, v, self._forces, fused=False)
             total, partial = self._forces, forces[np.newaxis]
         parallel = len(x) >= PARALLEL_MIN_PARTICLES and numba.get_num_threads() > 1
-        state = (update, body, x, v, total, partial, field, dt, coefficients)
+        state = (update, layout, x, v, total, partial, field, dt, coefficients)
         return Advanced(*advance_particles(*state, parallel), stretch, power)
 
     def _pass(
-        self, body: Body, x: np.ndarray, v: np.ndarray, out: np.ndarray, fused: bool
+        self, layout: Layout, x: np.ndarray, v: np.ndarray, out: np.ndarray, fused: bool
     ) -> tuple[float, float, np.ndarray, np.ndarray]:
         """The springs' loop: the largest stretch, the dashpot power (W), and the spring
         forces as an (N, d) array plus the threads' (T, N, d) to add to it.
@@ -542,18 +541,15 @@ class NumbaKernel(HostState, KeptEdges):
         ``out`` (cleared first) plus the edge loop's threads' buffers, or the gather's
         forces by coordinate, seen transposed.
         """
-        if self._none.shape[1:] != x.shape:
-            self._none = np.zeros((0, *x.shape))
-        lattice = body.spring_set
-        if isinstance(lattice, LatticeSprings):
+        if layout is not self._layout:
+            self._lay_out(layout, x)
+        if self._gather.lattice is not None:
             kept = self._gather
-            if (kept.lattice, kept.version, kept.particles) != (lattice, body.version, len(x)):
-                kept = self._gather = plan(lattice, body.version, len(x))
             parallel = kept.springs >= PARALLEL_MIN_GATHERED and numba.get_num_threads() > 1
             gather = gather_parallel if parallel else gather_serial
             stretch, power = gather(x, v, out, not fused, *kept.arguments)
             return stretch, power, kept.forces if fused else out, self._none
-        arrays = self._sorted_edges(body)
+        arrays = self._sorted
         blocks = numba.get_num_threads() if len(arrays[0]) >= PARALLEL_MIN_SPRINGS else 1
         if blocks == 1:
             if fused:
@@ -564,23 +560,29 @@ class NumbaKernel(HostState, KeptEdges):
         sums = spring_forces_parallel(x, v, *arrays, self._partial, out, not fused)
         return *sums, out, self._partial if fused else self._none
 
-    def _sorted_edges(self, body: Body) -> tuple[np.ndarray, ...]:
-        """Ends a, b of all springs sorted by (a, b), and the stiffness, rest length and
-        dashpot of each, in that order.
+    def _lay_out(self, layout: Layout, x: np.ndarray) -> None:
+        """Derive from a new ``layout`` what the springs' loop reads: a lattice's gather plan
+        or an edge list's sorted springs (`sorted_edges`)."""
+        self._layout, self._none = layout, np.zeros((0, *x.shape))
+        if layout.lattice is not None:
+            self._gather = plan(layout.lattice, layout.version, layout.n_particles)
+            self._sorted = ()
+        else:
+            self._gather, self._sorted = NO_PLAN, sorted_edges(layout.edges, layout.n_particles)
 
-        In that order consecutive springs share or neighbour their particles, so the
-        edge loop reads and writes memory it has just used, whatever order the springs
-        were added in (a shuffled 60³ grid: several times faster). The ends are uint32
-        (half the memory traffic of int64); the values are the body's own arrays, or
-        copies in the sorted order.
-        """
-        if self._sorted[0] is not body.spring_set or self._sorted[1] != body.version:
-            edges = self.edges(body)
-            order = np.lexsort((edges.b, edges.a))
-            if np.array_equal(order, np.arange(len(order))):
-                order = slice(None)
-            a, b, *values = (array[order] for array in edges.arrays())
-            index = np.uint32 if body.n_particles < 2**32 else np.uint64
-            arrays = (a.astype(index), b.astype(index), *values)
-            self._sorted = (body.spring_set, body.version, arrays)
-        return self._sorted[2]
+
+def sorted_edges(edges: EdgeSprings, n_particles: int) -> tuple[np.ndarray, ...]:
+    """Ends a, b of all springs sorted by (a, b), and the stiffness, rest length and dashpot
+    of each, in that order.
+
+    In that order consecutive springs share or neighbour their particles, so the edge loop
+    reads and writes memory it has just used, whatever order the springs were added in (a
+    shuffled 60³ grid: several times faster). The ends are uint32 (half the memory traffic
+    of int64); the values are the body's own arrays, or copies in the sorted order.
+    """
+    order = np.lexsort((edges.b, edges.a))
+    if np.array_equal(order, np.arange(len(order))):
+        order = slice(None)
+    a, b, *values = (array[order] for array in edges.arrays())
+    index = np.uint32 if n_particles < 2**32 else np.uint64
+    return (a.astype(index), b.astype(index), *values)
