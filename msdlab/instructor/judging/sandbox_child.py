@@ -117,14 +117,56 @@ def _limit_resources(memory_bytes: int, cpu_seconds: int) -> None:
 
 
 def _refuse_new_processes() -> None:
-    """From now on this process can start no process and no thread (``RLIMIT_NPROC`` 0: the
-    kernel refuses every fork, clone and spawn, however it is asked for): whatever the
-    submission runs runs here, in the one process whose processor time its budget is
-    charged. Ignored only by a process with root's capabilities (the ``process`` isolation
-    run as root)."""
+    """From now on this process can start no process and no thread: whatever the submission
+    runs runs here, in the one process whose processor time its budget is charged. Twice
+    over: ``RLIMIT_NPROC`` 0, and a seccomp filter (`_refuse_clone`) for root, whom Linux
+    never holds to the process limit (the ``process`` isolation run as root, as on
+    Gradescope)."""
     import resource
 
     resource.setrlimit(resource.RLIMIT_NPROC, (0, 0))
+    _refuse_clone()
+
+
+# The system calls that make a process or a thread, by the machine's audit architecture.
+CLONE_CALLS = {
+    "x86_64": (0xC000003E, (56, 57, 58, 435)),  # clone, fork, vfork, clone3
+    "aarch64": (0xC00000B7, (220, 435)),  # clone, clone3
+}
+
+
+def _refuse_clone() -> None:
+    """A seccomp filter under which the kernel answers every clone, fork, vfork and clone3
+    with EAGAIN, as the process limit does (other ABIs of the machine: EPERM to every call).
+    Left out, as before, on a machine or kernel that has none."""
+    import ctypes
+    import errno
+    import platform
+
+    if platform.machine() not in CLONE_CALLS:
+        return
+    arch, calls = CLONE_CALLS[platform.machine()]
+    allow, refuse = 0x7FFF0000, 0x00050000 | errno.EAGAIN  # SECCOMP_RET_ALLOW, _RET_ERRNO
+    load, equal, at_least, answer = 0x20, 0x15, 0x35, 0x06  # BPF LD|W|ABS, JEQ, JGE, RET
+    program = [(load, 0, 0, 4), (equal, 1, 0, arch), (answer, 0, 0, 0x00050000 | errno.EPERM)]
+    program += [(load, 0, 0, 0), (at_least, len(calls) + 1, 0, 0x40000000)]  # x32's calls
+    program += [(equal, len(calls) - i, 0, call) for i, call in enumerate(calls)]
+    program += [(answer, 0, 0, allow), (answer, 0, 0, refuse)]
+
+    class Instruction(ctypes.Structure):
+        _fields_ = [("code", ctypes.c_ushort), ("jt", ctypes.c_ubyte),
+                    ("jf", ctypes.c_ubyte), ("k", ctypes.c_uint)]  # fmt: skip
+
+    class Program(ctypes.Structure):
+        _fields_ = [("len", ctypes.c_ushort), ("filter", ctypes.POINTER(Instruction))]
+
+    instructions = (Instruction * len(program))(*program)
+    filter_program = Program(len(program), instructions)
+    prctl = ctypes.CDLL(None, use_errno=True).prctl
+    prctl.argtypes = [ctypes.c_int, ctypes.c_ulong, ctypes.c_void_p, ctypes.c_ulong,
+                      ctypes.c_ulong]  # fmt: skip
+    prctl(38, 1, None, 0, 0)  # PR_SET_NO_NEW_PRIVS: needed to filter without root
+    prctl(22, 2, ctypes.addressof(filter_program), 0, 0)  # PR_SET_SECCOMP, MODE_FILTER
 
 
 _BLOCKED = {
