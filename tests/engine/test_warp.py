@@ -6,6 +6,9 @@ drifts by a stated amount. (The contract's methods: tests/engine/test_backends.p
 
 from __future__ import annotations
 
+import ctypes
+import subprocess
+import sys
 import warnings
 
 import numpy as np
@@ -168,6 +171,22 @@ def test_auto_picks_warp_on_a_gpu_and_numba_elsewhere(monkeypatch: pytest.Monkey
     assert choice.make_kernel("auto").name == "warp"
     with pytest.raises(ValueError, match="kernel must be one of numba, numpy, warp, auto"):
         choice.make_kernel("cuda")
+
+
+def test_auto_without_a_driver_says_nothing_and_leaves_warp_unloaded() -> None:
+    """Where NVIDIA's driver library does not load, ``kernel="auto"`` is numba without a word
+    on stderr: Warp, whose start-up would say it found no driver, is not even imported."""
+    try:
+        ctypes.CDLL("libcuda.so.1")
+        pytest.skip("this machine has NVIDIA's driver")
+    except OSError:
+        pass
+    code = (
+        "import sys; from msdlab.engine.backends import choice; "
+        "print(choice.make_kernel('auto').name, 'warp' in sys.modules)"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert (done.stdout.split(), done.stderr) == (["numba", "False"], "")
 
 
 def test_float32_on_request_drifts_by_a_stated_amount(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ctypes
 import os
 import sys
 import warnings
@@ -86,10 +87,13 @@ def make_kernel(name: str | None = None) -> SpringKernel:
 
 
 def gpu_present() -> bool:
-    """Whether Warp is installed and sees a CUDA device (``kernel="auto"`` then picks it)."""
+    """Whether Warp is installed and sees a CUDA device (``kernel="auto"`` then picks it).
+    Warp is imported only where NVIDIA's driver library loads: elsewhere its start-up would
+    print that it found no driver, for a choice the user left to msdlab."""
     try:
+        ctypes.CDLL("nvcuda.dll" if sys.platform == "win32" else "libcuda.so.1")
         import warp
-    except ImportError:
+    except (OSError, ImportError):
         return False
     return warp.get_cuda_device_count() > 0
 
