@@ -29,7 +29,7 @@ COLOURS = {
     "gallery/scene_jelly_cube.html",  # a gallery example: code, output, picture, animation
     "notebooks/task2.html",  # a notebook: cells and their outputs
     "api/index.html",
-    "api/generated/msdlab.simulation.html",  # a module's reference
+    "api/generated/msdlab.engine.simulation.simulation.html",  # a module's reference
 }
 
 
