@@ -1450,7 +1450,7 @@ export async function replay(el, data) {
     if (playing) index = Math.floor(((performance.now() - start) * data.fps) / 1000) % count;
     scrub.value = index;
     const where = `t = ${data.times[index].toPrecision(4)} ${data.unit}`;
-    view.status.textContent = `${where}   frame ${index + 1} / ${count}`;
+    view.status.textContent = `${where} · frame ${index + 1} of ${count}`;
     view.status.dataset.frame = String(index);
     if (said !== index) scrub.setAttribute("aria-valuetext", `${where}, frame ${index + 1} of ${count}`);
     said = index;

@@ -82,6 +82,7 @@ def test_the_replay_page_is_named_and_worked_by_keys(replay_file):
             page.wait_for_function("() => document.querySelector('.msdlab-scrub').value === '2'")
             assert status.get_attribute("data-frame") == "2"
             assert scrub.get_attribute("aria-valuetext").endswith("frame 3 of 31")
+            assert status.inner_text().endswith(" · frame 3 of 31")  # the time, then the frame
             page.keyboard.press("End")
             page.wait_for_function("() => document.querySelector('.msdlab-scrub').value === '30'")
             page.keyboard.press("Tab")  # on to the body, the play button and the scrubber
