@@ -53,6 +53,23 @@ def _checked_squared_distances(squared_distances: Sequence[int]) -> list[int]:
     return values
 
 
+def _checked_axis(axis: Sequence[float]) -> np.ndarray:
+    """``axis`` as a float array, else ValueError; where the axis is a single number (the
+    angle, given where the axis goes) the message names the order of the arguments."""
+    axis = np.asarray(axis, dtype=float)
+    if axis.shape != (3,) or not np.all(np.isfinite(axis)) or not np.any(axis):
+        order = (
+            ": the angle? drop_rotated_cube takes (angle_degrees, axis, squared_distances, "
+            "steps), as msd.rotation_matrix does"
+            if axis.shape == ()
+            else ""
+        )
+        raise ValueError(
+            f"the rotation axis must be a non-zero 3-vector, got {axis.tolist()}{order}"
+        )
+    return axis
+
+
 # --------------------------------------------------------------------------- your answers
 def neighbour_offsets(squared_distances: Sequence[int] = (1, 2, 3)) -> np.ndarray:
     """All grid offsets (M, 3) of integers in {-1, 0, 1} whose squared length is in the list.
@@ -86,8 +103,8 @@ def grid_springs(
 
 
 def drop_rotated_cube(
-    axis: Sequence[float],
     angle_degrees: float,
+    axis: Sequence[float],
     squared_distances: Sequence[int] = (1, 2, 3),
     steps: int = 1500,
 ) -> float:
@@ -99,6 +116,7 @@ def drop_rotated_cube(
     STIFFNESS, unit masses (``msd.Body.from_arrays``), then ``steps`` steps of
     ``msd.Verlet()`` at dt = DT with ``msd.Gravity(GRAVITY)`` and ``msd.Ground(0.0)``.
     """
+    axis = _checked_axis(axis)
     raise NotImplementedError(
         "Task 4: build the rotated cube with your springs, run it as in task 3, return the ratio."
     )

@@ -40,14 +40,14 @@ def flatness(positions: np.ndarray) -> float:
     return float(np.sqrt(max(np.linalg.eigvalsh(gyration)[0], 0.0)))
 
 
-def _checked_axis(axis: Sequence[float]) -> np.ndarray:
+def _checked_axis(
+    axis: Sequence[float], takes: str = "rotation_matrix takes (angle_degrees, axis)"
+) -> np.ndarray:
+    """``axis`` as a float array, else ValueError; where the axis is a single number (the
+    angle, given where the axis goes) the message names the order, ``takes``."""
     axis = np.asarray(axis, dtype=float)
     if axis.shape != (3,) or not np.all(np.isfinite(axis)) or not np.any(axis):
-        order = (
-            ": the angle? rotation_matrix takes (angle_degrees, axis), as msd.rotation_matrix does"
-            if axis.shape == ()
-            else ""
-        )
+        order = f": the angle? {takes}, as msd.rotation_matrix does" if axis.shape == () else ""
         raise ValueError(
             f"the rotation axis must be a non-zero 3-vector, got {axis.tolist()}{order}"
         )
@@ -72,7 +72,7 @@ def rotation_matrix(angle_degrees: float, axis: Sequence[float]) -> np.ndarray:
     ### END SOLUTION
 
 
-def rotate_layout(positions: np.ndarray, axis: Sequence[float], angle_degrees: float) -> np.ndarray:
+def rotate_layout(positions: np.ndarray, angle_degrees: float, axis: Sequence[float]) -> np.ndarray:
     """Positions (..., 3) rotated by ``angle_degrees`` about ``axis`` through their centroid.
 
     Returns a new array of the same shape, e.g. (nx, ny, nz, 3) for a grid; the
@@ -81,6 +81,7 @@ def rotate_layout(positions: np.ndarray, axis: Sequence[float], angle_degrees: f
     positions = np.asarray(positions, dtype=float)
     if positions.shape[-1] != 3:
         raise ValueError(f"positions must have shape (..., 3), got {positions.shape}")
+    axis = _checked_axis(axis, "rotate_layout takes (positions, angle_degrees, axis)")
     ### BEGIN SOLUTION
     # TODO: rotate every position about the centroid with rotation_matrix(angle_degrees, axis).
     rotation = rotation_matrix(angle_degrees, axis)
@@ -123,8 +124,8 @@ def spring_acceleration(
 
 
 def drop_rotated_cube(
-    axis: Sequence[float],
     angle_degrees: float,
+    axis: Sequence[float],
     neighbours: Sequence[int] = (1,),
     steps: int = 1500,
 ) -> float:
@@ -137,10 +138,11 @@ def drop_rotated_cube(
     (``msd.Verlet()``, dt = DT) with gravity and the floor
     (``msd.Gravity(GRAVITY)``, ``msd.Ground(0.0)``).
     """
+    axis = _checked_axis(axis, "drop_rotated_cube takes (angle_degrees, axis, neighbours, steps)")
     ### BEGIN SOLUTION
     # TODO: build, rotate and lift the cube, run the simulation, return the flatness ratio.
     body = msd.Body.grid((N, N, N), spacing=2.0 / N, stiffness=STIFFNESS, neighbours=neighbours)
-    body.positions = rotate_layout(body.positions, axis, angle_degrees)
+    body.positions = rotate_layout(body.positions, angle_degrees, axis)
     body.positions[:, 1] += LIFT - body.positions[:, 1].min()
     before = flatness(body.positions)
     simulation = msd.Simulation(body, msd.Verlet(), DT, [msd.Gravity(GRAVITY), msd.Ground(0.0)])

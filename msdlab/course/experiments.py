@@ -24,12 +24,12 @@ from .feedback import returned
 
 @functools.lru_cache(maxsize=64)  # per task module (one submission) and setting
 def cube_ratio(
-    task: Any, axis: Sequence[float], angle: float, neighbours: Sequence[int], steps: int = 0
+    task: Any, angle: float, axis: Sequence[float], neighbours: Sequence[int], steps: int = 0
 ) -> float:
-    """The flatness ratio (after / before) of ``task.drop_rotated_cube(axis, angle,
+    """The flatness ratio (after / before) of ``task.drop_rotated_cube(angle, axis,
     neighbours)``, with ``steps=steps`` where ``steps`` is given (> 0)."""
     if steps:
-        ratio = task.drop_rotated_cube(axis, angle, neighbours, steps=steps)
+        ratio = task.drop_rotated_cube(angle, axis, neighbours, steps=steps)
     else:
-        ratio = task.drop_rotated_cube(axis, angle, neighbours)
+        ratio = task.drop_rotated_cube(angle, axis, neighbours)
     return float(returned(ratio, "drop_rotated_cube"))

@@ -53,7 +53,7 @@ with course.attempt():
 cube = msd.Body.grid((4, 4, 4), spacing=0.5, neighbours=(1, 2, 3))
 springs = cube.edges()  # the grid's springs as a list: ends a, b and their values
 with course.attempt():
-    turned = task3.rotate_layout(cube.positions, (1, 1, 0), 30)
+    turned = task3.rotate_layout(cube.positions, 30, (1, 1, 0))
     moved = turned.mean(axis=0) - cube.positions.mean(axis=0)
     print("the centroid stays:", np.allclose(moved, 0))
     lengths = np.linalg.norm(turned[springs.a] - turned[springs.b], axis=1)
@@ -85,7 +85,7 @@ with course.attempt():
 # %% [markdown]
 # ## The experiment
 #
-# `drop_rotated_cube(axis, angle)` drops a $4^3$ cube of axis springs, rotated
+# `drop_rotated_cube(angle, axis)` drops a $4^3$ cube of axis springs, rotated
 # and lifted just above the floor, for 1500 steps of the template, and returns
 # its flatness after / before (1: kept its shape, 0: folded flat). Flatness is
 # the smallest spread of the particles in any direction, so it does not
@@ -93,10 +93,10 @@ with course.attempt():
 
 # %%
 # NBVAL_CHECK_OUTPUT
-cases = [((0, 0, 1), 0), ((0, 0, 1), 10), ((0, 0, 1), 30), ((1, 0, 1), 30)]
+cases = [(0, (0, 0, 1)), (10, (0, 0, 1)), (30, (0, 0, 1)), (30, (1, 0, 1))]
 with course.attempt():
-    for axis, angle in cases:
-        ratio = task3.drop_rotated_cube(axis, angle)
+    for angle, axis in cases:
+        ratio = task3.drop_rotated_cube(angle, axis)
         fate = "kept its shape" if ratio > 0.9 else "folded flat" if ratio < 0.1 else "bent"
         print(f"axis {axis}, {angle:>2}°: flatness ratio {ratio:.1f}, {fate}")
 
@@ -107,7 +107,7 @@ with course.attempt():
 # %%
 with course.attempt():
     sim = jelly.jelly_cube(size=4, angle=0, neighbours=(1,), damping=0.0, dt=0.1)
-    sim.body.positions = task3.rotate_layout(sim.body.positions, (0, 0, 1), 30)
+    sim.body.positions = task3.rotate_layout(sim.body.positions, 30, (0, 0, 1))
     run = sim.run(steps=2000, record_every=50)
     display(HTML(viz.to_html(run, max_frames=41, up="y", view=(-30, 20), time_unit="units")))
 

@@ -83,9 +83,9 @@ with course.attempt():
 # %%
 # NBVAL_CHECK_OUTPUT
 with course.attempt():
-    for axis, angle in [((0, 0, 1), 30), ((1, 0, 1), 30), ((1, 1, 1), 58.3)]:
+    for angle, axis in [(30, (0, 0, 1)), (30, (1, 0, 1)), (58.3, (1, 1, 1))]:
         for wanted in [(1,), (1, 2, 3)]:
-            ratio = task4.drop_rotated_cube(axis, angle, wanted)
+            ratio = task4.drop_rotated_cube(angle, axis, wanted)
             fate = "kept its shape" if ratio > 0.9 else "folded flat" if ratio < 0.1 else "bent"
             print(f"axis {axis} {angle:>4}°, {wanted!s:<9}: flatness ratio {ratio:.1f}, {fate}")
 

@@ -15,7 +15,7 @@ def counting_task(results):
     stateful submission) and records its calls."""
     calls = []
 
-    def drop_rotated_cube(axis, angle, neighbours, steps=1500):
+    def drop_rotated_cube(angle, axis, neighbours, steps=1500):
         calls.append((axis, angle, neighbours, steps))
         result = results[len(calls) - 1]
         if isinstance(result, Exception):
@@ -29,27 +29,27 @@ def counting_task(results):
 
 def test_each_setting_runs_once_and_its_checks_share_the_first_result():
     task, calls = counting_task([0.2, 0.95, 0.7, 0.4])
-    assert cube_ratio(task, (0.0, 0.0, 1.0), 45.0, (1,)) == 0.2
-    assert cube_ratio(task, (0.0, 0.0, 1.0), 45.0, (1, 2, 3)) == 0.95
-    assert cube_ratio(task, (0.0, 0.0, 1.0), 45.0, (1,), steps=1) == 0.7
-    assert cube_ratio(task, (0.0, 0.0, 1.0), 45.0, (1,)) == 0.2  # not 0.4: run once
+    assert cube_ratio(task, 45.0, (0.0, 0.0, 1.0), (1,)) == 0.2
+    assert cube_ratio(task, 45.0, (0.0, 0.0, 1.0), (1, 2, 3)) == 0.95
+    assert cube_ratio(task, 45.0, (0.0, 0.0, 1.0), (1,), steps=1) == 0.7
+    assert cube_ratio(task, 45.0, (0.0, 0.0, 1.0), (1,)) == 0.2  # not 0.4: run once
     assert calls == [
         ((0.0, 0.0, 1.0), 45.0, (1,), 1500),
         ((0.0, 0.0, 1.0), 45.0, (1, 2, 3), 1500),
         ((0.0, 0.0, 1.0), 45.0, (1,), 1),
     ]
     other, other_calls = counting_task([0.5])
-    assert cube_ratio(other, (0.0, 0.0, 1.0), 45.0, (1,)) == 0.5  # another submission runs it
+    assert cube_ratio(other, 45.0, (0.0, 0.0, 1.0), (1,)) == 0.5  # another submission runs it
     assert len(other_calls) == 1
 
 
 def test_a_failing_run_is_not_kept_each_check_sees_its_failure():
     task, calls = counting_task([ZeroDivisionError("division by zero"), "not a number", 0.3])
     with pytest.raises(ZeroDivisionError):
-        cube_ratio(task, (1.0, 0.0, 0.0), 30.0, (1,))
+        cube_ratio(task, 30.0, (1.0, 0.0, 0.0), (1,))
     with pytest.raises(ValueError):
-        cube_ratio(task, (1.0, 0.0, 0.0), 30.0, (1,))
-    assert cube_ratio(task, (1.0, 0.0, 0.0), 30.0, (1,)) == 0.3
+        cube_ratio(task, 30.0, (1.0, 0.0, 0.0), (1,))
+    assert cube_ratio(task, 30.0, (1.0, 0.0, 0.0), (1,)) == 0.3
     assert len(calls) == 3
 
 

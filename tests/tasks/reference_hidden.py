@@ -58,8 +58,8 @@ def axis_pairs(shape: Sequence[int]) -> np.ndarray:
 
 @cached  # the same for every submission: computed once per grading run
 def drop_rotated_cube(
-    axis: Sequence[float],
     angle_degrees: float,
+    axis: Sequence[float],
     neighbours: Sequence[int],
     n: int = 4,
     steps: int = 1500,

@@ -43,7 +43,7 @@ DEGREES_AS_RADIANS = (
 LEFT_HANDED = "a left-handed turn (the transpose): flip the sign of the sin terms"
 
 
-def matrix_mistakes(axis, angle):
+def matrix_mistakes(angle, axis):
     """Matrices (3, 3) that typical mistakes in rotation_matrix(angle, axis) give, by cause."""
     expected = msd.rotation_matrix(angle, axis)
     theta, n = np.radians(angle), np.asarray(axis, dtype=float)
@@ -77,11 +77,11 @@ def matrix_mistake(task3):
         return None
     if got.shape != (3, 3) or np.allclose(got, msd.rotation_matrix(angle, axis), atol=1e-12):
         return None
-    return matching_variant(got, matrix_mistakes(axis, angle), rtol=1e-9)
+    return matching_variant(got, matrix_mistakes(angle, axis), rtol=1e-9)
 
 
-def layout_mistakes(grid, axis, angle):
-    """Positions that typical mistakes in rotate_layout(grid, axis, angle) give, by cause."""
+def layout_mistakes(grid, angle, axis):
+    """Positions that typical mistakes in rotate_layout(grid, angle, axis) give, by cause."""
     rotation = msd.rotation_matrix(angle, axis)
     centroid = grid.reshape(-1, 3).mean(axis=0)
     return {
@@ -107,17 +107,17 @@ def layout_mistake(task3):
     grid = oracles.template_positions((3, 4, 2), 0.1, (-1.0, 1.5, -1.0))
     axis, angle = (1.0, 1.0, 0.0), -30.0
     try:
-        got = np.asarray(task3.rotate_layout(grid.copy(), axis, angle), dtype=float)
+        got = np.asarray(task3.rotate_layout(grid.copy(), angle, axis), dtype=float)
     except Exception:  # the checks say what is wrong
         return None
     centroid = grid.reshape(-1, 3).mean(axis=0)
     right = (grid - centroid) @ msd.rotation_matrix(angle, axis).T + centroid
     if got.shape != grid.shape or relative_error(got, right) < 1e-12:
         return None
-    return matching_variant(got, layout_mistakes(grid, axis, angle)) or matrix_mistake(task3)
+    return matching_variant(got, layout_mistakes(grid, angle, axis)) or matrix_mistake(task3)
 
 
-def matrix_at_fault(task3, axis, angle):
+def matrix_at_fault(task3, angle, axis):
     """Why rotate_layout may be wrong because rotation_matrix is, or None."""
     try:
         got = np.asarray(task3.rotation_matrix(angle, axis), dtype=float)
@@ -136,7 +136,7 @@ def rotation_at_fault(task3):
         return recognised
     grid = oracles.template_positions((2, 3, 2), 0.5, (0.0, 1.0, 0.0))
     try:
-        got = np.asarray(task3.rotate_layout(grid.copy(), (0.0, 0.0, 1.0), 45.0), dtype=float)
+        got = np.asarray(task3.rotate_layout(grid.copy(), 45.0, (0.0, 0.0, 1.0)), dtype=float)
     except Exception as error:
         return f"your rotate_layout fails ({type(error).__name__}), and the cube is turned by it"
     centroid = grid.reshape(-1, 3).mean(axis=0)
@@ -171,7 +171,7 @@ def test_rotation_matrix_right_handed(task3):
         for angle in (30.0, -58.3, 180.0):
             got = as_array(task3.rotation_matrix(angle, axis), "rotation_matrix", (3, 3))
             expected = msd.rotation_matrix(angle, axis)
-            own = matching_variant(got, matrix_mistakes(axis, angle), rtol=1e-9)
+            own = matching_variant(got, matrix_mistakes(angle, axis), rtol=1e-9)
             mistake = own and (matrix_mistake(task3) or own)
             expect(
                 np.allclose(got, expected, atol=1e-12),
@@ -189,18 +189,18 @@ def test_rotate_layout_turns_about_centroid(task3):
     """rotate_layout keeps the shape of the array, the centroid and every distance."""
     grid = oracles.template_positions((3, 4, 2), 0.1, (-1.0, 1.5, -1.0))
     for axis, angle in (((0.0, 0.0, 1.0), 45.0), ((1.0, 1.0, 0.0), -30.0)):
-        got = as_array(task3.rotate_layout(grid.copy(), axis, angle), "rotate_layout", grid.shape)
+        got = as_array(task3.rotate_layout(grid.copy(), angle, axis), "rotate_layout", grid.shape)
         centroid = grid.reshape(-1, 3).mean(axis=0)
         expected = (grid - centroid) @ msd.rotation_matrix(angle, axis).T + centroid
-        mistake = layout_mistake(task3) or matching_variant(got, layout_mistakes(grid, axis, angle))
+        mistake = layout_mistake(task3) or matching_variant(got, layout_mistakes(grid, angle, axis))
         moved = got.reshape(-1, 3).mean(axis=0) - centroid
         expect(
             relative_error(got, expected) < 1e-12,
-            saw=f"rotate_layout(grid, {axis}, {angle}) moved the centroid by {vec(moved)} and "
+            saw=f"rotate_layout(grid, {angle}, {axis}) moved the centroid by {vec(moved)} and "
             f"puts particles up to {num(np.max(np.abs(got - expected)))} away from the rotated "
             "grid",
             cause=mistake
-            or matrix_at_fault(task3, axis, angle)
+            or matrix_at_fault(task3, angle, axis)
             or "rotate every position p to R (p - c) + c, c the centroid",
         )
 
@@ -332,7 +332,7 @@ def test_no_net_force_or_torque(task3):
 def test_tilted_cube_collapses_upright_one_stands(task3):
     """Axis springs only: tilted 45° about z the cube folds flat; turned 45° about y it stands."""
     for axis, angle, collapses in (((0.0, 0.0, 1.0), 45.0, True), ((0.0, 1.0, 0.0), 45.0, False)):
-        got = cube_ratio(task3, axis, angle, (1,))
+        got = cube_ratio(task3, angle, axis, (1,))
         if collapses:
             expect(
                 got < 0.3,

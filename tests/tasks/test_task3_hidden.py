@@ -112,8 +112,8 @@ def test_zero_length_spring_gives_no_nan(task3):
 def test_cube_tilted_about_x_collapses(task3):
     """Axis springs only, tilted 30° about x: the cube folds flat too; in every setting (the
     public check's included) the ratio is the one of the experiment as described."""
-    got = cube_ratio(task3, (1.0, 0.0, 0.0), 30.0, (1,))
-    expected = reference.drop_rotated_cube((1.0, 0.0, 0.0), 30.0, (1,))
+    got = cube_ratio(task3, 30.0, (1.0, 0.0, 0.0), (1,))
+    expected = reference.drop_rotated_cube(30.0, (1.0, 0.0, 0.0), (1,))
     expect(
         abs(got - expected) < 0.1 and got < 0.3,
         saw=f"tilted 30° about x the flatness ratio is {num(got)}; the experiment gives "
@@ -123,11 +123,11 @@ def test_cube_tilted_about_x_collapses(task3):
         ),
     )
     for axis, angle in (((0.0, 0.0, 1.0), 45.0), ((0.0, 1.0, 0.0), 45.0)):
-        got = cube_ratio(task3, axis, angle, (1,))
-        expected = reference.drop_rotated_cube(axis, angle, (1,))
+        got = cube_ratio(task3, angle, axis, (1,))
+        expected = reference.drop_rotated_cube(angle, axis, (1,))
         expect(
             abs(got - expected) <= SAME_EXPERIMENT,
-            saw=f"drop_rotated_cube({axis}, {angle}) = {num(got, 8)}, but the experiment as "
+            saw=f"drop_rotated_cube({angle}, {axis}) = {num(got, 8)}, but the experiment as "
             f"described gives a flatness ratio of {num(expected, 8)}",
             cause=lambda: (
                 rotation_at_fault(task3)
@@ -140,7 +140,7 @@ def test_cube_tilted_about_x_collapses(task3):
 @pytest.mark.points(1)
 def test_drop_rotated_cube_uses_steps_and_neighbours(task3):
     """One step leaves the cube as it was; with 1, √2, √3 springs the tilted cube stands."""
-    still = cube_ratio(task3, (0.0, 0.0, 1.0), 45.0, (1,), steps=1)
+    still = cube_ratio(task3, 45.0, (0.0, 0.0, 1.0), (1,), steps=1)
     expect(
         abs(still - 1.0) < 0.01,
         saw=f"drop_rotated_cube(..., steps=1) = {num(still)}: in a single step the cube "
@@ -150,8 +150,8 @@ def test_drop_rotated_cube_uses_steps_and_neighbours(task3):
             or "the number of steps is ignored (run `steps` steps, not a fixed number)"
         ),
     )
-    held = cube_ratio(task3, (0.0, 0.0, 1.0), 45.0, (1, 2, 3))
-    expected = reference.drop_rotated_cube((0.0, 0.0, 1.0), 45.0, (1, 2, 3))
+    held = cube_ratio(task3, 45.0, (0.0, 0.0, 1.0), (1, 2, 3))
+    expected = reference.drop_rotated_cube(45.0, (0.0, 0.0, 1.0), (1, 2, 3))
     expect(
         abs(held - expected) < 0.1,
         saw=f"with springs to neighbours (1, 2, 3) the tilted cube's flatness ratio is "

@@ -220,8 +220,8 @@ def cube_mistake(task4):
     if springs_mistake(task4) or springs_wrong(task4):
         return None
     try:
-        axis_only = cube_ratio(task4, (0.0, 0.0, 1.0), 45.0, (1,))
-        every = cube_ratio(task4, (0.0, 0.0, 1.0), 45.0, (1, 2, 3))
+        axis_only = cube_ratio(task4, 45.0, (0.0, 0.0, 1.0), (1,))
+        every = cube_ratio(task4, 45.0, (0.0, 0.0, 1.0), (1, 2, 3))
     except Exception:  # the checks say what is wrong
         return None
     if axis_only != every:
@@ -420,7 +420,7 @@ def rest_length_cause(rest, distance, spacing):
 def test_rotated_cube_holds_its_shape(task4):
     """Tilted 45° about z, a cube with 1, √2, √3 springs stands; with axis springs only it folds."""
     axis, angle = (0.0, 0.0, 1.0), 45.0
-    held = cube_ratio(task4, axis, angle, (1, 2, 3))
+    held = cube_ratio(task4, angle, axis, (1, 2, 3))
     expect(
         held > 0.9,
         saw=f"with 26 neighbours, tilted {angle}° about z, the cube kept {percent(held)} of its "
@@ -430,7 +430,7 @@ def test_rotated_cube_holds_its_shape(task4):
             or "missing diagonal springs or wrong rest lengths, or a different experiment"
         ),
     )
-    folded = cube_ratio(task4, axis, angle, (1,))
+    folded = cube_ratio(task4, angle, axis, (1,))
     expect(
         folded < 0.3,
         saw=f"with axis springs only the tilted cube kept {percent(folded)} of its thickness; "

@@ -85,8 +85,8 @@ def test_any_grid_shape_and_neighbours(task4, shape, neighbours, spacing):
 def test_cube_tilted_about_x_holds(task4):
     """Tilted 30° about x, the cube with 26 neighbours keeps its shape; in every setting (the
     public check's included) the ratio is the one of the experiment as described."""
-    got = cube_ratio(task4, (1.0, 0.0, 0.0), 30.0, (1, 2, 3))
-    expected = reference.drop_rotated_cube((1.0, 0.0, 0.0), 30.0, (1, 2, 3))
+    got = cube_ratio(task4, 30.0, (1.0, 0.0, 0.0), (1, 2, 3))
+    expected = reference.drop_rotated_cube(30.0, (1.0, 0.0, 0.0), (1, 2, 3))
     expect(
         got > 0.9 and abs(got - expected) < 0.1,
         saw=f"tilted 30° about x the flatness ratio is {num(got)} (the experiment gives "
@@ -94,8 +94,8 @@ def test_cube_tilted_about_x_holds(task4):
         cause=lambda: springs_at_fault(task4) or "missing diagonal springs",
     )
     for axis, angle in (((1.0, 0.0, 0.0), 30.0), ((0.0, 0.0, 1.0), 45.0)):
-        got = cube_ratio(task4, axis, angle, (1, 2, 3))
-        expected = reference.drop_rotated_cube(axis, angle, (1, 2, 3))
+        got = cube_ratio(task4, angle, axis, (1, 2, 3))
+        expected = reference.drop_rotated_cube(angle, axis, (1, 2, 3))
         expect(
             abs(got - expected) <= SAME_EXPERIMENT,
             saw=f"with 26 neighbours, tilted {angle}° about {axis}, the flatness ratio is "
@@ -111,7 +111,7 @@ def test_cube_tilted_about_x_holds(task4):
 @pytest.mark.points(1)
 def test_drop_rotated_cube_runs_the_steps_asked_for(task4):
     """drop_rotated_cube(..., steps=1) leaves the cube as it was: ratio 1."""
-    still = cube_ratio(task4, (0.0, 0.0, 1.0), 45.0, (1,), steps=1)
+    still = cube_ratio(task4, 45.0, (0.0, 0.0, 1.0), (1,), steps=1)
     expect(
         abs(still - 1.0) < 0.01,
         saw=f"drop_rotated_cube(..., steps=1) = {num(still)}: in a single step the cube "
@@ -121,7 +121,7 @@ def test_drop_rotated_cube_runs_the_steps_asked_for(task4):
             or "the number of steps is ignored (run `steps` steps, not a fixed number)"
         ),
     )
-    folded = cube_ratio(task4, (0.0, 0.0, 1.0), 45.0, (1,))
+    folded = cube_ratio(task4, 45.0, (0.0, 0.0, 1.0), (1,))
     expect(
         folded < 0.3,
         saw=f"with all its steps the tilted cube with axis springs only kept {percent(folded)} "

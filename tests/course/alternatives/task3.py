@@ -15,7 +15,7 @@ def rotation_matrix(angle_degrees, axis):
     return scipy.linalg.expm(math.radians(angle_degrees) * cross)
 
 
-def rotate_layout(positions, axis, angle_degrees):
+def rotate_layout(positions, angle_degrees, axis):
     positions = np.asarray(positions, dtype=float)
     flat = positions.reshape(-1, 3)
     centre = flat.sum(axis=0) / len(flat)
@@ -37,11 +37,11 @@ def spring_acceleration(positions, springs, rest_lengths, stiffness):
     return a
 
 
-def drop_rotated_cube(axis, angle_degrees, neighbours=(1,), steps=1500):
+def drop_rotated_cube(angle_degrees, axis, neighbours=(1,), steps=1500):
     import msdlab as msd
 
     body = msd.Body.grid((4, 4, 4), spacing=0.5, stiffness=0.5, neighbours=neighbours)
-    body.positions = rotate_layout(body.positions, axis, angle_degrees) + np.array([3.0, 7.0, -2.0])
+    body.positions = rotate_layout(body.positions, angle_degrees, axis) + np.array([3.0, 7.0, -2.0])
     body.positions[:, 1] -= body.positions[:, 1].min() - 0.05
     eigen = np.linalg.eigvalsh(np.cov(body.positions.T, bias=True))
     before = math.sqrt(eigen[0])

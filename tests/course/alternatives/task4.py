@@ -36,7 +36,7 @@ def grid_springs(shape, spacing, squared_distances=(1, 2, 3)):
     return np.array(pairs, dtype=np.int64).reshape(-1, 2), np.array(rest)
 
 
-def drop_rotated_cube(axis, angle_degrees, squared_distances=(1, 2, 3), steps=1500):
+def drop_rotated_cube(angle_degrees, axis, squared_distances=(1, 2, 3), steps=1500):
     body = msd.Body.grid((4, 4, 4), spacing=0.5, neighbours=())
     springs, rest = grid_springs((4, 4, 4), 0.5, squared_distances)
     body.add_springs(springs, 0.5, rest)
