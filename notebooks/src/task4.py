@@ -22,6 +22,7 @@ from IPython.display import HTML, display
 import msdlab as msd
 from msdlab import viz
 from msdlab.course.notebook import Course
+from msdlab.course.plot_words import plot_in_words, run_in_words
 from msdlab.engine.backends import numpy as kernels
 
 course = Course()  # your assignments/ (MSDLAB_IMPL=solutions: the reference answers)
@@ -103,6 +104,7 @@ with course.attempt():
     forces = [msd.Gravity(task4.GRAVITY), msd.Ground(0.0)]
     run = msd.Simulation(jelly, msd.Verlet(), task4.DT, forces).run(steps=2000, record_every=50)
     display(HTML(viz.to_html(run, max_frames=41, up="y", view=(-30, 20), time_unit="units")))
+    print(run_in_words(run, time_unit="units"))
 
 # %% [markdown]
 # ## What does it cost?
@@ -142,6 +144,7 @@ with course.attempt():
     ax.set(xlabel="springs", ylabel="ms per step", title="Cost of a step")
     ax.legend()
     plt.show()
+    print(plot_in_words(ax))
 
 # %% [markdown]
 # There is a second cost. More springs make the lattice stiffer: its highest
