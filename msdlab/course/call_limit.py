@@ -5,8 +5,10 @@
 left of it), so a check stays under its own limit after a limited call. `limited` wraps a task
 module's function (or the methods a task's class defines) so that one call may take at most
 ``seconds``, failing with `CallTimedOut`, whose message names the function and the check that
-called it. A function that timed out fails at once for the rest of that check (`forgive`
-starts the next check afresh), so a property check does not wait again for every example.
+called it (raised again as `StopIgnored`, which ``except Exception`` does not catch, should the
+code catch it and go on). A function that timed out fails at once for the rest of that check
+(`forgive` starts the next check afresh), so a property check does not wait again for every
+example.
 
 Works only in the main thread of a POSIX process; elsewhere nothing is limited. Limits nest:
 an inner limit longer than what is left of the outer one leaves the outer one in charge.
@@ -32,6 +34,16 @@ class CallTimedOut(Exception):
     """A call into the task module took longer than the per-call limit."""
 
 
+class StopIgnored(BaseException):
+    """A stop (`CallTimedOut`, or the task budget's `TaskStopped`) that the student's code
+    caught and went on after, raised again where ``except Exception`` cannot catch it; its
+    ``__cause__`` is the stop."""
+
+
+GRACE = 1.0
+"""Seconds a block may go on after its stop before the stop is raised again as `StopIgnored`."""
+
+
 @contextlib.contextmanager
 def time_limit(seconds: float, expire: Callable[[], NoReturn]) -> Iterator[None]:
     """Call ``expire`` (which raises) if the block runs longer than ``seconds``; the timer and
@@ -45,8 +57,17 @@ def time_limit(seconds: float, expire: Callable[[], NoReturn]) -> Iterator[None]
         yield
         return
 
+    stop: list[BaseException] = []
+
     def interrupt(signum: int, frame: object) -> None:
-        expire()
+        if stop:  # the code caught the stop and went on
+            raise StopIgnored(str(stop[0])) from stop[0]
+        signal.setitimer(signal.ITIMER_REAL, GRACE)
+        try:
+            expire()
+        except Exception as error:
+            stop.append(error)
+            raise
 
     previous = signal.signal(signal.SIGALRM, interrupt)
     started = time.monotonic()

@@ -357,7 +357,9 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo):
     elif report.failed:
         result.outcome = "failed" if report.when == "call" else "error"
         result.exception, result.message, result.mistake = _describe(call, _task_folder(item))
-        if call.excinfo is not None and isinstance(call.excinfo.value, call_limit.CallTimedOut):
+        if call.excinfo is not None and isinstance(
+            _stop_of(call.excinfo.value), call_limit.CallTimedOut
+        ):
             result.message = _timed_out_once(result.message, item)
     elif report.when == "call":
         result.outcome = "passed"
@@ -409,7 +411,7 @@ def _describe(call: pytest.CallInfo, folder: Path | None) -> tuple[str | None, s
     Hypothesis found) and the mistake the check recognised ('' if none)."""
     if call.excinfo is None:
         return None, "", ""
-    error = call.excinfo.value
+    error = _stop_of(call.excinfo.value)
     errors = getattr(error, "exceptions", None)  # an exception group (Python 3.10: a backport)
     if isinstance(errors, tuple) and len(errors) == 1:
         error, errors = errors[0], None
@@ -425,6 +427,11 @@ def _describe(call: pytest.CallInfo, folder: Path | None) -> tuple[str | None, s
                   for i, line in enumerate(text.splitlines())]  # fmt: skip
     kind = " and ".join(sorted(kinds))
     return kind, "\n".join(lines), mistakes.pop() if len(mistakes) == 1 else ""
+
+
+def _stop_of(error: BaseException) -> BaseException:
+    """``error``, or the stop it raised again where the student's code had caught it."""
+    return error.__cause__ if isinstance(error, call_limit.StopIgnored) else error
 
 
 def _explain(error: BaseException, folder: Path | None) -> str:

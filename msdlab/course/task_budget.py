@@ -12,7 +12,9 @@ function of the student's files that the checks called into (the outermost frame
 folder: ``DampedVerlet.step`` for a step the engine asked of it; a file's top level while it
 is imported). Time spent in the checks' own code is charged to nothing. A function that has
 used up its budget is stopped with `TaskStopped`, which says where the student's code was
-(`stuck_at`); later in the task's checks it is stopped again at its first tick.
+(`stuck_at`); later in the task's checks it is stopped again at its first tick. Code that
+catches the stop and goes on is stopped at the next tick by `StopIgnored`, which
+``except Exception`` does not catch.
 
 Works in the main thread of a POSIX process; elsewhere nothing is limited.
 """
@@ -28,6 +30,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from types import FrameType
 
+from .call_limit import StopIgnored
+
 TASK_TIMEOUT = 60.0
 """Processor seconds each function may take in its task's checks: the grader's budget."""
 
@@ -38,7 +42,7 @@ TICK = 0.05
 class TaskStopped(Exception):
     """A function of a task file used up its processor time and was stopped (an Exception,
     as pytest needs of what a fixture raises; should the student's code swallow it, the
-    next tick stops it again)."""
+    next tick raises it again as `StopIgnored`)."""
 
 
 def student_frames(frame: FrameType | None, folder: Path) -> list[FrameType]:
@@ -90,6 +94,8 @@ class TaskBudget:
     said: dict[str, str] = field(default_factory=dict)
     """Check -> what its first stop said (the check fails with it, should its code or the
     check's have caught the stop)."""
+    raised: dict[tuple[int, str], tuple[str, TaskStopped]] = field(default_factory=dict)
+    """(task, function) -> the check in which it was last stopped, and that stop."""
 
     def __post_init__(self) -> None:
         self.folder = Path(self.folder).resolve()
@@ -119,15 +125,25 @@ class TaskBudget:
         self.spent[key] = self.spent.get(key, 0.0) + TICK
         if self.spent[key] < self.seconds:
             return
-        first = self.stopped.setdefault(key, check)
+        in_check, earlier = self.raised.get(key, ("", None))
+        if in_check == check:  # its code caught the stop and went on
+            raise StopIgnored(str(earlier)) from earlier
+        self.said.setdefault(check, self._stop_message(key, check, frame))
+        stop = TaskStopped(self.said[check])
+        self.raised[key] = (check, stop)
+        raise stop
+
+    def _stop_message(self, key: tuple[int, str], check: str, frame: FrameType | None) -> str:
+        """What stopping ``key``'s function in ``check`` says: where it was, or, after its
+        first check, where to look."""
+        (task, function), first = key, self.stopped.setdefault(key, check)
         if first != check:
-            raise TaskStopped(
-                f"{key[1]} had used up its processor time in task {task}'s checks in check "
+            return (
+                f"{function} had used up its processor time in task {task}'s checks in check "
                 f"{first} and was stopped again (see there)"
             )
-        self.said[check] = (
-            f"{key[1]} used up the {self.seconds:g} s of processor time it may take in task "
+        return (
+            f"{function} used up the {self.seconds:g} s of processor time it may take in task "
             f"{task}'s checks (as when graded) and was stopped in {stuck_at(frame, self.folder)}"
             "\nan endless loop, or far too much work? (--task-timeout S allows more)"
         )
-        raise TaskStopped(self.said[check])

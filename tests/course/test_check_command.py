@@ -107,6 +107,39 @@ def test_an_endless_loop_is_stopped_and_named(capsys, tmp_path):
     assert "total: 8/9 points" in out  # the other checks do not wait for it
 
 
+SWALLOWING = """
+def particle_count(n=N):
+    while True:
+        try:
+            while True:
+                pass
+        except Exception:  # catches every stop that is an Exception, and goes on
+            pass
+"""
+
+
+@pytest.mark.parametrize(
+    ("limits", "said"),
+    [(["--call-timeout", "0.5"], "particle_count did not return within 0.5 s"),
+     (["--call-timeout", "600", "--task-timeout", "0.5"], "particle_count used up the 0.5 s")],
+)  # fmt: skip
+def test_code_that_catches_the_stop_and_goes_on_is_stopped_all_the_same(
+    capsys, tmp_path, limits, said
+):
+    """A loop that catches what stops it (``except Exception``) is stopped again a moment
+    later, by an exception it cannot catch, with what the first stop said."""
+    shutil.copy(SOLUTIONS / "task1.py", tmp_path / "task1.py")
+    with (tmp_path / "task1.py").open("a") as handle:
+        handle.write(SWALLOWING)
+    started = time.monotonic()
+    assert main(["check", "1", "--impl", str(tmp_path), *limits]) == 1
+    assert time.monotonic() - started < 60
+    out = " ".join(capsys.readouterr().out.split())
+    assert f"task1.py: {said}" in out and "StopIgnored" not in out
+    assert f"{tmp_path.name}/task1.py, line " in out and "in particle_count" in out
+    assert "total: 8/9 points" in out
+
+
 def endless(tmp_path: Path, where: str) -> Path:
     """Task 2's answer with an endless loop at the top level of the file, or at the start of
     ``where`` (a function every check of task 2 calls); its line is the file's 'while'."""
