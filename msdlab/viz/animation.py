@@ -13,6 +13,7 @@ Neither needs an external address.
 from __future__ import annotations
 
 import base64
+import html
 import io
 import uuid
 from collections.abc import Iterator, Sequence
@@ -26,6 +27,7 @@ from matplotlib.figure import Figure
 from PIL import Image
 
 from .. import Trajectory
+from .plot_words import run_in_words
 from .replay import replay_page
 from .upright import resolve_up
 from .view import BodyView, check_colour, new_axes, rim_height, sags, strains
@@ -155,15 +157,17 @@ def to_html(
 
     For Jupyter: ``IPython.display.HTML(to_html(trajectory))`` (needs no ffmpeg).
     Options as in `animate`, frames drawn at ``dpi``; the figure is closed, so no
-    still picture shows up as well.
+    still picture shows up as well. The run in words (`run_in_words`) is its caption.
     """
     import matplotlib.pyplot as plt
 
     movie = _build(
         trajectory, max_frames, fps, view, up, time_unit, energy_unit, title, spheres, colour
     )
+    axis = "xyz".index(resolve_up(up, trajectory, trajectory.body.dim))
+    words = run_in_words(trajectory, axis, time_unit, title or "Animation")
     try:
-        return html_player([_png(image) for image in movie.images(dpi)], fps)
+        return html_player([_png(image) for image in movie.images(dpi)], fps, words)
     finally:
         plt.close(movie.figure)
 
@@ -224,22 +228,30 @@ def save_animation(
     return path
 
 
-def html_player(frames_png: Sequence[bytes], fps: float) -> str:
+def html_player(frames_png: Sequence[bytes], fps: float, words: str = "") -> str:
     """An HTML player for PNG frames: play/pause, step, a slider and the frame number,
-    with the frames embedded and plain-text buttons (no fonts or scripts from the web)."""
+    with the frames embedded and plain-text buttons (no fonts or scripts from the web).
+
+    ``words`` (lines: a head, then "- " items) describe the animation: the picture's text
+    alternative is their first line, and all of them are its caption.
+    """
     name = f"msdlab_{uuid.uuid4().hex[:12]}"
     sources = ",\n".join(
         f'"data:image/png;base64,{base64.b64encode(png).decode()}"' for png in frames_png
     )
     last = len(frames_png) - 1
-    return f"""<div id="{name}" style="font-family: sans-serif">
-<img alt="animation frame" style="max-width: 100%"><br>
-<button data-do="back" title="previous frame">&#9664;&#9646;</button>
-<button data-do="play" title="play / pause">&#9654; play</button>
-<button data-do="next" title="next frame">&#9646;&#9654;</button>
-<input type="range" min="0" max="{last}" value="0" style="width: 50%; vertical-align: middle">
+    head, *items = words.splitlines() or ["animation"]
+    caption = "".join(f"<li>{html.escape(item.removeprefix('- '))}</li>" for item in items)
+    return f"""<figure id="{name}" style="font-family: sans-serif; margin: 0">
+<img alt="{html.escape(head)}" style="max-width: 100%"><br>
+<button data-do="back" aria-label="previous frame" title="previous frame">&#9664;&#9646;</button>
+<button data-do="play" aria-label="play" title="play / pause">&#9654; play</button>
+<button data-do="next" aria-label="next frame" title="next frame">&#9646;&#9654;</button>
+<input type="range" min="0" max="{last}" value="0" aria-label="frame"
+ style="width: 50%; vertical-align: middle">
 <span></span>
-</div>
+<figcaption>{html.escape(head)}<ul style="margin: 0">{caption}</ul></figcaption>
+</figure>
 <script>
 (function () {{
   const frames = [{sources}];
@@ -250,12 +262,16 @@ def html_player(frames_png: Sequence[bytes], fps: float) -> str:
   function show(i) {{
     index = (i + frames.length) % frames.length;
     image.src = frames[index]; slider.value = index;
-    label.textContent = "frame " + (index + 1) + " / " + frames.length;
+    label.textContent = "frame " + (index + 1) + " of " + frames.length;
+    slider.setAttribute("aria-valuetext", label.textContent);
   }}
-  function stop() {{ clearInterval(timer); timer = null; play.innerHTML = "&#9654; play"; }}
+  function stop() {{
+    clearInterval(timer); timer = null;
+    play.innerHTML = "&#9654; play"; play.setAttribute("aria-label", "play");
+  }}
   function start() {{
     timer = setInterval(() => show(index + 1), {1000.0 / fps:.1f});
-    play.innerHTML = "&#10073;&#10073; pause";
+    play.innerHTML = "&#10073;&#10073; pause"; play.setAttribute("aria-label", "pause");
   }}
   root.querySelector('[data-do="back"]').onclick = () => {{ stop(); show(index - 1); }};
   root.querySelector('[data-do="next"]').onclick = () => {{ stop(); show(index + 1); }};

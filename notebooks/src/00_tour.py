@@ -65,6 +65,7 @@ fig, ax = plt.subplots(figsize=(7, 3))
 ax.plot(t, stretch)
 ax.set(xlabel="time (s)", ylabel="stretch (m)", title="One particle on a spring")
 plt.show()
+print(viz.plot_in_words(ax))
 
 # %% [markdown]
 # ## A body
@@ -118,8 +119,9 @@ print(f"the cube kept its shape (every side 0.4 m ± 10 %): {np.allclose(size, 0
 print(run.energies.table())
 
 # %%
-viz.plot_energy(run.energies)
+figure = viz.plot_energy(run.energies)
 plt.show()
+print(viz.plot_in_words(figure))
 
 # %% [markdown]
 # ## Seeing it move

@@ -44,8 +44,9 @@ print(f"energy {ledger.total[0]:.0f} J at the start, {ledger.total[-1]:.0f} J af
 print(f"taken out by λ: {ledger.dissipated['viscous'][-1]:.0f} J")
 
 # %%
-viz.plot_energy(ledger)
+figure = viz.plot_energy(ledger)
 plt.show()
+print(viz.plot_in_words(figure))
 
 # %% [markdown]
 # ## Pinned along the top row, and without shear springs
@@ -69,6 +70,8 @@ for place, (name, sim) in enumerate(variants.items(), 1):
     ax = fig.add_subplot(1, 3, place, projection="3d")
     viz.plot_body(sim.body, ax=ax, view=(-30, 20), title=name)
 plt.show()
+for name, sim in variants.items():
+    print(viz.body_in_words(sim.body, up=2, title=name))
 
 # %% [markdown]
 # ## Which Euler?

@@ -44,12 +44,15 @@ from msdlab.scenes import SCENES, gallery
 # %%
 scenes = [scene for scene in SCENES.values() if scene.unit == "frames"]
 fig, axes = plt.subplots(2, 5, figsize=(16, 6))
+after = {}
 for scene, ax in zip(scenes, axes.flat):
-    sim = scene.build()
+    after[scene.name] = sim = scene.build()
     sim.run(steps=300, record_every=300)
     viz.BodyView(ax, sim.body, colorbar=False)
     ax.set(xlim=(0, gallery.WIDTH), ylim=(0, gallery.HEIGHT), title=scene.name)
 plt.show()
+for name, sim in after.items():
+    print(viz.body_in_words(sim.body, title=name))
 
 # %% [markdown]
 # ## Two models, one equilibrium
@@ -100,6 +103,7 @@ ax.plot(x, y, "o", label="the rope's particles")
 ax.set(xlabel="x (px)", ylabel="y (px)", aspect="equal")
 ax.legend()
 plt.show()
+print(viz.plot_in_words(ax))
 
 # %% [markdown]
 # ## The speed cap hides the instability

@@ -50,6 +50,7 @@ for place, view in ((1, (45, 45)), (2, (0, 0))):  # the report's two camera angl
         sim.body, ax=ax, view=view, spheres=spheres, colour="sag", title=f"after 5 s, view {view}"
     )
 plt.show()
+print(viz.body_in_words(sim.body, up=2, title="The net and the ball after 5 s"))
 
 # %% [markdown]
 # ## The seven experiments
@@ -77,6 +78,7 @@ ax.set(xlabel="time (s)", ylabel="height of the ball's centre (m)", ylim=(-2, 1.
 ax.set_title("The seven experiments")
 ax.legend(ncol=2, fontsize="small")
 plt.show()
+print(viz.plot_in_words(ax))
 
 # %% [markdown]
 # As the report says: a heavier ball sinks deeper, softer links sag more and
@@ -159,8 +161,9 @@ print(f"velocity Verlet: predicted largest stable dt {1e3 * limit:.1f} ms (the r
 # the integrator's error.
 
 # %%
-viz.plot_energy(control.energies)
+figure = viz.plot_energy(control.energies)
 plt.show()
+print(viz.plot_in_words(figure))
 
 # %% [markdown]
 # ## Live: the ball on the net

@@ -22,6 +22,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import msdlab as msd
+from msdlab import viz
 
 INTEGRATORS = [
     msd.ExplicitEuler(),
@@ -81,6 +82,7 @@ for name, ledger in ledgers.items():
 ax.set(xlabel="time (ms)", ylabel="energy / energy at the start", title="Energy drift")
 ax.legend()
 plt.show()
+print(viz.plot_in_words(ax))
 
 # %% [markdown]
 # Forward Euler gains energy in every step, at any $\Delta t$: for an undamped

@@ -19,12 +19,11 @@ import inspect
 
 import matplotlib.pyplot as plt
 import numpy as np
-from IPython.display import HTML, display
+from IPython.display import HTML
 
 import msdlab as msd
 from msdlab import viz
 from msdlab.course.notebook import Course
-from msdlab.course.plot_words import plot_in_words, run_in_words
 
 course = Course()  # your assignments/ (MSDLAB_IMPL=solutions: the reference answers)
 task1 = course.task(1)
@@ -70,7 +69,7 @@ ax.axhline(task1.FLOOR, color="k", lw=0.8, label="floor")
 ax.set(xlabel="step", ylabel="height y", title="The template's grid falls and lands")
 ax.legend()
 plt.show()
-print(plot_in_words(ax))
+print(viz.plot_in_words(ax))
 
 # %% [markdown]
 # ## Your answers
@@ -156,8 +155,7 @@ print(f"highest particle now at y = {body.positions[:, 1].max():.2f}")
 # flat sheet.
 
 # %%
-display(HTML(viz.to_html(run, max_frames=35, up="y", view=(-30, 20), time_unit="s")))
-print(run_in_words(run, time_unit="s"))
+HTML(viz.to_html(run, max_frames=35, up="y", view=(-30, 20), time_unit="s"))
 
 # %% [markdown]
 # ## Check your answers

@@ -27,7 +27,6 @@ from IPython.display import HTML, display
 import msdlab as msd
 from msdlab import viz
 from msdlab.course.notebook import Course
-from msdlab.course.plot_words import plot_in_words, run_in_words
 
 course = Course()  # your assignments/ (MSDLAB_IMPL=solutions: the reference answers)
 task2 = course.task(2)
@@ -135,7 +134,7 @@ with course.attempt():
     ax.set(xlabel="step", ylabel="energy", title="A free grid of axis springs wobbling")
     ax.legend()
     plt.show()
-    print(plot_in_words(ax))
+    print(viz.plot_in_words(ax))
 
 # %% [markdown]
 # ## The template with springs
@@ -169,7 +168,7 @@ with course.attempt():
     ax.set(xlabel="step", ylabel="y", title="A grid of axis springs lands")
     ax.legend()
     plt.show()
-    print(plot_in_words(ax))
+    print(viz.plot_in_words(ax))
 
 # %%
 with course.attempt():
@@ -177,7 +176,6 @@ with course.attempt():
     movie = msd.Trajectory(drawing, dt, steps, steps * dt, frames, None, msd.EnergyLedger())
     if np.isfinite(frames).all():
         display(HTML(viz.to_html(movie, max_frames=31, up="y", view=(-30, 20), time_unit="units")))
-        print(run_in_words(movie, time_unit="units"))
     else:  # springs that put energy in: the grid flew apart, there is nothing to draw
         blown = steps[~np.isfinite(frames).all(axis=(1, 2))][0]
         print(f"the grid blew apart (positions not finite by step {blown}): the checks say why")

@@ -25,7 +25,6 @@ from IPython.display import HTML, display
 import msdlab as msd
 from msdlab import viz
 from msdlab.course.notebook import Course
-from msdlab.course.plot_words import run_in_words
 from msdlab.engine.backends import numpy as kernels
 from msdlab.scenes import jelly
 
@@ -111,7 +110,6 @@ with course.attempt():
     sim.body.positions = task3.rotate_layout(sim.body.positions, 30, (0, 0, 1))
     run = sim.run(steps=2000, record_every=50)
     display(HTML(viz.to_html(run, max_frames=41, up="y", view=(-30, 20), time_unit="units")))
-    print(run_in_words(run, time_unit="units"))
 
 # %% [markdown]
 # ## Why it folds: counting springs

@@ -26,7 +26,6 @@ from IPython.display import HTML, display
 import msdlab as msd
 from msdlab import viz
 from msdlab.course.notebook import Course
-from msdlab.course.plot_words import plot_in_words, run_in_words
 from msdlab.scenes import jelly
 
 course = Course()  # your assignments/ (MSDLAB_IMPL=solutions: the reference answers)
@@ -95,7 +94,7 @@ with course.attempt():
     ax.set(xlabel="time", ylabel="kinetic + elastic energy", title="Damping takes energy out")
     ax.legend()
     plt.show()
-    print(plot_in_words(ax))
+    print(viz.plot_in_words(ax))
 
 # %% [markdown]
 # Each step multiplies the velocity by $1-\lambda$, so after $n$ steps it is
@@ -169,9 +168,8 @@ with course.attempt():
     ax.set(xlabel="time", ylabel="height of the cube", title="Landing, with and without damping")
     ax.legend()
     plt.show()
-    print(plot_in_words(ax))
+    print(viz.plot_in_words(ax))
     display(HTML(viz.to_html(runs[0.01], max_frames=41, up="y", view=(-30, 20), time_unit="units")))
-    print(run_in_words(runs[0.01], time_unit="units", title="Animation, λ = 0.01,"))
 
 # %% [markdown]
 # ## Check your answers

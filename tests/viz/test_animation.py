@@ -1,6 +1,7 @@
 """Animations saved as GIF, HTML and (with ffmpeg) MP4."""
 
 import base64
+import html
 import json
 import re
 import shutil
@@ -55,6 +56,15 @@ def test_to_html_is_inline_html_and_leaves_no_figure_open(rope_run):
     page = viz.to_html(rope_run, max_frames=3)
     assert "<script" in page and page.count("data:image/png;base64") == 3
     assert plt.get_fignums() == []  # Jupyter shows no stray still picture
+
+
+def test_the_inline_players_picture_has_the_runs_words(rope_run):
+    words = viz.run_in_words(rope_run, up=1, time_unit="s")
+    head, *items = words.splitlines()
+    page = viz.to_html(rope_run, max_frames=3, up="y")
+    assert f'<img alt="{html.escape(head)}"' in page and '<input type="range"' in page
+    assert all(f"<li>{html.escape(item[2:])}</li>" in page for item in items), page[-2000:]
+    assert 'aria-label="frame"' in page
 
 
 def test_a_body_without_springs_animates():
