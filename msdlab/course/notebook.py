@@ -13,7 +13,9 @@
 The task files are those of ``Course(spec)``, else of ``$MSDLAB_IMPL``, else the
 student's ``assignments/`` (even in a checkout that holds ``solutions/``), as for
 ``pytest --impl`` and ``msdlab check``; `Course.label` says when they are the reference
-answers.
+answers. A course notebook is one of msdlab's own processes: ``Course()`` makes the
+command line's process settings (`msdlab.process.configure_process`: threads that wait
+sleep, so a big body's threaded step keeps its speed on a busy machine).
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
+from ..process import configure_process
 from . import loader, manifest, own_numbers
 from .pytest_plugin import ENV_IMPL
 from .report import CheckReport
@@ -75,6 +78,7 @@ class Course:
     """The task files a notebook studies, and its notes about unfinished tasks."""
 
     def __init__(self, spec: str | None = None, start: Path | None = None) -> None:
+        configure_process()
         self.root = loader.course_root(Path.cwd() if start is None else start)
         self.spec = spec or os.environ.get(ENV_IMPL) or loader.DEFAULT
         self.folder = loader.resolve(self.spec, self.root)
