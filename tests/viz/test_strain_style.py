@@ -2,15 +2,21 @@
 simulated colour blindness, every colour keeps 3:1 against white, and the lines carry the
 strain's sign in the pictures, the live view and the replay page alike."""
 
+import json
+import re
+
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 from matplotlib.colors import Normalize, to_hex, to_rgb
 
+import msdlab as msd
 from msdlab import viz
 from msdlab.scenes import gallery
+from msdlab.viz.frontend import describe
 from msdlab.viz.lines import LEVELS, SpringLines
-from msdlab.viz.strain_style import STRAIN_MAP, STROKES, stroke_classes
+from msdlab.viz.replay import replay_page
+from msdlab.viz.strain_style import KEY, STRAIN_MAP, STROKES, stroke_classes
 
 # Machado, Oliveira and Fernandes (2009), severity 1: linear RGB seen as a dichromat sees it
 DICHROMACIES = {
@@ -114,3 +120,17 @@ def test_a_picture_of_a_pulled_body_has_its_key(tmp_path):
         "near rest length",
         "squeezed",
     ]
+
+
+def test_the_live_view_and_replay_page_get_each_levels_line_and_the_key():
+    sim = gallery.mesh()
+    scene = describe(sim, up="y", view=None, strain_limit=0.3)
+    assert [s["name"] for s in scene["strokes"]] == [s.name for s in STROKES]
+    assert scene["strokes"][0]["dash"] and scene["strokes"][2]["dash"] == []
+    assert scene["stroke_of_level"] == stroke_classes(np.arange(LEVELS), LEVELS).tolist()
+    assert scene["key"] == KEY and scene["colours"] == levels()  # the pictures' colours
+    run = msd.Simulation(sim.body).run(steps=2, record_every=1)
+    page = replay_page(run, np.arange(2), fps=10, up="y", view=None, strain_limit=0.3)
+    data = json.loads(re.search(r'id="msdlab-data">(.*?)</script>', page, re.S)[1])
+    assert data["scene"]["strokes"] == scene["strokes"]
+    assert "strainKey(root, scene)" in page  # live.js draws the key under the body
