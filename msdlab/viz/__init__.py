@@ -1,7 +1,7 @@
 """Seeing a simulation: plots of a body and of its energy ledger, animations, mouse dragging.
 
 from msdlab import viz
-viz.plot_body(sim.body)                        # springs coloured by strain
+viz.plot_body(sim.body)                        # springs drawn by strain
 viz.plot_energy(trajectory.energies)
 viz.save_animation(trajectory, "run.gif")      # or .mp4 (needs ffmpeg), .html (a replay page)
 viz.save_scene_animation(scene, sim, trajectory, "run.gif")   # a scene as the gallery draws it

@@ -250,7 +250,7 @@ def plot_body(
     save: str | Path | None = None,
     colour: str = "strain",
 ) -> Figure:
-    """Plot ``body`` (at ``positions``, default its own) with springs coloured by strain
+    """Plot ``body`` (at ``positions``, default its own) with springs drawn by strain
     (or ``colour="sag"``, see `BodyView`); return the figure, also written to ``save``
     (.png, .pdf, .svg) if given. Given a simulation, "up" is against its gravity (`upright`)."""
     if isinstance(body, Simulation):
