@@ -156,9 +156,10 @@ class BodyView:
                 label="strain" if colour == "strain" else "sag below the rim",
             )
             if strain:
+                fixed = ax.figure.get_layout_engine() is None  # a window's: above the title
                 ax.figure.legend(
                     handles=key_handles(max(width, 1.0)),
-                    loc="outside lower center",
+                    loc="upper center" if fixed else "outside lower center",
                     ncols=3,
                     fontsize="small",
                     frameon=False,
