@@ -139,3 +139,29 @@ def test_the_replay_page_draws_springs_by_strain_in_lines_and_words(tmp_path):
     assert springs == classes  # squeezed, near rest and stretched
     assert all(name in shown for name in ("stretched", "near rest length", "squeezed"))
     assert said == scene["key"] and "thin dashed" in said
+
+
+def test_a_dense_bodys_pixel_lines_are_dashed_plain_or_thick_by_class(tmp_path):
+    """Over 3000 springs the page writes 1-px lines into the pixels: a squeezed spring's is
+    dashed (3 pixels of 5), a stretched one's 2 px wide."""
+    from playwright.sync_api import sync_playwright
+
+    body = msd.Body.grid((30, 30), spacing=0.1, stiffness=800.0, neighbours=(1, 2))
+    run = msd.Simulation(body, msd.Verlet(), dt=1e-3).run(steps=2, record_every=1)
+    page_file = viz.save_animation(run, tmp_path / "net.html")
+    with sync_playwright() as playwright:
+        browser = launch(playwright)
+        try:
+            page = browser.new_page(reduced_motion="reduce")
+            page.goto(page_file.as_uri())
+            page.wait_for_function("() => window.msdlabViews?.[0]?.stats.drawn > 0")
+            painted = page.evaluate(
+                """() => [0, 1, 2].map((stroke) => {
+                  const pixels = window.msdlabViews[0].painter.pixels;
+                  pixels.clear();
+                  pixels.line(10, 10, 59, 10, 0xff000000, stroke);  // 50 px along x
+                  return pixels.words.filter((word) => word === 0xff000000).length; })"""
+            )
+        finally:
+            browser.close()
+    assert painted == [30, 50, 100]
