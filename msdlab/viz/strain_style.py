@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from matplotlib.colors import LinearSegmentedColormap, to_hex
+from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 STRAIN_MAP = LinearSegmentedColormap.from_list("msdlab-strain", ["#1f4e99", "#7f7f7f", "#a33d05"])
@@ -55,9 +56,11 @@ def linestyle(stroke: Stroke) -> str | tuple[float, tuple[float, float]]:
     return "solid" if stroke.dash is None else (0.0, stroke.dash)
 
 
-def key_handles(width: float) -> list[Line2D]:
-    """The legend's lines, stretched first, for springs of plain width ``width`` (points)."""
-    return [
+def add_key(figure: Figure, width: float) -> None:
+    """The key to the lines on ``figure``, for springs of plain width ``width`` (points):
+    under everything, or above the title of a figure without a layout engine (a window's,
+    whose axes stay still), where nothing would make room for it below."""
+    handles = [
         Line2D(
             [],
             [],
@@ -68,6 +71,16 @@ def key_handles(width: float) -> list[Line2D]:
         )
         for stroke in reversed(STROKES)
     ]
+    fixed = figure.get_layout_engine() is None
+    figure.legend(
+        handles=handles,
+        loc="upper center" if fixed else "outside lower center",
+        ncols=3,
+        fontsize="small",
+        frameon=False,
+        title="springs",
+        title_fontsize="small",
+    )
 
 
 def scene_strokes(width: float, count: int) -> dict:

@@ -25,7 +25,7 @@ from .. import Body, Simulation
 from ..engine.model.springs import EdgeSprings
 from ..interaction import SphereContact
 from .lines import SpringLines, SpringLines3D
-from .strain_style import STRAIN_MAP, key_handles
+from .strain_style import STRAIN_MAP, add_key
 from .upright import UPS, resolve_up
 
 COLOURINGS = ("strain", "sag")  # what the springs' colour shows
@@ -85,8 +85,8 @@ class BodyView:
 
     ``colour`` "strain" draws springs by strain, ``strain_limit`` drawn at full
     colour (`strain_style`: blue, thin and dashed squeezed, orange and thick
-    stretched), with a key to the lines under the figure; "sag" (3-D) by their depth below the rim
-    (the highest pinned particle), ``strain_limit`` then being the deepest colour, in
+    stretched), the key to the lines with the colour bar; "sag" (3-D) by their depth
+    below the rim (the highest pinned particle), ``strain_limit`` then being the deepest colour, in
     length units: a net's sag shows from any view. ``view`` = (azimuth, elevation) in
     degrees, report convention;
     ``spheres`` are (particle, radius) pairs drawn as balls (see `spheres_of`).
@@ -153,19 +153,10 @@ class BodyView:
                 # 3-D: below the box, clear of the z axis's label and ticks at its right
                 location="bottom" if self.is_3d else "right",
                 pad=0.06 if self.is_3d else 0.02,
-                label="strain" if colour == "strain" else "sag below the rim",
+                label="strain" if strain else "sag below the rim",
             )
             if strain:
-                fixed = ax.figure.get_layout_engine() is None  # a window's: above the title
-                ax.figure.legend(
-                    handles=key_handles(max(width, 1.0)),
-                    loc="upper center" if fixed else "outside lower center",
-                    ncols=3,
-                    fontsize="small",
-                    frameon=False,
-                    title="springs",
-                    title_fontsize="small",
-                )
+                add_key(ax.figure, max(width, 1.0))  # samples wide enough to read
 
     def values(self, positions: np.ndarray) -> np.ndarray:
         """What the springs' colour shows at ``positions``: strain or sag."""
