@@ -59,8 +59,8 @@ def described(example: dict) -> str | None:
     if scene.colour == "strain" and body.n_springs:
         strain = strains(body.edges(), body.positions)
         words += (
-            f" coloured by strain (blue squeezed, red stretched), from {strain.min():+.2%} "
-            f"to {strain.max():+.2%}"
+            " drawn by strain (thick orange stretched, dashed blue squeezed),"
+            f" from {strain.min():+.2%} to {strain.max():+.2%}"
         )
     elif body.n_springs:
         words += " coloured by their depth below the rim"

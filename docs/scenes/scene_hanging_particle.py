@@ -26,7 +26,7 @@ run = sim.run(steps=steps, record_every=max(1, steps // 30))
 print(run.energies.table(rows=5))
 
 # %%
-# The body at the end of the run, each spring coloured by its strain.
+# The body at the end of the run, each spring drawn by its strain (line and colour).
 viz.plot_scene(scene, sim)
 
 # %%

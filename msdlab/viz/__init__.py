@@ -1,7 +1,7 @@
 """Seeing a simulation: plots of a body and of its energy ledger, animations, mouse dragging.
 
 from msdlab import viz
-viz.plot_body(sim.body)                        # springs coloured by strain
+viz.plot_body(sim.body)                        # springs drawn by strain
 viz.plot_energy(trajectory.energies)
 print(viz.plot_in_words(ax))                   # a plot's lines in words (the Axes drawn on)
 viz.save_animation(trajectory, "run.gif")      # or .mp4 (needs ffmpeg), .html (a replay page)

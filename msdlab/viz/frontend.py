@@ -2,9 +2,9 @@
 
 The body's springs (int32 pairs), rest lengths (float32) and pinned particles
 (uint8) go once; positions (float32) go every frame. The scene dict holds the
-colour table of the springs (matplotlib's coolwarm in `LEVELS` levels, as the
-animations draw them), the vertical axis, the initial camera and the walls and
-floor as line segments.
+colour table of the springs (`strain_style.STRAIN_MAP` in `LEVELS` levels, as the
+animations draw them) with each level's line and the key in words, the vertical
+axis, the initial camera and the walls and floor as line segments.
 """
 
 from __future__ import annotations
@@ -14,22 +14,22 @@ from itertools import product
 from pathlib import Path
 
 import numpy as np
-from matplotlib import colormaps
 from matplotlib.colors import to_hex
 
 from .. import Body, Simulation
 from ..interaction import Ground, Walls
 from .lines import LEVELS
+from .strain_style import STRAIN_MAP, scene_strokes
 from .upright import UPS
 
 ESM = Path(__file__).with_name("live.js")  # the front end, an ES module (package data)
 SIZE = (640, 480)  # the body's canvas (px)
+SPRING_WIDTH = 1.5  # px: a spring near its rest length (see `strain_style.STROKES`)
 
 
-def colour_table(cmap: str = "coolwarm") -> list[str]:
-    """The springs' colours, squeezed (blue) to stretched (red), one per level."""
-    scale = colormaps[cmap]
-    return [to_hex(scale((level + 0.5) / LEVELS)) for level in range(LEVELS)]
+def colour_table() -> list[str]:
+    """The springs' colours, squeezed (blue) to stretched (orange), one per level."""
+    return [to_hex(STRAIN_MAP((level + 0.5) / LEVELS)) for level in range(LEVELS)]
 
 
 def body_arrays(body: Body) -> dict[str, bytes]:
@@ -113,6 +113,7 @@ def describe(
         "span": float(np.max(box_high - box_low)),
         "strain_limit": float(strain_limit),
         "colours": colour_table(),
+        **scene_strokes(SPRING_WIDTH, LEVELS),
         "world": {"edges": world},
         "spheres": [[int(p), float(r)] for p, r in spheres],
         "energy": energy,

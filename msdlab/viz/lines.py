@@ -4,8 +4,10 @@ matplotlib's `LineCollection` makes one `Path` object per segment each time its
 segments change, which for a body of thousands of springs is most of the time
 of an animation frame. `SpringLines` sorts the springs into ``LEVELS`` colour
 levels and draws each level as one path of separate segments (move to one end,
-line to the other), so a frame costs a few array operations. In 3-D axes the ends
-are projected at each draw, as `mpl_toolkits.mplot3d`'s own collections do.
+line to the other), so a frame costs a few array operations. Springs of strain also
+get their level's line (`strain_style.STROKES`: thick, plain or thin dashed), one
+width and dash per path. In 3-D axes the ends are projected at each draw, as
+`mpl_toolkits.mplot3d`'s own collections do.
 """
 
 from __future__ import annotations
@@ -15,6 +17,8 @@ from matplotlib.collections import Collection, LineCollection
 from matplotlib.path import Path
 from mpl_toolkits.mplot3d import proj3d
 
+from .strain_style import STROKES, linestyle, stroke_classes
+
 LEVELS = 64  # colours of the scale: steps of 1/64 of its range are not visible
 
 
@@ -23,13 +27,22 @@ class SpringLines(LineCollection):
 
     ``values`` are shown at the middle of their level (of ``LEVELS`` across the
     norm's range; values outside it at the ends). ``ends`` and ``values`` are
-    the springs' own data; ``get_array()`` holds the levels' values.
+    the springs' own data; ``get_array()`` holds the levels' values. With
+    ``stroke_width`` (points) the values are strains, each level drawn in its
+    `strain_style` stroke of that plain width.
     """
 
     _paths_made = True  # until the first springs are set
 
-    def __init__(self, ends: np.ndarray, values: np.ndarray, **style: object) -> None:
+    def __init__(
+        self,
+        ends: np.ndarray,
+        values: np.ndarray,
+        stroke_width: float | None = None,
+        **style: object,
+    ) -> None:
         super().__init__([], **style)
+        self.stroke_width = stroke_width
         self.set_springs(ends, values)
 
     def set_springs(self, ends: np.ndarray, values: np.ndarray) -> None:
@@ -47,6 +60,14 @@ class SpringLines(LineCollection):
         present = np.flatnonzero(counts)
         self._starts = np.concatenate([[0], np.cumsum(counts[present])])
         self.set_array(self.norm.inverse((present + 0.5) / LEVELS))
+        if self.stroke_width is not None:
+            self._set_strokes(present)
+
+    def _set_strokes(self, present: np.ndarray) -> None:
+        """Each present level's path in its class's width and dash."""
+        strokes = [STROKES[c] for c in stroke_classes(present, LEVELS)]
+        self.set_linewidth([s.width * self.stroke_width for s in strokes] or [self.stroke_width])
+        self.set_linestyle([linestyle(s) for s in strokes] or ["solid"])
 
     def _set_points(self, ends_2d: np.ndarray) -> None:
         """The ends (E, 2, 2) in level order, drawn at the next draw."""

@@ -6,8 +6,9 @@
 // the page queues the states and shows one a frame, so states that arrive together
 // (the network bunches small messages) are each shown, not only the last. 2-D bodies are drawn as they are;
 // 3-D ones through an orbit camera (orthographic: left-drag on empty space or
-// right-drag turns, the wheel zooms). Springs are coloured by strain on the
-// colour table the scene brings (matplotlib's coolwarm in 64 levels).
+// right-drag turns, the wheel zooms). Springs are drawn by strain in the colour and the
+// line of their level that the scene brings (64 levels; thin dashed squeezed, plain near
+// rest, thick stretched: msdlab/viz/strain_style.py), with a key under the body.
 // Everything works by keyboard too (the body's canvas: the focus among particles, the hand,
 // pins; the view: run, step, reset, the instruments), and the view speaks: two polite live
 // regions say what the keys did and, every 2 s at most, what the body does (words from
@@ -261,14 +262,14 @@ function surface(springs, n, outside) {
 
 /** A canvas's pixels as 32-bit words, for drawing many 1-px lines fast. */
 class Pixels {
-  constructor(canvas, colours) {
+  constructor(canvas, scene) {
     this.width = canvas.width;
     this.height = canvas.height;
     this.context = canvas.getContext("2d");
     this.image = this.context.createImageData(this.width, this.height);
     this.words = new Uint32Array(this.image.data.buffer);
-    // the springs' colours, 70 % over white as the matplotlib views draw dense bodies
-    this.colours = colours.map((hex) => this.word(hex, 0.7));
+    this.colours = scene.colours.map((hex) => this.word(hex, 1));
+    this.strokes = Uint8Array.from(scene.stroke_of_level); // each level's line, as `line` takes
     this.dark = this.word("#4d4d4d", 1);
     this.dotColour = this.word("#262626", 0.8);
   }
@@ -284,14 +285,20 @@ class Pixels {
     this.words.fill(0xffffffff);
   }
 
-  /** A 1-px line (a DDA: one pixel per step along the longer axis). */
-  line(x0, y0, x1, y1, colour) {
+  /** A line (a DDA: one pixel per step along the longer axis); `stroke` 0: 1 px dashed,
+   * 3 pixels on and 2 off, 1: 1 px, 2: 2 px wide (the classes of `strain_style.STROKES`). */
+  line(x0, y0, x1, y1, colour, stroke = 1) {
     const steps = Math.ceil(Math.max(Math.abs(x1 - x0), Math.abs(y1 - y0)));
     const dx = (x1 - x0) / (steps || 1), dy = (y1 - y0) / (steps || 1);
     const { width, height, words } = this;
+    const across = stroke === 2 ? (Math.abs(dx) > Math.abs(dy) ? width : 1) : 0;
     let x = x0 + 0.5, y = y0 + 0.5;
     for (let i = 0; i <= steps; i++, x += dx, y += dy) {
-      if (x >= 0 && y >= 0 && x < width && y < height) words[(y | 0) * width + (x | 0)] = colour;
+      if (stroke === 0 && i % 5 >= 3) continue;
+      if (x >= 0 && y >= 0 && x < width - 1 && y < height - 1) {
+        const k = (y | 0) * width + (x | 0);
+        words[k] = words[k + across] = colour;
+      }
     }
   }
 
@@ -326,7 +333,7 @@ class Painter {
     this.order = new Uint32Array(rest.length);
     this.counts = new Uint32Array(LEVELS + 1);
     this.dense = rest.length > DENSE;
-    if (this.dense) this.pixels = new Pixels(canvas, scene.colours);
+    if (this.dense) this.pixels = new Pixels(canvas, scene);
     this.shown = surface(springs, this.n, scene.dim === 3 && rest.length > SURFACE_ONLY);
     this.next = new Uint32Array(LEVELS);
     // the walls' and floor's segments: their ends, and where they are on the screen
@@ -398,8 +405,9 @@ class Painter {
       let sum = 0;
       for (let k = 0; k < d; k++) sum += (x[d * a + k] - x[d * b + k]) ** 2;
       const level = Math.floor(((Math.sqrt(sum) / rest[e] - 1 + limit) / (2 * limit)) * LEVELS);
-      const colour = pixels.colours[level < 0 ? 0 : level >= LEVELS ? LEVELS - 1 : level];
-      pixels.line(screen[2 * a], screen[2 * a + 1], screen[2 * b], screen[2 * b + 1], colour);
+      const l = level < 0 ? 0 : level >= LEVELS ? LEVELS - 1 : level;
+      pixels.line(screen[2 * a], screen[2 * a + 1], screen[2 * b], screen[2 * b + 1],
+        pixels.colours[l], pixels.strokes[l]);
     }
     const size = this.n > 2000 ? 1 : 2; // a dense body: its springs show between the dots
     for (const i of particles) pixels.dot(screen[2 * i], screen[2 * i + 1], pixels.dotColour, size);
@@ -435,11 +443,18 @@ class Painter {
     for (let e = 0; e < rest.length; e++) order[next[levels[e]]++] = e;
   }
 
+  /** The springs a path per level, in its colour and its class's width and dash. */
   drawSprings(g) {
     const { springs, order, counts, screen } = this;
-    g.lineWidth = 1.5;
+    const { strokes, stroke_of_level: strokeOf } = this.scene;
+    let stroke = -1;
     for (let l = 0; l < LEVELS; l++) {
       if (counts[l] === counts[l + 1]) continue;
+      if (strokeOf[l] !== stroke) { // the levels' classes in order: two changes at most
+        stroke = strokeOf[l];
+        g.lineWidth = strokes[stroke].width;
+        g.setLineDash(strokes[stroke].dash);
+      }
       g.beginPath();
       for (let i = counts[l]; i < counts[l + 1]; i++) {
         const a = 2 * springs[2 * order[i]], b = 2 * springs[2 * order[i] + 1];
@@ -449,6 +464,7 @@ class Painter {
       g.strokeStyle = this.scene.colours[l];
       g.stroke();
     }
+    g.setLineDash([]);
   }
 
   drawParticles(g) {
@@ -652,6 +668,7 @@ export function mountView(el, scene, arrays, source) {
   row.style.cssText = "display: flex; flex-wrap: wrap; align-items: flex-start; gap: 6px";
   const canvas = bodyCanvas(row, scene, !!source.grab);
   const energy = scene.energy ? new EnergyPanel(row, scene.energy_unit) : null;
+  strainKey(root, scene);
   const status = element("div", { className: "msdlab-status" }, root);
   const camera = new Camera(scene, canvas.width, canvas.height);
   const painter = new Painter(canvas, scene, arrays.springs, arrays.rest, arrays.fixed);
@@ -703,6 +720,31 @@ export function mountView(el, scene, arrays, source) {
   };
   requestAnimationFrame(frame);
   return view;
+}
+
+/** The key to the springs: a sample of each class's line with its name (for the eye), and
+ * the key in words (for a screen reader). */
+function strainKey(parent, scene) {
+  const key = element("div", { className: "msdlab-key" }, parent);
+  key.style.cssText = "margin: 4px 0; display: flex; flex-wrap: wrap; gap: 4px 14px; "
+    + "align-items: center; color: #333";
+  const shown = element("span", { textContent: "springs:" }, key);
+  shown.setAttribute("aria-hidden", "true");
+  for (const stroke of [...scene.strokes].reverse()) {
+    const item = element("span", {}, key);
+    item.setAttribute("aria-hidden", "true");
+    item.append(strokeSample(stroke), ` ${stroke.name}`);
+  }
+  element("span", { className: "msdlab-hidden", textContent: scene.key }, key);
+  return key;
+}
+
+/** A short line drawn as `stroke` draws springs (a border: dashed or solid). */
+function strokeSample({ width, dash, colour }) {
+  const line = element("span");
+  line.style.cssText = "display: inline-block; width: 30px; margin-right: 4px; "
+    + `vertical-align: middle; border-top: ${width}px ${dash.length ? "dashed" : "solid"} ${colour}`;
+  return line;
 }
 
 /** The body's canvas: focusable, named, its keys in a description (`live`: a live view's,

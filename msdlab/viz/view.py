@@ -1,4 +1,4 @@
-"""Drawing one body on matplotlib axes: springs coloured by strain, particles as dots.
+"""Drawing one body on matplotlib axes: springs drawn by strain, particles as dots.
 
 `BodyView` owns the artists and redraws them for new positions, so static
 plots, animations and the interactive window share one drawing. 3-D views take
@@ -25,11 +25,12 @@ from .. import Body, Simulation
 from ..engine.model.springs import EdgeSprings
 from ..interaction import SphereContact
 from .lines import SpringLines, SpringLines3D
+from .strain_style import STRAIN_MAP, add_key
 from .upright import UPS, resolve_up
 
 COLOURINGS = ("strain", "sag")  # what the springs' colour shows
 LIVE_STRAIN_LIMIT = 0.3  # strain drawn at full colour in live views: what a drag or fall reaches
-BALL_COLOUR = "tab:green"  # not on the coolwarm scale of the springs
+BALL_COLOUR = "tab:green"  # not on the strain map of the springs
 _U, _V = np.meshgrid(np.linspace(0, 2 * np.pi, 13), np.linspace(0, np.pi, 7))
 _UNIT_SPHERE = np.stack([np.cos(_U) * np.sin(_V), np.sin(_U) * np.sin(_V), np.cos(_V)])
 
@@ -82,9 +83,10 @@ def new_axes(
 class BodyView:
     """The artists drawing ``body`` on ``ax`` (2-D or 3-D axes), updated by `update`.
 
-    ``colour`` "strain" colours springs by strain, ``strain_limit`` drawn at full
-    colour (blue squeezed, red stretched); "sag" (3-D) by their depth below the rim
-    (the highest pinned particle), ``strain_limit`` then being the deepest colour, in
+    ``colour`` "strain" draws springs by strain, ``strain_limit`` drawn at full
+    colour (`strain_style`: blue, thin and dashed squeezed, orange and thick
+    stretched), the key to the lines with the colour bar; "sag" (3-D) by their depth
+    below the rim (the highest pinned particle), ``strain_limit`` then being the deepest colour, in
     length units: a net's sag shows from any view. ``view`` = (azimuth, elevation) in
     degrees, report convention;
     ``spheres`` are (particle, radius) pairs drawn as balls (see `spheres_of`).
@@ -116,12 +118,13 @@ class BodyView:
         self.colour, self.up = colour, up
         self.rim = rim_height(body, positions, up) if colour == "sag" else 0.0
         limit = strain_limit or max(1e-3, float(np.max(np.abs(self.values(positions)), initial=0)))
-        thin = body.n_springs > 300  # a dense body: light springs, so the shape shows through
+        width = 0.6 if body.n_springs > 300 else 1.2  # a dense body's shape shows through
+        strain = colour == "strain"
         style = {
-            "cmap": "coolwarm" if colour == "strain" else "cool",
-            "norm": Normalize(-limit, limit) if colour == "strain" else Normalize(0.0, limit),
-            "linewidths": 0.6 if thin else 1.2,
-            "alpha": 0.7 if thin else 1.0,
+            "cmap": STRAIN_MAP if strain else "cool",
+            "norm": Normalize(-limit, limit) if strain else Normalize(0.0, limit),
+            "linewidths": width,
+            "stroke_width": width if strain else None,
         }
         lines = SpringLines3D if self.is_3d else SpringLines
         self.springs = lines(self._segments(positions), self.values(positions), **style)
@@ -150,8 +153,10 @@ class BodyView:
                 # 3-D: below the box, clear of the z axis's label and ticks at its right
                 location="bottom" if self.is_3d else "right",
                 pad=0.06 if self.is_3d else 0.02,
-                label="strain" if colour == "strain" else "sag below the rim",
+                label="strain" if strain else "sag below the rim",
             )
+            if strain:
+                add_key(ax.figure, max(width, 1.0))  # samples wide enough to read
 
     def values(self, positions: np.ndarray) -> np.ndarray:
         """What the springs' colour shows at ``positions``: strain or sag."""
@@ -237,7 +242,7 @@ def plot_body(
     save: str | Path | None = None,
     colour: str = "strain",
 ) -> Figure:
-    """Plot ``body`` (at ``positions``, default its own) with springs coloured by strain
+    """Plot ``body`` (at ``positions``, default its own) with springs drawn by strain
     (or ``colour="sag"``, see `BodyView`); return the figure, also written to ``save``
     (.png, .pdf, .svg) if given. Given a simulation, "up" is against its gravity (`upright`)."""
     if isinstance(body, Simulation):

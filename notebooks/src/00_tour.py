@@ -127,7 +127,7 @@ print(viz.plot_in_words(figure))
 # ## Seeing it move
 #
 # `viz.to_html` makes an animation with play controls that runs in the browser
-# (no ffmpeg needed); springs are coloured by strain, blue squeezed, red stretched.
+# (no ffmpeg needed); springs show strain: thick orange stretched, dashed blue squeezed.
 
 # %%
 HTML(viz.to_html(run, max_frames=40, up="y", view=(-30, 20)))

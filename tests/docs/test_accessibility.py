@@ -103,7 +103,7 @@ def test_every_animation_is_folded_until_the_reader_plays_it(site):
 
 def test_the_gallery_pictures_say_what_they_show(site):
     """A gallery example's still says the scene, its particles and springs and the strains
-    its colours stand for; its animation what the run is."""
+    its lines and colours stand for; its animation what the run is."""
     examples = sorted((site / "gallery").glob("scene_*.html"))
     assert examples
     for example in examples:
@@ -113,5 +113,5 @@ def test_the_gallery_pictures_say_what_they_show(site):
             if src.endswith(".gif"):
                 assert alt.startswith("Animation of the run of"), (example.name, alt)
             else:
-                described = re.search(r"\d+ particles?, \d+ springs? coloured by", alt)
+                described = re.search(r"\d+ particles?, \d+ springs? (drawn|coloured) by", alt)
                 assert described, (example.name, alt)

@@ -9,6 +9,7 @@ from browser import launch, needs
 
 import msdlab as msd
 from msdlab import viz
+from msdlab.scenes import gallery
 
 pytestmark = [*needs("playwright"), pytest.mark.timeout(120)]
 
@@ -95,3 +96,72 @@ def test_the_replay_page_is_named_and_worked_by_keys(replay_file):
             assert still.get_by_role("button", name="play the replay (space)").count() == 1
         finally:
             browser.close()
+
+
+# every stroke of the canvas: its width, whether dashed, its colour (springs' and others')
+RECORD_STROKES = """
+window.strokes = [];
+const stroke = CanvasRenderingContext2D.prototype.stroke;
+CanvasRenderingContext2D.prototype.stroke = function (...path) {
+  window.strokes.push([this.lineWidth, this.getLineDash().length > 0, this.strokeStyle]);
+  return stroke.apply(this, path);
+};
+"""
+
+
+def test_the_replay_page_draws_springs_by_strain_in_lines_and_words(tmp_path):
+    """The sagging mesh's springs are drawn in their class's width and dash (squeezed
+    thin and dashed, stretched thick), and the key says so to the eye and in words."""
+    from playwright.sync_api import sync_playwright
+
+    run = gallery.mesh().run(steps=200, record_every=20)
+    replay_file = viz.save_animation(run, tmp_path / "mesh.html")
+
+    with sync_playwright() as playwright:
+        browser = launch(playwright)
+        try:
+            page = browser.new_page(reduced_motion="reduce")
+            page.add_init_script(RECORD_STROKES)
+            page.goto(replay_file.as_uri())
+            page.wait_for_function("() => window.msdlabViews?.[0]?.stats.drawn > 0")
+            page.locator(".msdlab-live").focus()
+            page.keyboard.press("End")  # the mesh sagging: its rows stretched, columns squeezed
+            page.wait_for_function("() => window.msdlabViews[0].stats.drawn > 1")
+            scene = page.evaluate("() => window.msdlabViews[0].painter.scene")
+            strokes = page.evaluate("() => window.strokes")
+            key = page.locator(".msdlab-key")
+            shown, said = key.inner_text(), key.locator(".msdlab-hidden").inner_text()
+        finally:
+            browser.close()
+    colours = set(scene["colours"])
+    springs = {(width, dashed) for width, dashed, colour in strokes if colour in colours}
+    classes = {(s["width"], bool(s["dash"])) for s in scene["strokes"]}
+    assert springs == classes  # squeezed, near rest and stretched
+    assert all(name in shown for name in ("stretched", "near rest length", "squeezed"))
+    assert said == scene["key"] and "thin dashed" in said
+
+
+def test_a_dense_bodys_pixel_lines_are_dashed_plain_or_thick_by_class(tmp_path):
+    """Over 3000 springs the page writes 1-px lines into the pixels: a squeezed spring's is
+    dashed (3 pixels of 5), a stretched one's 2 px wide."""
+    from playwright.sync_api import sync_playwright
+
+    body = msd.Body.grid((30, 30), spacing=0.1, stiffness=800.0, neighbours=(1, 2))
+    run = msd.Simulation(body, msd.Verlet(), dt=1e-3).run(steps=2, record_every=1)
+    page_file = viz.save_animation(run, tmp_path / "net.html")
+    with sync_playwright() as playwright:
+        browser = launch(playwright)
+        try:
+            page = browser.new_page(reduced_motion="reduce")
+            page.goto(page_file.as_uri())
+            page.wait_for_function("() => window.msdlabViews?.[0]?.stats.drawn > 0")
+            painted = page.evaluate(
+                """() => [0, 1, 2].map((stroke) => {
+                  const pixels = window.msdlabViews[0].painter.pixels;
+                  pixels.clear();
+                  pixels.line(10, 10, 59, 10, 0xff000000, stroke);  // 50 px along x
+                  return pixels.words.filter((word) => word === 0xff000000).length; })"""
+            )
+        finally:
+            browser.close()
+    assert painted == [30, 50, 100]
