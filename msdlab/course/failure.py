@@ -29,6 +29,10 @@ ANY_VALUE = "# or any other generated value"
 SECTION = re.compile(r"^# -{10,} (?P<name>.+?)\s*$")
 """A task file's section header, ``# ----...---- given code`` or ``... your answers``."""
 
+ARGUMENT_CHECK = re.compile(r"\b_checked_\w+\(")
+"""A call of one of the given code's checks of a function's arguments (``_checked_axis``):
+what it raises is the fault of the line that called the function with those arguments."""
+
 
 def raised_in(error: BaseException, folder: Path | None, code: bool = True) -> str:
     """'in your code: assignments/task2.py, line 51, in spring_acceleration' and (with
@@ -57,9 +61,17 @@ def outside_given_code(frames: list[tuple[str, int]]) -> int:
     """Which of the frames (file, line) of a student's task files, outermost first, names
     where an error comes from: the innermost one outside the files' given code (the section
     under ``# ---- given code``), that is, the student's line that called the given code
-    which raised; the innermost where all of them are given code."""
+    which raised; the innermost where all of them are given code. Where that line is the
+    given check of its function's arguments (`ARGUMENT_CHECK`), the student's line that
+    called the function with them."""
     for index in range(len(frames) - 1, -1, -1):
         if not in_given_code(*frames[index]):
+            while (
+                index > 0
+                and ARGUMENT_CHECK.search(linecache.getline(*frames[index]))
+                and not in_given_code(*frames[index - 1])
+            ):
+                index -= 1
             return index
     return len(frames) - 1
 

@@ -50,6 +50,30 @@ def test_an_error_in_the_given_code_names_the_students_line_that_called_it(tmp_p
     assert "line 3, in checked" in failure.raised_in(raised.value, folder)
 
 
+def test_a_given_check_of_arguments_names_the_line_that_passed_them(tmp_path):
+    """A function of the student's answers whose first line is the given check of its
+    arguments (``_checked_axis``): an argument it refuses is the fault of the student's line
+    that called the function with it, as Python reports a wrong number of arguments."""
+    folder = tmp_path / "assignments"
+    folder.mkdir()
+    bar = "# " + "-" * 75
+    (folder / "task3.py").write_text(
+        f"{bar} given code\ndef _checked_axis(axis):\n    raise ValueError('the angle?')\n\n\n"
+        f"{bar} your answers\ndef matrix(angle, axis):\n    axis = _checked_axis(axis)\n\n\n"
+        "def turn(angle, axis):\n    return matrix(axis, angle)  # the order swapped\n"
+    )
+    namespace: dict = {}
+    exec(compile((folder / "task3.py").read_text(), str(folder / "task3.py"), "exec"), namespace)
+    with pytest.raises(ValueError) as raised:
+        namespace["turn"](30.0, (0, 0, 1))
+    assert failure.raised_in(raised.value, folder).startswith(
+        "in your code: assignments/task3.py, line 12, in turn\n    return matrix(axis, angle)"
+    )
+    with pytest.raises(ValueError) as raised:  # called by a check: the function's own line
+        namespace["matrix"](30.0, 30.0)
+    assert "line 8, in matrix" in failure.raised_in(raised.value, folder)
+
+
 def test_the_failing_input_plainly():
     note = (
         "Falsifying example: test_rotation(\n    task2=<task module /a/task2.py>,\n"
