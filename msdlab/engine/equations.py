@@ -158,8 +158,8 @@ def ground_contact(
         v' = keep·v_t + ṡ n
 
     Both x' and v_t are the projection I - n nᵀ, their derivative (∂x'/∂x = ∂v_t/∂v).
-    Removed: friction's loss (1 - keep²)·½ m |v_t|² minus the contact's `kick_work`
-    of the kick ṡ - v·n.
+    Removed: friction's loss (1 - keep²)·½ m |v_t|² minus the contact's work, `kick_work`
+    of the kick ṡ - v·n (written out here: the step's trace stays short).
     """
     n0, n1, n2 = normal
     depth = height - above
@@ -169,7 +169,7 @@ def ground_contact(
     before = start_velocity[0] * n0 + start_velocity[1] * n1 + start_velocity[2] * n2
     t0, t1, t2 = velocity[0] - landing * n0, velocity[1] - landing * n1, velocity[2] - landing * n2
     normal_speed = moved / dt
-    work = kick_work(mass, normal_speed - landing, before, normal_speed)
+    work = 0.5 * mass * (normal_speed - landing) * (before + normal_speed)  # `kick_work`'s
     removed = 0.5 * (1.0 - keep * keep) * mass * (t0 * t0 + t1 * t1 + t2 * t2) - work
     v0, v1, v2 = (
         keep * t0 + normal_speed * n0,
@@ -179,18 +179,25 @@ def ground_contact(
     return (x0, x1, x2), (v0, v1, v2), removed
 
 
+def damping_kick_work(mass: float, factor: float, v_before: float, v_after: float) -> float:
+    """Work (J) of the kick a velocity ``factor`` gives a particle of ``mass`` (kg) at the start
+    of a step, along one coordinate: Δv = (factor - 1)·v_before (∂Δv/∂v_before = factor - 1),
+    `kick_work` with the step's end velocity v_after; numbers or arrays of them::
+
+        W = ½ m (factor - 1) v_before (v_before + v_after)
+    """
+    return 0.5 * mass * ((factor - 1.0) * v_before) * (v_before + v_after)  # `kick_work`'s
+
+
 def damping_work(
     masses: np.ndarray, v_before: np.ndarray, v_after: np.ndarray, factor: float
 ) -> float:
     """Energy (J) a velocity factor per step takes out of a leapfrog step.
 
     The step scales the velocity it starts from, v_before, by ``factor`` before
-    the forces act (damped Verlet, eq. 1.4: factor = 1 - λ): a kick
-    Δv = (factor - 1)·v_before (∂Δv/∂v_before = factor - 1), whose work is `contact_work`
-    with the step's end velocity v_after. Booking (1 - factor²)·½ Σ m v_before² instead
-    misses the work against the forces' kick and leaves a first-order drift. On the
-    particles of ``masses`` (N,), velocities (N, d); the numba kernel sums it by blocks of
-    particles, the Warp kernels per coordinate.
+    the forces act (damped Verlet, eq. 1.4: factor = 1 - λ): a kick whose work is
+    `damping_kick_work`, with the step's end velocity v_after, summed over the particles of
+    ``masses`` (N,), velocities (N, d). Booking (1 - factor²)·½ Σ m v_before² instead
+    misses the work against the forces' kick and leaves a first-order drift.
     """
-    kick = (factor - 1.0) * v_before
-    return -float(np.sum(kick_work(masses[:, None], kick, v_before, v_after)))
+    return -float(np.sum(damping_kick_work(masses[:, None], factor, v_before, v_after)))

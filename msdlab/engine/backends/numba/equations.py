@@ -6,15 +6,10 @@ The same functions, not copies: each is `msdlab.engine.equations`'s own code, ha
 """
 
 import numba
-from numba.extending import register_jitable
 
 from ... import equations
 
 _inlined = numba.njit(cache=True, inline="always")
-
-# `ground_contact` and `damping_work` call `equations.kick_work` by its name: numba compiles
-# that function where they call it.
-register_jitable(inline="always")(equations.kick_work)
 
 spring_state = _inlined(equations.spring_state)
 spring_energy = _inlined(equations.spring_energy)
@@ -23,7 +18,7 @@ transverse_stiffness = _inlined(equations.transverse_stiffness)
 spring_jacobian = _inlined(equations.spring_jacobian)
 acceleration = _inlined(equations.acceleration)
 ground_contact = _inlined(equations.ground_contact)
-damping_work = _inlined(equations.damping_work)
+damping_kick_work = _inlined(equations.damping_kick_work)
 
 
 @numba.njit(cache=True, inline="always")

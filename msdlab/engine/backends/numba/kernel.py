@@ -29,6 +29,7 @@ from ..contract import Advanced, Jacobians, SpringSums
 from ..layout import Layout
 from .equations import (
     acceleration,
+    damping_kick_work,
     dashpot_power,
     ground_contact,
     separation,
@@ -37,7 +38,6 @@ from .equations import (
     spring_state,
     transverse_stiffness,
 )
-from .equations import damping_work as particles_damping_work
 from .lattice import (
     NO_PLAN,
     gather_parallel,
@@ -239,17 +239,21 @@ def finite(x, v):
 
 @numba.njit(cache=True)
 def _kick_works(masses, v_before, v_after, factor, block):
-    """`equations.damping_work` (J) of the particles of ``block``: minus the work of their
-    kicks (factor - 1)·v_before."""
-    part = slice(block * BLOCK, min(len(masses), (block + 1) * BLOCK))
-    return particles_damping_work(masses[part], v_before[part], v_after[part], factor)
+    """Σ `equations.damping_kick_work` (J) of the kicks (factor - 1)·v_before over the
+    particles of ``block``."""
+    total = 0.0
+    for i in range(block * BLOCK, min(len(masses), (block + 1) * BLOCK)):
+        for q in range(v_before.shape[1]):
+            total += damping_kick_work(masses[i], factor, v_before[i, q], v_after[i, q])
+    return total
 
 
 @numba.njit(cache=True, parallel=True)
 def damping_work(masses, v_before, v_after, factor):
-    """`equations.damping_work` (J) summed by blocks of `BLOCK` particles, on the threads for
-    a big state (`PARALLEL_MIN_PARTICLES`), then over the blocks in order: the same sum
-    either way.
+    """`equations.damping_work` (J): minus the work of the kicks (factor - 1)·v_before.
+
+    Summed by blocks of `BLOCK` particles, on the threads for a big state
+    (`PARALLEL_MIN_PARTICLES`), then over the blocks in order: the same sum either way.
     """
     sums = np.empty((len(masses) + BLOCK - 1) // BLOCK)
     if len(masses) < _REDUCTIONS_MIN_PARTICLES:
@@ -261,7 +265,7 @@ def damping_work(masses, v_before, v_after, factor):
     total = 0.0
     for block in range(len(sums)):
         total += sums[block]
-    return total
+    return -total
 
 
 # The ground's clamp in one loop over the particles, with its booking on the way. The

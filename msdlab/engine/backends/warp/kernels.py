@@ -54,8 +54,8 @@ def module_name(scalar: type) -> str:
 
 
 def equations(scalar: type, module: str) -> dict[str, Any]:
-    """`msdlab.equations`' spring terms, a particle's acceleration, a kick's work and the
-    damping's, as Warp functions of ``scalar``."""
+    """`msdlab.equations`' spring terms, a particle's acceleration and the work of the
+    damping's kick, as Warp functions of ``scalar``."""
 
     @wp.func(module=module)
     def spring_state(k: scalar, rest: scalar, c: scalar, d: Any, w: Any):
@@ -74,24 +74,18 @@ def equations(scalar: type, module: str) -> dict[str, Any]:
         return force * (free / mass)
 
     @wp.func(module=module)
-    def kick_work(mass: scalar, kick: scalar, before: scalar, after: scalar) -> scalar:
-        """`equations.kick_work`: ½ m Δv (v_before + v_after), along one coordinate."""
-        return scalar(0.5) * mass * kick * (before + after)
-
-    @wp.func(module=module)
-    def damping_kick(mass: scalar, factor: scalar, before: scalar, after: scalar) -> scalar:
-        """`equations.damping_work` along one coordinate: minus the kick (factor - 1)·v's."""
-        return -kick_work(mass, (factor - scalar(1.0)) * before, before, after)
+    def damping_kick_work(mass: scalar, factor: scalar, before: scalar, after: scalar) -> scalar:
+        """`equations.damping_kick_work`: the work of the kick (factor - 1)·v_before."""
+        return scalar(0.5) * mass * ((factor - scalar(1.0)) * before) * (before + after)
 
     return {
         "spring_state": spring_state,
         "acceleration": acceleration,
-        "kick_work": kick_work,
-        "damping_kick": damping_kick,
+        "damping_kick_work": damping_kick_work,
     }
 
 
-def ground_function(scalar: type, module: str, kick_work: Any) -> Any:
+def ground_function(scalar: type, module: str) -> Any:
     """`equations.ground_contact` as a Warp function of ``scalar``."""
     vector = wp.types.vector(3, scalar)
 
@@ -120,7 +114,7 @@ def ground_function(scalar: type, module: str, kick_work: Any) -> Any:
             velocity[0] - landing * n[0], velocity[1] - landing * n[1], velocity[2] - landing * n[2]
         )
         normal_speed = moved / dt
-        work = kick_work(mass, normal_speed - landing, before, normal_speed)
+        work = scalar(0.5) * mass * (normal_speed - landing) * (before + normal_speed)
         tangential = t[0] * t[0] + t[1] * t[1] + t[2] * t[2]
         removed = scalar(0.5) * (scalar(1.0) - keep * keep) * mass * tangential - work
         speed = vector(
@@ -209,7 +203,7 @@ class Kernels:
             functions = equations(scalar, module)
             terms = spring_terms(scalar, module, functions["spring_state"])
             neighbour = lattice_neighbour(module)
-            ground = ground_function(scalar, module, functions["kick_work"])
+            ground = ground_function(scalar, module)
             functions["clamp"] = clamp_particle(scalar, module, ground)
             functions["particle_acceleration"] = particle_acceleration(scalar, module, functions)
             _KERNELS[scalar] = cls(
@@ -220,7 +214,7 @@ class Kernels:
                 energy_lattice_kernel(scalar, module, terms, neighbour),
                 energy_edges_kernel(scalar, module, terms),
                 finite_kernel(scalar, module),
-                damping_kernel(scalar, module, functions["damping_kick"]),
+                damping_kernel(scalar, module, functions["damping_kick_work"]),
                 clamp_kernel(scalar, module, functions["clamp"]),
                 reduce_kernel(scalar, module),
             )
@@ -369,7 +363,7 @@ def finite_kernel(scalar: type, module: str) -> Any:
     return finite_rows
 
 
-def damping_kernel(scalar: type, module: str, damping_kick: Any) -> Any:
+def damping_kernel(scalar: type, module: str, damping_kick_work: Any) -> Any:
     """`equations.damping_work` over the particles."""
 
     @wp.kernel(module=module)
@@ -383,8 +377,8 @@ def damping_kernel(scalar: type, module: str, damping_kick: Any) -> Any:
         i = wp.tid()
         work = scalar(0.0)
         for q in range(before.shape[1]):
-            work += damping_kick(masses[i], factor, before[i, q], after[i, q])
-        wp.atomic_add(bins, i % bins.shape[0], DAMPING, work)
+            work += damping_kick_work(masses[i], factor, before[i, q], after[i, q])
+        wp.atomic_add(bins, i % bins.shape[0], DAMPING, -work)
 
     return damping_rows
 
