@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
+Vector = tuple[float, float, float]  # three coordinates, the third 0 in 2-D
+
 
 def spring_force(
     stiffness: float,
@@ -132,27 +134,59 @@ def contact_work(
 
 def ground_contact(
     mass: float,
-    landing: float,
-    moved: float,
-    before: float,
-    tangential_squared: float,
+    position: Vector,
+    above: float,
+    velocity: Vector,
+    start: Vector,
+    start_velocity: Vector,
+    normal: Vector,
+    height: float,
     dt: float,
     keep: float,
-) -> tuple[float, float]:
-    """The ground's kick on a particle put back on its plane: the new normal speed (m/s) and
-    the energy (J) the ground removed in the step.
+) -> tuple[Vector, Vector, float]:
+    """The ground's contact with a particle that ended a step below its plane n·x = h: the
+    particle put back on the plane, its new velocity (m/s) and the energy (J) the ground
+    removed in the step.
 
-    The particle ended the step with normal velocity ``landing`` v·n and tangential speed²
-    ``tangential_squared`` |v_t|² (m²/s²), started it with normal velocity ``before``
-    v_old·n, and really moved ``moved`` (x - x_old)·n (m) along n. Its normal speed becomes
-    ṡ = moved/dt, what position Verlet implies (no bounce, no sticking), and its tangential
-    velocity is kept times ``keep`` = 1 - friction. Removed: friction's loss
-    (1 - keep²)·½ m |v_t|² minus the contact's work ½ m (ṡ - v·n)(v·n_old + ṡ)
-    (`contact_work` of the kick ṡ - v·n).
+    ``position`` x and ``velocity`` v are the step's end, ``start`` and ``start_velocity``
+    its start, ``normal`` n a unit vector, three coordinates each (0 for the third in
+    2-D); ``above`` is x·n, which found the particle below. The particle is projected
+    along n onto the plane, its normal speed becomes what position Verlet implies (no
+    bounce, no sticking), its tangential velocity is kept times ``keep`` = 1 - friction::
+
+        x' = x + (h - x·n) n,   v_t = v - (v·n) n,   ṡ = (x' - x_start)·n / dt,
+        v' = keep·v_t + ṡ n
+
+    Both x' and v_t are the projection I - n nᵀ, their derivative (∂x'/∂x = ∂v_t/∂v).
+    Removed: friction's loss (1 - keep²)·½ m |v_t|² minus the contact's work, `kick_work`
+    of the kick ṡ - v·n (written out here: the step's trace stays short).
     """
+    n0, n1, n2 = normal
+    depth = height - above
+    x0, x1, x2 = position[0] + depth * n0, position[1] + depth * n1, position[2] + depth * n2
+    landing = velocity[0] * n0 + velocity[1] * n1 + velocity[2] * n2  # v·n at the end
+    moved = (x0 - start[0]) * n0 + (x1 - start[1]) * n1 + (x2 - start[2]) * n2
+    before = start_velocity[0] * n0 + start_velocity[1] * n1 + start_velocity[2] * n2
+    t0, t1, t2 = velocity[0] - landing * n0, velocity[1] - landing * n1, velocity[2] - landing * n2
     normal_speed = moved / dt
     work = 0.5 * mass * (normal_speed - landing) * (before + normal_speed)  # `kick_work`'s
-    return normal_speed, 0.5 * (1.0 - keep * keep) * mass * tangential_squared - work
+    removed = 0.5 * (1.0 - keep * keep) * mass * (t0 * t0 + t1 * t1 + t2 * t2) - work
+    v0, v1, v2 = (
+        keep * t0 + normal_speed * n0,
+        keep * t1 + normal_speed * n1,
+        keep * t2 + normal_speed * n2,
+    )
+    return (x0, x1, x2), (v0, v1, v2), removed
+
+
+def damping_kick_work(mass: float, factor: float, v_before: float, v_after: float) -> float:
+    """Work (J) of the kick a velocity ``factor`` gives a particle of ``mass`` (kg) at the start
+    of a step, along one coordinate: Δv = (factor - 1)·v_before (∂Δv/∂v_before = factor - 1),
+    `kick_work` with the step's end velocity v_after; numbers or arrays of them::
+
+        W = ½ m (factor - 1) v_before (v_before + v_after)
+    """
+    return 0.5 * mass * ((factor - 1.0) * v_before) * (v_before + v_after)  # `kick_work`'s
 
 
 def damping_work(
@@ -161,10 +195,9 @@ def damping_work(
     """Energy (J) a velocity factor per step takes out of a leapfrog step.
 
     The step scales the velocity it starts from, v_before, by ``factor`` before
-    the forces act (damped Verlet, eq. 1.4: factor = 1 - λ): a kick
-    Δv = (factor - 1)·v_before, whose work is `contact_work` with the step's
-    end velocity v_after. Booking (1 - factor²)·½ Σ m v_before² instead misses
-    the work against the forces' kick and leaves a first-order drift.
+    the forces act (damped Verlet, eq. 1.4: factor = 1 - λ): a kick whose work is
+    `damping_kick_work`, with the step's end velocity v_after, summed over the particles of
+    ``masses`` (N,), velocities (N, d). Booking (1 - factor²)·½ Σ m v_before² instead
+    misses the work against the forces' kick and leaves a first-order drift.
     """
-    kick = (factor - 1.0) * v_before
-    return -float(np.sum(kick_work(masses[:, None], kick, v_before, v_after)))
+    return -float(np.sum(damping_kick_work(masses[:, None], factor, v_before, v_after)))

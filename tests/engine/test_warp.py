@@ -17,7 +17,7 @@ import pytest
 import msdlab as msd
 from msdlab.engine.backends import choice
 
-pytest.importorskip("warp")
+wp = pytest.importorskip("warp")
 
 
 @pytest.fixture
@@ -87,6 +87,81 @@ def test_the_state_lives_on_the_device_and_crosses_once_per_state_asked_for() ->
     run = sim.run(steps=30, record_every=10)
     assert backend.state()[0] is sim.body.positions
     np.testing.assert_array_equal(run.positions[-1], sim.body.positions)
+
+
+def copies(monkeypatch: pytest.MonkeyPatch, sim: msd.Simulation) -> dict[str, int]:
+    """Counts, from now on, the copies of x and v between the host and the device: "down",
+    a state buffer read to the host (``wp.array.numpy``); "up", host arrays written into a
+    state buffer or into the scratch arrays the contract's methods copy x and v into
+    (``wp.array.assign``)."""
+    backend, counts = sim.dynamics.springs, {"down": 0, "up": 0}
+    read, write = wp.array.numpy, wp.array.assign
+
+    def held(array: object) -> bool:
+        scratch = [backend._scratch.get(name) for name in ("x", "v")]
+        return any(array is other for other in (*backend._state, *scratch))
+
+    def counted_read(array: wp.array) -> np.ndarray:
+        counts["down"] += held(array)
+        return read(array)
+
+    def counted_write(array: wp.array, source: object) -> None:
+        counts["up"] += held(array)
+        write(array, source)
+
+    monkeypatch.setattr(wp.array, "numpy", counted_read)
+    monkeypatch.setattr(wp.array, "assign", counted_write)
+    return counts
+
+
+def test_a_public_step_copies_x_and_v_once_to_the_host(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The state stays on the device: each `sim.step()` reads x and v back once (the body's
+    new arrays) and copies nothing up, as the body holds what the device holds."""
+    sim = falling_cube("warp", n=3)
+    sim.step()  # the first step copies the body's state up
+    counted = copies(monkeypatch, sim)
+    for _ in range(5):
+        sim.step()
+    assert counted == {"down": 2 * 5, "up": 0}
+
+
+@pytest.mark.parametrize("sync", ["step", "frame"])
+def test_a_recorded_frame_copies_x_and_v_once(monkeypatch: pytest.MonkeyPatch, sync: str) -> None:
+    """A recorded frame reads x and v back once; its energies (the springs' forces for the
+    velocity at the positions, the elastic energy) are computed from the device's state,
+    not from copies of the frame sent up again."""
+    sim = falling_cube("warp", n=3)
+    sim.step()
+    counted = copies(monkeypatch, sim)
+    run = sim.run(steps=30, record_every=10, sync=sync)
+    assert counted == {"down": 2 * 3, "up": 0}
+    reference = falling_cube("numba", n=3)
+    reference.step()
+    expected = reference.run(steps=30, record_every=10)
+    np.testing.assert_allclose(run.energies.total, expected.energies.total, rtol=1e-11)
+
+
+def test_edits_of_the_body_between_steps_are_copied_up_and_seen(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """An edit in place of the arrays the backend handed out (a particle dragged, a velocity
+    set, a pin) is where the next step starts: x and v go up once, the pins too."""
+    sim, reference = falling_cube("warp", n=3), falling_cube("numba", n=3)
+    for each in (sim, reference):
+        each.step()
+    counted = copies(monkeypatch, sim)
+    for body in (sim.body, reference.body):
+        body.positions[5, 1] += 0.01  # dragged
+        body.velocities[6] = 0.0
+        body.fixed[7] = True  # pinned where it is
+    pinned = sim.body.positions[7].copy()
+    for each in (sim, reference):
+        each.step()
+    assert counted == {"down": 2, "up": 2}
+    np.testing.assert_array_equal(sim.body.positions[7], pinned)
+    np.testing.assert_array_equal(sim.body.velocities[7], 0.0)
+    np.testing.assert_allclose(sim.body.positions, reference.body.positions, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(sim.body.velocities, reference.body.velocities, atol=1e-10)
 
 
 def student_update(x: float, v: float, a: float, dt: float, damping: float) -> tuple[float, float]:

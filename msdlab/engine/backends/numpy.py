@@ -125,23 +125,22 @@ def ground_clamp(
     ``normal`` n (d,) is a unit vector; x, v are the step's new state (N, d), x_old and v_old
     its start.
     """
-    candidates = (x @ normal < height).nonzero()[0]
+    above = x @ normal
+    candidates = (above < height).nonzero()[0]
     below = candidates[~fixed[candidates]]  # fixed ones only among the few below
     if len(below) == 0:
         return 0.0
-    y, u = x.take(below, axis=0), v.take(below, axis=0)
-    depth = height - y @ normal
-    y += depth[:, None] * normal
-    x[below] = y
-    landing = u @ normal  # the normal velocity the step ended with (m/s)
-    moved = (y - x_old.take(below, axis=0)) @ normal
-    tangential = u - landing[:, None] * normal
-    keep = 1.0 - friction
-    normal_speed, removed = equations.ground_contact(
-        masses.take(below), landing, moved, v_old.take(below, axis=0) @ normal,
-        np.einsum("ij,ij->i", tangential, tangential), dt, keep,
+    dim = x.shape[1]
+    rows = np.zeros((5, 3, len(below)))  # x, v, x_old, v_old of those below, n; third 0 in 2-D
+    for k, array in enumerate((x, v, x_old, v_old)):
+        rows[k, :dim] = array.take(below, axis=0).T
+    rows[4, :dim, 0] = normal
+    put, speed, removed = equations.ground_contact(
+        masses.take(below), rows[0], above.take(below), *rows[1:4], rows[4, :, 0],
+        height, dt, 1.0 - friction,
     )  # fmt: skip
-    v[below] = keep * tangential + normal_speed[:, None] * normal
+    x[below] = np.column_stack(put[:dim])
+    v[below] = np.column_stack(speed[:dim])
     return float(np.sum(removed))
 
 

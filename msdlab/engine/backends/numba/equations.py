@@ -18,7 +18,7 @@ transverse_stiffness = _inlined(equations.transverse_stiffness)
 spring_jacobian = _inlined(equations.spring_jacobian)
 acceleration = _inlined(equations.acceleration)
 ground_contact = _inlined(equations.ground_contact)
-kick_work = _inlined(equations.kick_work)
+damping_kick_work = _inlined(equations.damping_kick_work)
 
 
 @numba.njit(cache=True, inline="always")

@@ -29,9 +29,9 @@ from ..contract import Advanced, Jacobians, SpringSums
 from ..layout import Layout
 from .equations import (
     acceleration,
+    damping_kick_work,
     dashpot_power,
     ground_contact,
-    kick_work,
     separation,
     spring_energy,
     spring_jacobian,
@@ -239,13 +239,12 @@ def finite(x, v):
 
 @numba.njit(cache=True)
 def _kick_works(masses, v_before, v_after, factor, block):
-    """Σ `equations.kick_work` (J) of the kicks (factor - 1)·v_before over the particles of
-    ``block``."""
+    """Σ `equations.damping_kick_work` (J) of the kicks (factor - 1)·v_before over the
+    particles of ``block``."""
     total = 0.0
     for i in range(block * BLOCK, min(len(masses), (block + 1) * BLOCK)):
         for q in range(v_before.shape[1]):
-            kick = (factor - 1.0) * v_before[i, q]
-            total += kick_work(masses[i], kick, v_before[i, q], v_after[i, q])
+            total += damping_kick_work(masses[i], factor, v_before[i, q], v_after[i, q])
     return total
 
 
@@ -271,9 +270,9 @@ def damping_work(masses, v_before, v_after, factor):
 
 # The ground's clamp in one loop over the particles, with its booking on the way. The
 # numpy backend's `backends.numpy.ground_clamp` takes some thirty numpy calls on the few particles
-# below the plane, which for a small body cost more than its springs; this loop does the
-# same per particle: put it back on the plane and apply `equations.ground_contact` (its new
-# normal speed and the energy removed).
+# below the plane, which for a small body cost more than its springs; this loop applies
+# the same `equations.ground_contact` per particle (put back on the plane, its new velocity
+# and the energy removed).
 
 
 @numba.njit(cache=True)
@@ -283,28 +282,36 @@ def ground_clamp(x, v, x_old, v_old, masses, fixed, normal, height, dt, friction
     keep = 1.0 - friction
     removed = 0.0
     dim = x.shape[1]
+    n = (normal[0], normal[1], normal[2] if dim == 3 else 0.0)
     for i in range(len(x)):
         above = 0.0
         for q in range(dim):
             above += x[i, q] * normal[q]
         if not above < height or fixed[i]:
             continue
-        depth = height - above
-        landing = moved = before = 0.0
-        for q in range(dim):
-            x[i, q] += depth * normal[q]
-            landing += v[i, q] * normal[q]
-            moved += (x[i, q] - x_old[i, q]) * normal[q]
-            before += v_old[i, q] * normal[q]
-        tangential = 0.0
-        for q in range(dim):
-            v[i, q] -= landing * normal[q]
-            tangential += v[i, q] * v[i, q]
-        normal_speed, lost = ground_contact(masses[i], landing, moved, before, tangential, dt, keep)
+        put, speed, lost = ground_contact(
+            masses[i],
+            row(x, i),
+            above,
+            row(v, i),
+            row(x_old, i),
+            row(v_old, i),
+            n,
+            height,
+            dt,
+            keep,
+        )
         removed += lost
         for q in range(dim):
-            v[i, q] = keep * v[i, q] + normal_speed * normal[q]
+            x[i, q] = put[q]
+            v[i, q] = speed[q]
     return removed
+
+
+@numba.njit(cache=True, inline="always")
+def row(x, i):
+    """Row i of ``x`` (N, d) as three coordinates, the third 0 in 2-D."""
+    return x[i, 0], x[i, 1], x[i, 2] if x.shape[1] == 3 else 0.0
 
 
 # The update loop: `compile_advance` turns an update such as `integrators.Verlet.update`

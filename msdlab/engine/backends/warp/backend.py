@@ -2,14 +2,17 @@
 
 Beyond the contract, a device's own state: two buffers of positions and velocities, the
 step's start (``state_0``) and its end (``state_1``), swapped after each step as Warp's
-examples do. `load` copies the host's arrays there; a whole step of an update integrator
-(`step`, or a frame of them, `frame`) runs there: the springs' gather, then one particle
-pass doing a, the update, the pinned particles, the ground and the ledger's sums, which
-come back in one copy of five numbers (`kernels.SUMS`); `state` copies x and v to the
-host once per state asked for (a recorded frame, the end of a call).
+examples do. `load` copies the host's arrays there, unless they are those `state` copied
+from there last, unedited; a whole step of an update integrator (`step`, or a frame of
+them, `frame`) runs there: the springs' gather, then one particle pass doing a, the
+update, the pinned particles, the ground and the ledger's sums, which come back in one copy
+of five numbers (`kernels.SUMS`); `state` copies x and v to the host once per state asked
+for (a recorded frame, the end of a call). A public step thus copies x and v once, to the
+host, and a recorded frame too: the ledger's energies read the device's state.
 
 The contract's methods take host arrays, as the numpy and numba backends do: they run
-the same Warp kernels on the arrays copied to the device and copy the result back. A few springs
+the same Warp kernels on the arrays copied to the device (or on the device's state, where
+the arrays are that state's host copy) and copy the result back. A few springs
 (``springs=``, a constraint's energy) and the Jacobians (implicit Euler's sparse solve runs
 on the host) are the numpy kernel's, on the host.
 """
@@ -87,13 +90,13 @@ class WarpKernel:
         self.dtype = np.float64 if precision == "float64" else np.float32
         self._state: list[wp.array] = []  # x and v of state_0, then of state_1
         self._host: tuple[np.ndarray, np.ndarray] | None = None  # what `state` handed out
+        self._seen: list[np.ndarray] = []  # the state `state` copied them from (`_holds`)
         self._sums = wp.zeros(len(SUMS), dtype=self.kernels.scalar, device=self.device)
         bins = bins or (1 if self.device.is_cpu else GPU_BINS)
         self._bins = wp.zeros((bins, len(SUMS)), dtype=self.kernels.scalar, device=self.device)
         self._scratch: dict[str, wp.array] = {}
         self._topology: tuple[object, tuple] = (None, ())
-        self._kept_particles: tuple[object, tuple] = (None, ())
-        self._stale = True  # whether the masses and pins are copied again at the next use
+        self._kept_particles: tuple[np.ndarray, ...] = ()  # `_particle_arrays`
         self._step_plans: dict[tuple, tuple[list, list]] = {}  # `_step_commands`
         self._frames: dict[tuple, tuple[object, wp.array]] = {}  # `frame`: graph, sums rows
         self._passes: dict[Callable, object] = {}  # the particle pass of each update
@@ -102,20 +105,31 @@ class WarpKernel:
 
     # ------------------------------------------------------------------ the state
     def load(self, x: np.ndarray, v: np.ndarray) -> None:
-        """Step from ``x`` (m) and ``v`` (m/s), (N, d), copied to the device (the body adopts
-        the arrays `state` hands out and may edit them in place: they are copied too)."""
+        """Step from ``x`` (m) and ``v`` (m/s), (N, d), copied to the device unless it holds
+        them already (`_holds`: the arrays `state` handed out, which the body adopts, as they
+        were; an edit in place between two steps is seen and copied)."""
+        if self._holds(0, x) and self._holds(1, v):
+            return
         if not self._state or self._state[0].shape != x.shape:
             self._state = [self._empty(x.shape) for _ in range(4)]
         self._state[0].assign(x.astype(self.dtype, copy=False))
         self._state[1].assign(v.astype(self.dtype, copy=False))
-        self._host, self._stale = None, True  # the masses and pins are read again
+        self._host = None
 
     def state(self) -> tuple[np.ndarray, np.ndarray]:
         """The positions (m) and velocities (m/s) on the device, copied to the host once per
         state (float64 arrays no one else holds)."""
         if self._host is None:
-            self._host = (self._read(self._state[0]), self._read(self._state[1]))
+            # on a GPU a copy, on Warp's CPU device the state's own memory
+            self._seen = [array.numpy() for array in self._state[:2]]
+            self._host = tuple(np.array(seen, dtype=np.float64) for seen in self._seen)
         return self._host
+
+    def _holds(self, index: int, array: np.ndarray) -> bool:
+        """Whether the device's state holds ``array`` as its positions (``index`` 0) or
+        velocities (1): the state `state` copied to the host last is still the device's,
+        and ``array`` equals it (compared on the host, nothing copied)."""
+        return self._host is not None and np.array_equal(array, self._seen[index])
 
     def step(
         self,
@@ -274,7 +288,7 @@ class WarpKernel:
             return self._reference.elastic_energy(layout, x, springs)
         total = self._scratch_array("energy", (1,))
         total.zero_()
-        positions = self._on_device(x, x)[0]
+        positions = self._device_array(0, "x", x)
         kernel, dim, arguments = self._springs(layout)[1]
         self._launch(kernel, dim, [positions, *arguments, total])
         return float(total.numpy()[0])
@@ -482,26 +496,28 @@ class WarpKernel:
 
     def _particle_arrays(self, layout: Layout) -> tuple[wp.array, wp.array]:
         """The masses (kg) and 1 for free, 0 for fixed particles, on the device: copied again
-        (in place) for a new layout and after each `load`, as the body's arrays may have been
-        edited in between."""
-        kept = self._kept_particles
-        if kept[0] is not layout:
-            if not kept[1] or kept[1][0].shape != (layout.n_particles,):
-                kept = (
-                    layout,
-                    (self._empty((layout.n_particles,)), self._empty((layout.n_particles,))),
-                )
-            self._kept_particles, self._stale = (layout, kept[1]), True
-        masses, free = self._kept_particles[1]
-        if self._stale:
-            masses.assign(layout.masses.astype(self.dtype))
-            free.assign((~layout.fixed).astype(self.dtype))
-            self._stale = False
-        return masses, free
+        (in place) when the layout's differ from those copied last, as the body's arrays may
+        be edited between steps (compared on the host with the copies kept)."""
+        n = layout.n_particles
+        if not self._kept_particles or len(self._kept_particles[0]) != n:
+            unequal = (np.full(n, np.nan), np.zeros(n, dtype=bool))  # NaN: equal to no mass
+            self._kept_particles = (*unequal, self._empty((n,)), self._empty((n,)))
+        masses, fixed, device_masses, free = self._kept_particles
+        if not (np.array_equal(layout.masses, masses) and np.array_equal(layout.fixed, fixed)):
+            masses[:], fixed[:] = layout.masses, layout.fixed
+            device_masses.assign(masses.astype(self.dtype))
+            free.assign((~fixed).astype(self.dtype))
+        return device_masses, free
 
     def _on_device(self, x: np.ndarray, v: np.ndarray) -> tuple[wp.array, wp.array]:
-        """``x`` and ``v`` copied to the device's scratch arrays."""
-        return self._upload("x", x), self._upload("v", v)
+        """``x`` and ``v`` on the device: its state where it holds them (`_holds`), else
+        copied to its scratch arrays."""
+        return self._device_array(0, "x", x), self._device_array(1, "v", v)
+
+    def _device_array(self, index: int, name: str, array: np.ndarray) -> wp.array:
+        """``array`` on the device: the state's positions (``index`` 0) or velocities (1) where
+        they are ``array`` (`_holds`), else ``array`` copied to the scratch array ``name``."""
+        return self._state[index] if self._holds(index, array) else self._upload(name, array)
 
     def _upload(self, name: str, array: np.ndarray) -> wp.array:
         """``array`` copied into the device's scratch array ``name``."""

@@ -54,8 +54,8 @@ def module_name(scalar: type) -> str:
 
 
 def equations(scalar: type, module: str) -> dict[str, Any]:
-    """`msdlab.equations`' spring terms, a particle's acceleration and the ground's kick, as
-    Warp functions of ``scalar``."""
+    """`msdlab.equations`' spring terms, a particle's acceleration and the work of the
+    damping's kick, as Warp functions of ``scalar``."""
 
     @wp.func(module=module)
     def spring_state(k: scalar, rest: scalar, c: scalar, d: Any, w: Any):
@@ -74,32 +74,57 @@ def equations(scalar: type, module: str) -> dict[str, Any]:
         return force * (free / mass)
 
     @wp.func(module=module)
-    def ground_contact(
-        mass: scalar,
-        landing: scalar,
-        moved: scalar,
-        before: scalar,
-        tangential_squared: scalar,
-        dt: scalar,
-        keep: scalar,
-    ):
-        """`equations.ground_contact`: the new normal speed and the energy removed."""
-        normal_speed = moved / dt
-        work = scalar(0.5) * mass * (normal_speed - landing) * (before + normal_speed)
-        loss = scalar(0.5) * (scalar(1.0) - keep * keep) * mass * tangential_squared
-        return normal_speed, loss - work
-
-    @wp.func(module=module)
-    def kick_work(mass: scalar, kick: scalar, before: scalar, after: scalar) -> scalar:
-        """`equations.kick_work`: ½ m Δv (v_before + v_after), along one coordinate."""
-        return scalar(0.5) * mass * kick * (before + after)
+    def damping_kick_work(mass: scalar, factor: scalar, before: scalar, after: scalar) -> scalar:
+        """`equations.damping_kick_work`: the work of the kick (factor - 1)·v_before."""
+        return scalar(0.5) * mass * ((factor - scalar(1.0)) * before) * (before + after)
 
     return {
         "spring_state": spring_state,
         "acceleration": acceleration,
-        "ground": ground_contact,
-        "kick_work": kick_work,
+        "damping_kick_work": damping_kick_work,
     }
+
+
+def ground_function(scalar: type, module: str) -> Any:
+    """`equations.ground_contact` as a Warp function of ``scalar``."""
+    vector = wp.types.vector(3, scalar)
+
+    @wp.func(module=module)
+    def ground_contact(
+        mass: scalar,
+        position: vector,
+        above: scalar,
+        velocity: vector,
+        start: vector,
+        start_velocity: vector,
+        n: vector,
+        height: scalar,
+        dt: scalar,
+        keep: scalar,
+    ):
+        """`equations.ground_contact`: the particle on the plane, its velocity, the energy."""
+        depth = height - above
+        put = vector(
+            position[0] + depth * n[0], position[1] + depth * n[1], position[2] + depth * n[2]
+        )
+        landing = velocity[0] * n[0] + velocity[1] * n[1] + velocity[2] * n[2]
+        moved = (put[0] - start[0]) * n[0] + (put[1] - start[1]) * n[1] + (put[2] - start[2]) * n[2]
+        before = start_velocity[0] * n[0] + start_velocity[1] * n[1] + start_velocity[2] * n[2]
+        t = vector(
+            velocity[0] - landing * n[0], velocity[1] - landing * n[1], velocity[2] - landing * n[2]
+        )
+        normal_speed = moved / dt
+        work = scalar(0.5) * mass * (normal_speed - landing) * (before + normal_speed)
+        tangential = t[0] * t[0] + t[1] * t[1] + t[2] * t[2]
+        removed = scalar(0.5) * (scalar(1.0) - keep * keep) * mass * tangential - work
+        speed = vector(
+            keep * t[0] + normal_speed * n[0],
+            keep * t[1] + normal_speed * n[1],
+            keep * t[2] + normal_speed * n[2],
+        )
+        return put, speed, removed
+
+    return ground_contact
 
 
 def spring_terms(scalar: type, module: str, spring_state: Any) -> Any:
@@ -178,7 +203,8 @@ class Kernels:
             functions = equations(scalar, module)
             terms = spring_terms(scalar, module, functions["spring_state"])
             neighbour = lattice_neighbour(module)
-            functions["clamp"] = clamp_particle(scalar, module, functions["ground"])
+            ground = ground_function(scalar, module)
+            functions["clamp"] = clamp_particle(scalar, module, ground)
             functions["particle_acceleration"] = particle_acceleration(scalar, module, functions)
             _KERNELS[scalar] = cls(
                 scalar,
@@ -188,7 +214,7 @@ class Kernels:
                 energy_lattice_kernel(scalar, module, terms, neighbour),
                 energy_edges_kernel(scalar, module, terms),
                 finite_kernel(scalar, module),
-                damping_kernel(scalar, module, functions["kick_work"]),
+                damping_kernel(scalar, module, functions["damping_kick_work"]),
                 clamp_kernel(scalar, module, functions["clamp"]),
                 reduce_kernel(scalar, module),
             )
@@ -337,7 +363,7 @@ def finite_kernel(scalar: type, module: str) -> Any:
     return finite_rows
 
 
-def damping_kernel(scalar: type, module: str, kick_work: Any) -> Any:
+def damping_kernel(scalar: type, module: str, damping_kick_work: Any) -> Any:
     """`equations.damping_work` over the particles."""
 
     @wp.kernel(module=module)
@@ -351,8 +377,7 @@ def damping_kernel(scalar: type, module: str, kick_work: Any) -> Any:
         i = wp.tid()
         work = scalar(0.0)
         for q in range(before.shape[1]):
-            kick = (factor - scalar(1.0)) * before[i, q]
-            work += kick_work(masses[i], kick, before[i, q], after[i, q])
+            work += damping_kick_work(masses[i], factor, before[i, q], after[i, q])
         wp.atomic_add(bins, i % bins.shape[0], DAMPING, -work)
 
     return damping_rows
@@ -360,6 +385,15 @@ def damping_kernel(scalar: type, module: str, kick_work: Any) -> Any:
 
 def clamp_particle(scalar: type, module: str, ground_contact: Any) -> Any:
     """The Warp function putting particle i back on the ground plane (`kernels.ground_clamp`)."""
+    vector = wp.types.vector(3, scalar)
+
+    @wp.func(module=module)
+    def row(x: wp.array2d(dtype=scalar), i: int):
+        """Row i of ``x`` as three coordinates, the third 0 in 2-D."""
+        third = scalar(0.0)
+        if x.shape[1] == 3:
+            third = x[i, 2]
+        return vector(x[i, 0], x[i, 1], third)
 
     @wp.func(module=module)
     def clamp(
@@ -381,22 +415,13 @@ def clamp_particle(scalar: type, module: str, ground_contact: Any) -> Any:
             above += x[i, q] * plane[q]
         if not (above < plane[3]):
             return scalar(0.0)
-        depth = plane[3] - above
-        landing = scalar(0.0)
-        moved = scalar(0.0)
-        before = scalar(0.0)
+        n = vector(plane[0], plane[1], plane[2])
+        put, speed, lost = ground_contact(
+            mass, row(x, i), above, row(v, i), row(x_old, i), row(v_old, i), n, plane[3], dt, keep
+        )
         for q in range(dim):
-            x[i, q] = x[i, q] + depth * plane[q]
-            landing += v[i, q] * plane[q]
-            moved += (x[i, q] - x_old[i, q]) * plane[q]
-            before += v_old[i, q] * plane[q]
-        tangential = scalar(0.0)
-        for q in range(dim):
-            v[i, q] = v[i, q] - landing * plane[q]
-            tangential += v[i, q] * v[i, q]
-        speed, lost = ground_contact(mass, landing, moved, before, tangential, dt, keep)
-        for q in range(dim):
-            v[i, q] = keep * v[i, q] + speed * plane[q]
+            x[i, q] = put[q]
+            v[i, q] = speed[q]
         return lost
 
     return clamp

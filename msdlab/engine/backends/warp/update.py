@@ -100,8 +100,8 @@ def particle_pass(update: Callable, kernels: Kernels, device: Any) -> Any:
     function, module = warp_function(update, kernels.scalar)
     scalar, functions = kernels.scalar, kernels.functions
     wp.set_module_options({"enable_backward": False, "fuse_fp": False}, wp.get_module(module))
-    acceleration_of, clamp, kick_work = (
-        functions["particle_acceleration"], functions["clamp"], functions["kick_work"]
+    acceleration_of, clamp, damping_kick_work = (
+        functions["particle_acceleration"], functions["clamp"], functions["damping_kick_work"]
     )  # fmt: skip
     array, table = wp.array2d(dtype=scalar), wp.array(dtype=scalar)
 
@@ -131,8 +131,7 @@ def particle_pass(update: Callable, kernels: Kernels, device: Any) -> Any:
         work = scalar(0.0)
         for q in range(x.shape[1]):
             if factor != scalar(1.0):
-                kick = (factor - scalar(1.0)) * v[i, q]
-                work += kick_work(masses[i], kick, v[i, q], v_new[i, q])
+                work += damping_kick_work(masses[i], factor, v[i, q], v_new[i, q])
             if not (wp.isfinite(x_new[i, q]) and wp.isfinite(v_new[i, q])):
                 wp.atomic_add(bins, i % bins.shape[0], NOT_FINITE, scalar(1.0))
         if work != scalar(0.0):
