@@ -2,11 +2,13 @@
 where no GPU is lent: the backend contract, the step and its trace, the energy ledger, the
 ground. tests/engine/conftest.py parametrises the engine's tests over the kernels, Warp
 among them, and keeps Warp's runs of the tests named here only; the seeds' scenes stepped
-whole on the device run on Warp in tests/scenes/test_on_warp.py.
+whole on the device, and the trampoline's first 0.6 s, run on Warp in
+tests/scenes/test_on_warp.py.
 
 Warp's CPU device runs one thread and a host integrator's every call crosses to it, so the
 whole engine suite on it would add minutes to CI; the seeds' scenes with contact forces
-(trampoline, contact ledger) pass on it too (``MSDLAB_KERNEL=warp``), in about 5 minutes.
+(trampoline, contact ledger) pass their whole tests on it too (``MSDLAB_KERNEL=warp``), in
+about 5 minutes.
 """
 
 from __future__ import annotations
