@@ -202,13 +202,23 @@ def run_checks(
 
 def _watch(process: subprocess.Popen, lines, timeout: float, progress: Progress) -> tuple[int, str]:
     """Wait for the checks' ``process``, telling ``progress`` of each check it starts (read
-    from ``lines``); its exit status and output. After ``timeout`` seconds it is ended."""
+    from ``lines``); its exit status and output. After ``timeout`` seconds, or when the wait
+    is interrupted (Ctrl-C, a notebook's interrupt, which reaches this process only), it is
+    ended."""
+    try:
+        return _read(process, lines, timeout, progress)
+    except BaseException:
+        process.kill()
+        process.wait()
+        raise
+
+
+def _read(process: subprocess.Popen, lines, timeout: float, progress: Progress) -> tuple[int, str]:
+    """`_watch`'s reading, until ``process`` ends or ``timeout`` seconds have passed."""
     deadline, output, last, buffer = time.monotonic() + timeout, bytearray(), "", b""
     streams = [process.stdout, lines]
     while process.stdout in streams:
         if time.monotonic() > deadline:
-            process.kill()
-            process.wait()
             raise ChecksDidNotRun(
                 f"the checks did not finish within {timeout:g} s"
                 + (f" (the last one started: {last})" if last else "")

@@ -56,6 +56,27 @@ def test_checks_run_on_the_graders_kernel_unless_chosen(chosen, expected, monkey
     assert report.checks and all(check.passed for check in report.checks), output
 
 
+def test_an_interrupted_run_of_the_checks_leaves_no_process_behind(monkeypatch, tmp_path):
+    """A notebook's interrupt reaches the kernel only, not the checks' pytest process: the
+    run ends that process before the interrupt goes on (it used to keep a CPU busy)."""
+    shutil.copy(SOLUTIONS / "task1.py", tmp_path / "task1.py")
+    with (tmp_path / "task1.py").open("a") as handle:
+        handle.write("\ndef particle_count(n=N):\n    while True:\n        pass\n")
+    started: list = []
+    real = runner.subprocess.Popen
+    monkeypatch.setattr(
+        runner.subprocess, "Popen", lambda *a, **k: started.append(real(*a, **k)) or started[-1]
+    )
+
+    def interrupt(running: str | None) -> None:
+        if running and "particle_count" in running:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        runner.run_checks(CHECKS, tmp_path, 1, call_timeout=600, progress=interrupt)
+    assert started[0].poll() is not None
+
+
 def test_pytests_own_output_has_no_warning_about_the_courses_config(capsys):
     """``msdlab check -v`` shows pytest's output: the course's pytest config (its
     ``timeout``) is understood by the plugins the checks run with."""
