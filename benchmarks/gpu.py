@@ -36,8 +36,8 @@ import numpy as np
 import warp as wp
 
 import msdlab as msd
+from msdlab.engine.backends.process import configure_process
 from msdlab.engine.backends.warp import WarpKernel
-from msdlab.process import configure_process
 
 configure_process()  # the process settings of the command line
 

@@ -27,7 +27,7 @@ def measure(n: int, integrator: str) -> dict:
     import resource
 
     import msdlab as msd
-    from msdlab.process import configure_process
+    from msdlab.engine.backends.process import configure_process
 
     configure_process()
 

@@ -75,7 +75,7 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=9)
     args = parser.parse_args()
 
-    from msdlab.process import configure_process
+    from msdlab.engine.backends.process import configure_process
 
     configure_process()
     print(f"{args.kernel} kernel, Verlet(0.01), gravity, ground, ledger; µs per step")

@@ -45,7 +45,7 @@ from pathlib import Path
 import numpy as np
 
 import msdlab as msd
-from msdlab.process import configure_process
+from msdlab.engine.backends.process import configure_process
 
 configure_process()  # the process settings of the command line
 

@@ -7,7 +7,7 @@ import sys
 from collections.abc import Sequence
 
 from .commands import COMMANDS, command_module
-from .process import configure_process
+from .engine.backends.process import configure_process
 
 
 def build_parser(commands: Sequence[str] = COMMANDS) -> argparse.ArgumentParser:

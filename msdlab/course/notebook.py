@@ -14,8 +14,8 @@ The task files are those of ``Course(spec)``, else of ``$MSDLAB_IMPL``, else the
 student's ``assignments/`` (even in a checkout that holds ``solutions/``), as for
 ``pytest --impl`` and ``msdlab check``; `Course.label` says when they are the reference
 answers. A course notebook is one of msdlab's own processes: ``Course()`` makes the
-command line's process settings (`msdlab.process.configure_process`: threads that wait
-sleep, so a big body's threaded step keeps its speed on a busy machine).
+command line's process settings (`msdlab.engine.backends.process.configure_process`:
+threads that wait sleep, so a big body's threaded step keeps its speed on a busy machine).
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
-from ..process import configure_process
+from ..engine.backends.process import configure_process
 from . import loader, manifest, own_numbers
 from .pytest_plugin import ENV_IMPL
 from .report import CheckReport

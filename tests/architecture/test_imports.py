@@ -4,7 +4,7 @@ engine. The layers are msdlab's folders; a module may import its own layer and t
 msdlab's layers, lowest first, are ``FOLDERS``: ``engine``; ``analysis`` and ``interaction``,
 built on it; the package ``msdlab`` itself (its ``__init__`` names the public names of the
 layers below); ``scenes`` and ``course``; ``viz``; ``instructor``; ``commands``; and last the
-modules directly in ``msdlab/``, the ways in (``cli`` and its ``process`` settings,
+modules directly in ``msdlab/``, the ways in (``cli``,
 ``__main__``, the Jupyter server's ``jupyter_extension``).
 
 The engine's layers, lowest first, are what ``msdlab/engine/`` holds, a folder or a module

@@ -10,7 +10,8 @@ import sys
 
 import pytest
 
-from msdlab import cli, process
+from msdlab import cli
+from msdlab.engine.backends import process
 
 SETTINGS = ("OMP_WAIT_POLICY", "MALLOC_MMAP_THRESHOLD_", "MALLOC_TRIM_THRESHOLD_")
 
@@ -77,7 +78,7 @@ def test_a_course_notebook_makes_them_as_the_command_line_does(tmp_path) -> None
 def test_freed_memory_is_kept_for_the_next_step(particles: int) -> None:
     """With `process.keep_freed_memory` the temporaries of a step reuse the memory of the
     last step's instead of faulting in fresh pages, and child processes inherit it."""
-    configure = "from msdlab.process import keep_freed_memory; keep_freed_memory()"
+    configure = "from msdlab.engine.backends.process import keep_freed_memory\nkeep_freed_memory()"
     step = FAULTS_PER_STEP.format(configure=configure, particles=particles)
     assert float(run(step)) < 5
     child = FAULTS_PER_STEP.format(configure="", particles=particles)
@@ -90,5 +91,5 @@ print(subprocess.run([sys.executable, "-c", {child!r}], capture_output=True, tex
 
 def test_a_setting_of_the_user_is_kept() -> None:
     user_set = "import os; os.environ['MALLOC_TRIM_THRESHOLD_'] = '131072'\n"
-    configure = "from msdlab.process import keep_freed_memory; keep_freed_memory()\n"
+    configure = "from msdlab.engine.backends import process\nprocess.keep_freed_memory()\n"
     assert run(user_set + configure + "print(os.environ.get('MALLOC_MMAP_THRESHOLD_'))") == "None"

@@ -6,5 +6,7 @@
 - `numpy`: the readable reference, the equations on whole arrays;
 - `numba`: the same equations compiled into loops (the default), loaded only when chosen;
 - `layout`: the body as the arrays every backend reads, laid out once per edit; `jacobian`:
-  the sparsity of the springs' Jacobians, part of the layout.
+  the sparsity of the springs' Jacobians, part of the layout;
+- `process`: the settings of a process that steps bodies (its threads, its memory), made
+  by msdlab's own processes, never by importing msdlab.
 """

@@ -1,5 +1,6 @@
-"""Process-wide settings for msdlab's own processes: made by the command line, never by
-importing msdlab (a library must not change the process it is imported into)."""
+"""Process-wide settings for a process that steps bodies: made by msdlab's own processes
+(the command line, a course notebook's ``Course()``), never by importing msdlab (a library
+must not change the process it is imported into)."""
 
 from __future__ import annotations
 
