@@ -34,10 +34,13 @@ def squashed_cube() -> tuple[msd.Body, np.ndarray]:
 def main(path: Path = PICTURE) -> str:
     """Draw the picture at ``path``; its words (`viz.body_in_words`)."""
     matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
     body, positions = squashed_cube()
     figure = viz.plot_body(body, positions, view=(-60, 20), up="y")
     figure.set_size_inches(4.8, 4.0)
     figure.savefig(path, dpi=80)
+    plt.close(figure)
     return viz.body_in_words(body, positions, title="The squashed jelly cube")
 
 

@@ -9,8 +9,11 @@ from msdlab.course import PROJECT_ROOT
 
 
 def test_the_jelly_picture_is_drawn_squashed_with_its_words(tmp_path):
+    import matplotlib.pyplot as plt
+
     pictures = module_at(PROJECT_ROOT / "docs" / "pictures.py", "msdlab_docs_pictures")
     words = pictures.main(tmp_path / "jelly.png")
+    assert plt.get_fignums() == []  # closed: the next test in this process starts with none
     assert Image.open(tmp_path / "jelly.png").size == Image.open(pictures.PICTURE).size
     assert words.startswith("The squashed jelly cube: a body of 216 particles and 1440 springs")
     assert "its lowest point at y = 0;" in words
