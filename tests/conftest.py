@@ -25,26 +25,6 @@ def pytest_configure(config: pytest.Config) -> None:
 # Folders whose test files share a session fixture: the built docs site, a Dask scheduler.
 SHARED = {"tests/docs", "tests/scale"}
 
-# The longest files (and the docs folder), handed to the workers first: a file of 6 minutes
-# started last keeps one worker busy after the other has run out of work.
-FIRST = (
-    "tests/journeys/test_documented_commands.py",
-    "tests/docs/",
-    "tests/course/test_grading_matrix.py",
-    "tests/journeys/",
-)
-
-
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """The files of `FIRST` first, in its order; the rest as collected."""
-
-    def rank(item: pytest.Item) -> int:
-        return next(
-            (i for i, start in enumerate(FIRST) if item.nodeid.startswith(start)), len(FIRST)
-        )
-
-    items.sort(key=rank)
-
 
 @pytest.hookimpl(optionalhook=True)
 def pytest_xdist_make_scheduler(config: pytest.Config, log: object) -> object:
