@@ -8,6 +8,7 @@ import shutil
 import subprocess
 import zlib
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 from matplotlib.animation import FFMpegWriter, FuncAnimation
@@ -28,6 +29,7 @@ def test_animate_returns_a_funcanimation_with_the_frames(rope_run):
     assert isinstance(animation, FuncAnimation)
     assert len(list(animation.new_frame_seq())) == 5
     assert animation.to_jshtml().count("data:image/png;base64") == 5
+    plt.close(animation._fig)  # the caller's figure: a later test starts with none
 
 
 def test_gif_has_one_image_per_frame(rope_run, tmp_path):
@@ -120,3 +122,4 @@ def test_a_net_animated_with_its_sag_shares_a_scale_between_runs():
     (colour_bar,) = [ax for ax in figure.axes if ax.get_xlabel() == "sag below the rim"]
     assert colour_bar.get_xlim() == pytest.approx((0.0, 0.9))  # below the 3-D box
     assert animation.to_jshtml().count("data:image/png;base64") == 5
+    plt.close(figure)
