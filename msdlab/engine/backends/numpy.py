@@ -131,14 +131,14 @@ def ground_clamp(
     if len(below) == 0:
         return 0.0
     dim = x.shape[1]
-    rows = np.zeros((5, 3, len(below)))  # x, v, x_old, v_old of those below, n; third 0 in 2-D
+    rows = np.zeros((4, 3, len(below)))  # x, v, x_old, v_old of those below; third 0 in 2-D
     for k, array in enumerate((x, v, x_old, v_old)):
         rows[k, :dim] = array.take(below, axis=0).T
-    rows[4, :dim, 0] = normal
+    n = np.zeros(3)
+    n[:dim] = normal
     put, speed, removed = equations.ground_contact(
-        masses.take(below), rows[0], above.take(below), *rows[1:4], rows[4, :, 0],
-        height, dt, 1.0 - friction,
-    )  # fmt: skip
+        masses.take(below), rows[0], above.take(below), *rows[1:], n, height, dt, 1.0 - friction
+    )
     x[below] = np.column_stack(put[:dim])
     v[below] = np.column_stack(speed[:dim])
     return float(np.sum(removed))
